@@ -1,0 +1,1 @@
+"""impactqp: rigid-body impacts as convex programs."""
