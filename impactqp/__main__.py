@@ -1,0 +1,7 @@
+"""``python -m impactqp``."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())

@@ -1,0 +1,64 @@
+"""Exception tree of impactqp.
+
+Every error the library raises on purpose derives from :class:`ImpactError`.
+Errors caused by the caller's input also derive from :class:`ValueError`, so
+``except ValueError`` keeps working for code that does not know impactqp.
+"""
+
+from __future__ import annotations
+
+
+class ImpactError(Exception):
+    """Root of all impactqp errors."""
+
+
+class InputError(ImpactError, ValueError):
+    """An argument has the wrong shape, type or value; the message names it."""
+
+
+class ShapeError(InputError):
+    """Arrays whose shapes do not fit together."""
+
+
+class NonFiniteError(InputError):
+    """NaN or infinity where a finite number is required."""
+
+
+class MassMatrixError(InputError):
+    """The mass matrix is not symmetric positive definite."""
+
+
+class RestitutionError(InputError):
+    """A restitution coefficient outside [0, 1] (or NaN)."""
+
+
+class UnknownBackendError(InputError):
+    """A backend name that impactqp does not know or cannot load."""
+
+
+class NonConvexLCPError(InputError):
+    """An LCP whose matrix is not symmetric positive semidefinite.
+
+    Such an LCP is not a convex QP; impactqp refuses it instead of answering
+    with something that is not a solution.
+    """
+
+
+class NonSymmetricLCPError(NonConvexLCPError):
+    """An LCP whose matrix is not symmetric."""
+
+
+class BackendUnsuitableError(ImpactError):
+    """A backend cannot handle this program (size, structure); try another one."""
+
+
+class SolverError(ImpactError):
+    """A backend failed or returned an answer that does not pass its certificate."""
+
+
+class NoSolutionError(ImpactError):
+    """The impact law has no solution for this input (e.g. an unbounded LCP)."""
+
+
+class CertificateError(SolverError):
+    """No backend produced an answer within the certificate's tolerance."""
