@@ -61,8 +61,10 @@ class CheckResult:
     meaning: str
 
     def line(self) -> str:
+        """One summary line: name, PASS/FAIL, margin and worst cone."""
         flag = "PASS" if self.passed else "FAIL"
-        return f"  {self.name:<23} {flag}  {self.meaning} = {self.margin:.3g}  (worst: {self.worst})"
+        return (f"  {self.name:<23} {flag}  {self.meaning} = {self.margin:.3g}"
+                f"  (worst: {self.worst})")
 
 
 @dataclass(frozen=True)
@@ -88,7 +90,13 @@ class SectorCertificate:
     reason: str
 
     @property
+    def admissible(self) -> bool:
+        """Kinematically, kinetically and energetically consistent on every cone (§2)."""
+        return self.kinematic.passed and self.kinetic.passed and self.energetic.passed
+
+    @property
     def checks(self) -> tuple[CheckResult, ...]:
+        """All six global checks, in summary order."""
         return (self.kinematic, self.kinetic, self.energetic, self.continuity,
                 self.non_expansive, self.velocity_non_expansive)
 
@@ -254,11 +262,11 @@ def certify_sector_table(table: Any, exact_energy: bool | None = None) -> Sector
               for i in range(len(cones))]
 
     def worst_min(name: str, vals: FloatArray, ok: NDArray[np.bool_], meaning: str) -> CheckResult:
-        i = int(np.argmin(np.where(ok, vals, -np.inf))) if not ok.all() else int(np.argmin(vals))
+        i = int(np.argmin(vals if ok.all() else np.where(ok, np.inf, vals)))  # worst failing
         return CheckResult(name, bool(ok.all()), float(vals.min()), labels[i], meaning)
 
     def worst_max(name: str, vals: FloatArray, ok: NDArray[np.bool_], meaning: str) -> CheckResult:
-        i = int(np.argmax(vals))
+        i = int(np.argmax(vals if ok.all() else np.where(ok, -np.inf, vals)))
         return CheckResult(name, bool(ok.all()), float(vals.max()), labels[i], meaning)
 
     kinematic = worst_min("kinematic", kin, kin >= -TOL, "min Q r")
@@ -281,12 +289,17 @@ def certify_sector_table(table: Any, exact_energy: bool | None = None) -> Sector
         reason = (f"discontinuous between cones '{pa}' and '{pb}' "
                   f"(jump {jmax:.3g} on a shared ray)")
     elif not non_exp.passed:
-        reason = f"piece on cone '{non_exp.worst}' expands the G⁻¹ norm (λ_max = {non_exp.margin:.6g})"
+        reason = (f"piece on cone '{non_exp.worst}' expands the G⁻¹ norm "
+                  f"(λ_max = {non_exp.margin:.6g})")
     elif not vel.passed:
-        reason = f"velocity map on cone '{vel.worst}' expands the M norm (‖A‖_M = {vel.margin:.6g})"
+        reason = (f"velocity map on cone '{vel.worst}' expands the M norm "
+                  f"(‖A‖_M = {vel.margin:.6g})")
     else:
         reason = (f"continuous across all {len(pairs)} neighbour pairs and every piece is "
                   "non-expansive in G⁻¹ and M, so the law is non-expansive, hence maximal "
                   "monotone (§6, §7)")
+    for c in (kinematic, kinetic, energetic):
+        if not c.passed:
+            reason += f"; note: {c.name} consistency fails on cone '{c.worst}'"
     return SectorCertificate(int(table.n_balls), len(cones), len(pairs), tuple(checks),
                              kinematic, kinetic, energetic, continuity, non_exp, vel, mm, reason)

@@ -216,7 +216,7 @@ def test_certificate_passes(n: int) -> None:
     assert cert.continuity.margin <= 1e-12
     assert cert.non_expansive.margin == pytest.approx(1.0, abs=1e-12)
     assert cert.velocity_non_expansive.margin == pytest.approx(1.0, abs=1e-12)
-    assert cert.maximal_monotone
+    assert cert.maximal_monotone and cert.admissible
     assert "maximal monotone" in cert.reason
     assert cert.n_neighbour_pairs == math.factorial(n) * (n - 1) // 2
     assert len(cert.cones) == math.factorial(n)
@@ -266,6 +266,7 @@ def test_expanding_but_continuous_law_fails_non_expansiveness() -> None:
     assert not cert.non_expansive.passed and cert.non_expansive.margin == pytest.approx(1.21)
     assert not cert.energetic.passed and cert.energetic.margin < 0
     assert not cert.maximal_monotone and "expands" in cert.reason
+    assert not cert.admissible and "energetic consistency fails" in cert.reason
 
 
 def test_expansion_matches_scipy_generalized_eigenvalues() -> None:
