@@ -1,30 +1,22 @@
-"""Command-line entry point ``impactqp``."""
+"""Command-line entry point ``impactqp``: each subcommand lives in :mod:`impactqp.commands`."""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
+from .commands import demo
 from .errors import ImpactError
 
-
-def _demo(args: argparse.Namespace) -> int:
-    from .demo import cradle_rows, format_rows
-
-    print(f"Newton's cradle, {args.balls} balls, ball 1 released at v = {args.v:g} (unit masses)")
-    print(format_rows(cradle_rows(n_balls=args.balls, v=args.v, backend=args.backend)))
-    return 0
+COMMANDS = [demo]
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="impactqp",
                                      description="Rigid-body impacts as convex programs.")
     sub = parser.add_subparsers(dest="command", required=True)
-    demo = sub.add_parser("demo", help="Newton's cradle through Moreau's law, verified")
-    demo.add_argument("--balls", type=int, default=3, help="number of balls (default 3)")
-    demo.add_argument("--v", type=float, default=1.0, help="speed of the released ball")
-    demo.add_argument("--backend", default="auto", help="QP backend (default auto)")
-    demo.set_defaults(func=_demo)
+    for command in COMMANDS:
+        command.register(sub)
     return parser
 
 
