@@ -44,14 +44,14 @@ def _check(masses, u, eps, ndim: int) -> tuple[np.ndarray, np.ndarray, float]:
     m = np.asarray(masses, dtype=float)
     if m.ndim != 1 or m.size == 0:
         raise ValueError(f"masses must be a non-empty 1-D array, got shape {m.shape}")
-    if not (np.all(np.isfinite(m)) and np.all(m > 0)):
+    if not (m.min() > 0.0 and m.max() < np.inf):  # NaN fails the first test
         raise ValueError("masses must be positive and finite")
     name = "u_minus" if ndim == 1 else "U_minus"
     u = np.asarray(u, dtype=float)
     if u.ndim != ndim or u.shape[-1] != m.size:
         want = "(N,)" if ndim == 1 else "(k, N)"
         raise ValueError(f"{name} must have shape {want} with N = {m.size}, got {u.shape}")
-    if not np.all(np.isfinite(u)):
+    if not np.isfinite(u).all():
         raise ValueError(f"{name} must be finite")
     try:
         e = float(eps)
@@ -128,21 +128,25 @@ def _finish(m, u, z, eps, left: bool, right: bool) -> ChainSolution:
     # inactive contacts (z strictly separating), per complementarity (§3).
     c = np.zeros((k, n + 1))
     c[:, 1:] = _prefix_sums(m * (z - u))
-    idx = np.arange(n + 1)
     if left and right:
         # z = 0: every contact is active and Λ is one of the set Λ_min + t (1, ..., 1),
         # t >= 0 (W has rank N, N+1 columns).  Λ_min (componentwise least, so least in
-        # every norm) takes L_0 = max_j C_j, i.e. the anchor is argmax C.
-        anchor = np.broadcast_to(np.argmax(c, axis=1)[:, None], c.shape)
+        # every norm) takes L_0 = max_j C_j (C_0 = 0 keeps L_0 >= 0).
+        lam = c.max(axis=1, keepdims=True) - c
     else:
         a = np.empty((k, n + 1), dtype=bool)
         a[:, 0] = (z[:, 0] > 0.0) if left else True
         a[:, n] = (z[:, -1] < 0.0) if right else True
-        a[:, 1:n] = z[:, 1:] > z[:, :-1]
-        last = np.maximum.accumulate(np.where(a, idx, -1), axis=1)
-        nxt = np.minimum.accumulate(np.where(a, idx, n + 1)[:, ::-1], axis=1)[:, ::-1]
-        anchor = np.where(last >= 0, last, nxt)  # leading segment: anchor to the right
-    lam = np.take_along_axis(c, anchor, axis=1) - c
+        np.greater(z[:, 1:], z[:, :-1], out=a[:, 1:n])
+        pos = np.flatnonzero(a)  # anchors, flat index into c
+        counts = np.empty_like(pos)
+        if left:  # every row ends with an anchor (L_N = 0): use the next anchor
+            counts[:1] = pos[:1] + 1
+            np.subtract(pos[1:], pos[:-1], out=counts[1:])
+        else:  # every row starts with an anchor (L_0 = 0): use the last anchor
+            counts[-1:] = k * (n + 1) - pos[-1:]
+            np.subtract(pos[1:], pos[:-1], out=counts[:-1])
+        lam = np.repeat(c.ravel()[pos], counts).reshape(k, n + 1) - c
     lam = lam[:, (0 if left else 1):(n + 1 if right else n)]
     if eps == 0.0:
         return ChainSolution(u_plus=z.copy(), impulses=lam, z=z)
