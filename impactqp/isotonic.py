@@ -83,34 +83,27 @@ def _pava_rows(y: np.ndarray, w: np.ndarray) -> np.ndarray:
     iteration treats all k rows at once, so cost is O(k N) array work for small N.
     """
     k, n = y.shape
-    rows = np.arange(k)
-    bw = np.empty((k, n))  # block weight sums (a stack per row)
-    bs = np.empty((k, n))  # block weighted sums of y
-    bm = np.empty((k, n))  # block means
-    b0 = np.empty((k, n), dtype=np.intp)  # first index of each block
-    top = np.zeros(k, dtype=np.intp)  # stack height per row
+    base = np.arange(k) * n  # row r's stack lives in the flat slots base[r] .. base[r]+n-1
+    bw, bs, bm = np.empty(k * n), np.empty(k * n), np.empty(k * n)  # weight, sum, mean
+    b0 = np.empty(k * n, dtype=np.intp)  # first index of each block
+    top = base.copy()  # next free slot per row
     for j in range(n):
-        bw[rows, top] = w[j]
-        bs[rows, top] = w[j] * y[:, j]
-        bm[rows, top] = y[:, j]
-        b0[rows, top] = j
+        bw[top], bs[top], bm[top], b0[top] = w[j], w[j] * y[:, j], y[:, j], j
         top += 1
-        act = rows if j > 0 else rows[:0]
-        while act.size:
+        act = np.flatnonzero(bm[top - 2] > bm[top - 1]) if j else top[:0]
+        while act.size:  # pool adjacent violators; at most j merges per row
             t = top[act]
-            act = act[bm[act, t - 2] > bm[act, t - 1]]  # adjacent violators: pool them
-            if not act.size:
-                break
-            t = top[act]
-            bw[act, t - 2] += bw[act, t - 1]
-            bs[act, t - 2] += bs[act, t - 1]
-            bm[act, t - 2] = bs[act, t - 2] / bw[act, t - 2]
-            top[act] -= 1
-            act = act[top[act] >= 2]
-    valid = np.arange(n)[None, :] < top[:, None]
+            bw[t - 2] += bw[t - 1]
+            bs[t - 2] += bs[t - 1]
+            bm[t - 2] = bs[t - 2] / bw[t - 2]
+            top[act] = t = t - 1
+            keep = t - base[act] >= 2
+            act, t = act[keep], t[keep]
+            act = act[bm[t - 2] > bm[t - 1]]
+    valid = np.arange(n)[None, :] < (top - base)[:, None]
     mark = np.zeros((k, n), dtype=np.intp)
-    mark[np.nonzero(valid)[0], b0[valid]] = 1
-    return np.take_along_axis(bm, np.cumsum(mark, axis=1) - 1, axis=1)
+    mark[np.nonzero(valid)[0], b0.reshape(k, n)[valid]] = 1
+    return bm[np.cumsum(mark, axis=1) - 1 + base[:, None]]
 
 
 def _finish(m, u, z, eps, left: bool, right: bool) -> ChainSolution:
@@ -215,8 +208,9 @@ def chain_moreau_batch(
     eps, left_wall, right_wall
         As in :func:`chain_moreau`.
     pava_max_n : int, default 64
-        For ``N <= pava_max_n`` a PAVA vectorised over rows is used; above it, scipy's
-        ``isotonic_regression`` row by row (both exact, same answer).
+        For ``N <= pava_max_n`` and ``k >= 2 N`` a PAVA vectorised over rows is used
+        (its cost is ~N Python-level steps); otherwise scipy's ``isotonic_regression`` row
+        by row.  Both are exact and agree to rounding.
 
     Returns
     -------
@@ -225,7 +219,7 @@ def chain_moreau_batch(
         row i equals ``chain_moreau(masses, U_minus[i], ...)``.
     """
     m, u, e = _check(masses, U_minus, eps, 2)
-    if m.size <= pava_max_n or u.shape[0] == 0:
+    if (m.size <= pava_max_n and u.shape[0] >= 2 * m.size) or u.shape[0] == 0:
         z = _pava_rows(u, m)
     else:
         z = np.stack([isotonic_regression(r, weights=m).x for r in u])

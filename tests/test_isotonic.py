@@ -155,6 +155,8 @@ def test_batch_empty_and_pava_vs_scipy_path():
     a = chain_moreau_batch(m, U, 0.2, pava_max_n=0)
     b = chain_moreau_batch(m, U, 0.2)
     np.testing.assert_allclose(a.impulses, b.impulses, atol=1e-14)
+    c = chain_moreau_batch(m, U[:2], 0.2)  # k < 2N: scipy path
+    np.testing.assert_allclose(c.z, b.z[:2], atol=1e-15)
 
 
 @pytest.mark.parametrize("args,word", [
