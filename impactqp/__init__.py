@@ -7,6 +7,7 @@ classification (:func:`classify`). See ``docs`` in the README for the convention
 """
 
 from .admissible import AdmissibleSet, Membership
+from .batch import BatchResult, moreau_batch
 from .certificate import Certificate
 from .classify import Classification, classify
 from .errors import (BackendUnsuitableError, CertificateError, ImpactError, InputError,
@@ -22,10 +23,10 @@ from .result import ImpactResult
 __version__ = "0.1.0"
 
 __all__ = [
-    "AdmissibleSet", "BackendUnsuitableError", "Certificate", "CertificateError", "ChainInfo",
+    "AdmissibleSet", "BatchResult", "BackendUnsuitableError", "Certificate", "CertificateError", "ChainInfo",
     "Classification", "ImpactError", "ImpactProblem", "ImpactResult", "ImpactStructure",
     "InputError", "LCPResult", "MassMatrixError", "Membership", "NoSolutionError",
     "NonConvexLCPError", "NonFiniteError", "NonSymmetricLCPError", "RestitutionError",
     "ShapeError", "SolverError", "UnknownBackendError", "chain", "classify", "fremond",
-    "moreau", "newton", "newtons_cradle", "random_impact", "solve_lcp",
+    "moreau", "moreau_batch", "newton", "newtons_cradle", "random_impact", "solve_lcp",
 ]

@@ -120,7 +120,7 @@ class AdmissibleSet:
         lam, res = best_impulses(p, u - p.u_minus)
         st = p.structure
         gamma = st.Wt_times(u)
-        s = np.sqrt(st.delassus_diagonal)
+        s = st.contact_scale
         kinematic = float(max(0.0, -np.min(gamma / (s * V), initial=0.0)))
         energetic = max(0.0, (p.norm(u) ** 2 - self.radius**2) / V**2)
         kinetic = res / V

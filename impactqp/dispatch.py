@@ -11,7 +11,7 @@ from typing import Callable, TypeVar
 import numpy as np
 from scipy.optimize import linprog
 
-from .backends import get_backend, parse_backend
+from .backends import get_backend
 from .backends.exact import MAX_CONSTRAINTS
 from .backends.nnls_ import MAX_VARIABLES
 from .certificate import Certificate
@@ -36,12 +36,6 @@ def auto_backends(qp: QuadraticProgram) -> list[str]:
     if qp.n_constraints <= MAX_CONSTRAINTS and "exact" not in names:
         names.append("exact")
     return names
-
-
-def check_backend_name(backend: str) -> None:
-    """Raise UnknownBackendError early for a bad name (before any solve)."""
-    if backend != "auto":
-        parse_backend(backend)
 
 
 def lcp_feasible(qp: QuadraticProgram) -> bool:

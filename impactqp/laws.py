@@ -13,9 +13,12 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from .backends import parse_backend
 from .certificate import DEFAULT_TOL, certify
-from .dispatch import check_backend_name, solve_certified
-from .errors import InputError, NonFiniteError, RestitutionError, ShapeError
+from .dispatch import solve_certified
+from .errors import (CertificateError, InputError, NonFiniteError, RestitutionError,
+                     ShapeError)
+from .fastpaths import FAST_PATHS, applies, lcp_fast, moreau_fast
 from .problem import ImpactProblem
 from .program import QPSolution, QuadraticProgram
 from .result import ImpactResult
@@ -42,6 +45,20 @@ def check_restitution(name: str, value: Any, m: int, *, matrix: bool = False) ->
     return arr
 
 
+def check_backend_name(backend: str) -> None:
+    """Raise UnknownBackendError early for a bad name (before any solve)."""
+    if backend not in ("auto",) + FAST_PATHS:
+        parse_backend(backend)
+
+
+def _fast_result(problem, law, coef, answer, path, cert, form):
+    """Accept a fast path's answer when its certificate passes; a named path must pass."""
+    if cert.ok:
+        u, lam, z = answer
+        return ImpactResult(problem, law, coef, u, lam, path, cert, form=form, z=z)
+    return None
+
+
 def _check_problem(problem: Any) -> None:
     if not isinstance(problem, ImpactProblem):
         raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
@@ -54,11 +71,17 @@ def _no_contact(problem: ImpactProblem, law: str, coef) -> ImpactResult:
     return ImpactResult(problem, law, coef, u, lam, "none", cert, z=u.copy())
 
 
-def impulse_program(problem: ImpactProblem, q: np.ndarray) -> QuadraticProgram:
-    """Impulse form min ½ΛᵀGΛ + qᵀΛ, Λ ≥ 0 (§3), with the factor B = L⁻¹W when dense."""
+def impulse_program(problem: ImpactProblem, q: np.ndarray,
+                    moreau_scale: float | None = None) -> QuadraticProgram:
+    """Impulse form min ½ΛᵀGΛ + qᵀΛ, Λ ≥ 0 (§3), with the factor B = L⁻¹W when dense.
+
+    For Moreau's law (q = (1+ε)γ⁻, ``moreau_scale`` = 1+ε) q = Bᵀd with d = (1+ε)Lᵀu⁻.
+    """
     st = problem.structure
-    factor = None if st.sparse else st.scaled_W
-    return QuadraticProgram(P=st.delassus, c=q, factor=factor)
+    if st.sparse:
+        return QuadraticProgram(P=st.delassus, c=q)
+    d = None if moreau_scale is None else moreau_scale * (st.cholesky_factor.T @ problem.u_minus)
+    return QuadraticProgram(P=st.delassus, c=q, factor=st.scaled_W, factor_rhs=d)
 
 
 def velocity_program(problem: ImpactProblem) -> QuadraticProgram:
@@ -106,9 +129,19 @@ def moreau(problem: ImpactProblem, eps: float = 0.0, backend: str = "auto", *,
     if problem.n_contacts == 0:
         return _no_contact(problem, "moreau", e)
     st = problem.structure
+    u_m = problem.u_minus
+    path = applies(st, backend) if form == "auto" else None
+    if path is not None:
+        answer = moreau_fast(problem, e, path)
+        if answer is not None:
+            cert = certify(problem, answer[0], answer[1], e, eps=e, tol=tol)
+            result = _fast_result(problem, "moreau", e, answer, path, cert, path)
+            if result is not None:
+                return result
+        if backend != "auto":
+            raise CertificateError(f"the {path!r} fast path gave no certified answer")
     if form == "auto":
         form = "velocity" if st.sparse else "impulse"
-    u_m = problem.u_minus
 
     if form == "velocity":
         qp = velocity_program(problem)
@@ -118,7 +151,7 @@ def moreau(problem: ImpactProblem, eps: float = 0.0, backend: str = "auto", *,
             u = (1.0 + e) * z - e * u_m
             return (u, lam, z), certify(problem, u, lam, e, eps=e, tol=tol)
     else:
-        qp = impulse_program(problem, (1.0 + e) * problem.gamma_minus)
+        qp = impulse_program(problem, (1.0 + e) * problem.gamma_minus, 1.0 + e)
 
         def finish(sol: QPSolution):
             lam = sol.x
@@ -138,6 +171,17 @@ def _lcp_law(problem: ImpactProblem, law: str, E: np.ndarray, backend: str,
     st = problem.structure
     g = problem.gamma_minus
     q = g + (E * g if E.ndim == 1 else E @ g)
+    if applies(st, backend, law=law) == "kernel":
+        lam = lcp_fast(problem, q)
+        if lam is not None:
+            u = problem.u_minus + st.Minv_W @ lam
+            cert = certify(problem, u, lam, E, tol=tol)
+            result = _fast_result(problem, law, E, (u, lam, None), "kernel", cert, "impulse")
+            if result is not None:
+                return result
+        if backend != "auto":
+            raise CertificateError("the 'kernel' fast path gave no certified answer "
+                                   "(q is not in the range of G); use a QP backend")
     qp = impulse_program(problem, q)
 
     def finish(sol: QPSolution):

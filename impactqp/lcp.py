@@ -14,7 +14,8 @@ from typing import Any
 import numpy as np
 
 from .certificate import DEFAULT_TOL
-from .dispatch import check_backend_name, solve_certified
+from .backends import parse_backend
+from .dispatch import solve_certified
 from .errors import NonConvexLCPError, NonFiniteError, NonSymmetricLCPError, ShapeError
 from .program import QPSolution, QuadraticProgram
 
@@ -120,7 +121,8 @@ def solve_lcp(G: Any, q: Any, backend: str = "auto", *, tol: float = DEFAULT_TOL
         No backend reached ``tol``.
     """
     G, q = check_lcp(G, q)
-    check_backend_name(backend)
+    if backend != "auto":
+        parse_backend(backend)
     if q.size == 0:
         return LCPResult(np.zeros(0), np.zeros(0), 0.0, {}, "none", tol)
     qp = QuadraticProgram(P=G, c=q)

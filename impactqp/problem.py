@@ -177,6 +177,19 @@ class ImpactStructure:
         return 0.5 * (G + G.T)
 
     @cached_property
+    def contact_scale(self) -> np.ndarray:
+        """sᵢ = sqrt(Gᵢᵢ): |γᵢ| ≤ sᵢ‖u‖ (the unit of contact velocities in certificates)."""
+        return np.sqrt(self.delassus_diagonal)
+
+    @cached_property
+    def kernel(self):
+        """The prepared active-set kernel of G (dense problems with few contacts)."""
+        from .kernel import ActiveSetKernel
+
+        G = self.delassus
+        return ActiveSetKernel(G.toarray() if sp.issparse(G) else G)
+
+    @cached_property
     def delassus_diagonal(self) -> np.ndarray:
         """Diagonal of G: the squared M⁻¹-length of each contact direction."""
         G = self.delassus

@@ -36,6 +36,8 @@ class QuadraticProgram:
     b : (r,) ndarray or None
     factor : (p, k) ndarray, optional
         A matrix B with P = BᵀB, when known; lets the NNLS path work without refactorizing.
+    factor_rhs : (p,) ndarray, optional
+        d with c = Bᵀd, when known (Moreau's law: d = (1+ε)Lᵀu⁻).
     """
 
     P: Any
@@ -43,6 +45,7 @@ class QuadraticProgram:
     A: Any = None
     b: np.ndarray | None = None
     factor: np.ndarray | None = None
+    factor_rhs: np.ndarray | None = None
     meta: dict = field(default_factory=dict, compare=False)
 
     @property

@@ -30,9 +30,12 @@ def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None
         raise BackendUnsuitableError(f"'nnls' is dense; {qp.n_vars} variables is too many")
     P = np.asarray(qp.P, dtype=float)
     B = qp.factor if qp.factor is not None else psd_factor(P)
-    d, *_ = np.linalg.lstsq(B.T, qp.c, rcond=None)
+    d = qp.factor_rhs
+    if d is None:
+        d, *_ = np.linalg.lstsq(B.T, qp.c, rcond=None)
     miss = np.abs(B.T @ d - qp.c).max(initial=0.0)
-    if miss > 1e-12 * max(np.abs(qp.c).max(initial=0.0), 1e-300) + 1e-300:
+    scale = np.abs(qp.c).max(initial=0.0) + np.abs(B).max(initial=0.0) * np.abs(d).max(initial=0.0)
+    if miss > 1e-10 * scale + 1e-300:
         raise BackendUnsuitableError("q is not in the range of the Delassus matrix (dependent "
                                      "contacts with an inconsistent q); use 'exact' or a QP solver")
     try:
