@@ -87,7 +87,7 @@ def moreau_batch(problem: ImpactProblem, U_minus: Any, eps: float = 0.0,
         Up, Lam, done = moreau_batch_fast(st, U, e, path)
         used = path
     else:
-        Up, Lam = np.empty_like(U), np.zeros((k, st.m))
+        Up, Lam = U.copy(), np.zeros((k, st.m))  # placeholders; every row is solved below
         done = np.zeros(k, dtype=bool)
         used = backend
     res = law_residuals(st, U, Up, Lam, e, eps=e)
