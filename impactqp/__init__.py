@@ -2,8 +2,9 @@
 
 Problems (:class:`ImpactProblem`, :func:`chain`, :func:`newtons_cradle`), the admissible
 set S (:class:`AdmissibleSet`), impact laws (:func:`moreau`, :func:`newton`,
-:func:`fremond`), LCPs with symmetric matrices (:func:`solve_lcp`) and the geometric
-classification (:func:`classify`). See ``docs`` in the README for the conventions.
+:func:`fremond`, :func:`sector_law` with its table :func:`sector_law_table`), the law
+verifier :func:`verify_law`, LCPs with symmetric matrices (:func:`solve_lcp`) and the
+geometric classification (:func:`classify`). See ``docs`` in the README for the conventions.
 """
 
 from .admissible import AdmissibleSet, Membership
@@ -11,13 +12,18 @@ from .certificate import Certificate
 from .classify import Classification, classify
 from .errors import (BackendUnsuitableError, CertificateError, ImpactError, InputError,
                      MassMatrixError, NoSolutionError, NonConvexLCPError, NonFiniteError,
-                     NonSymmetricLCPError, RestitutionError, ShapeError, SolverError,
-                     UnknownBackendError)
+                     NonSymmetricLCPError, RestitutionError, SectorInputError, SectorLawError,
+                     SectorTableTooLarge, ShapeError, SolverError, UnknownBackendError)
+from .fremond_map import fremond_admissibility_map
 from .laws import fremond, moreau, newton
 from .lcp import LCPResult, solve_lcp
 from .problem import ChainInfo, ImpactProblem, ImpactStructure
 from .problems import chain, newtons_cradle, random_impact
 from .result import ImpactResult
+from .sector import SectorCone, SectorTable, sector_law_table
+from .sector_certificate import SectorCertificate
+from .sector_law import SectorLawCertificate, sector_law
+from .verify import Counterexample, LawReport, verify_law
 
 __version__ = "0.1.0"
 
@@ -28,4 +34,7 @@ __all__ = [
     "NonConvexLCPError", "NonFiniteError", "NonSymmetricLCPError", "RestitutionError",
     "ShapeError", "SolverError", "UnknownBackendError", "chain", "classify", "fremond",
     "moreau", "newton", "newtons_cradle", "random_impact", "solve_lcp",
+    "Counterexample", "LawReport", "SectorCertificate", "SectorCone", "SectorInputError",
+    "SectorLawCertificate", "SectorLawError", "SectorTable", "SectorTableTooLarge",
+    "fremond_admissibility_map", "sector_law", "sector_law_table", "verify_law",
 ]
