@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from .problem import ImpactProblem
 from .problems import chain
 from .sector_certificate import certify_sector_table
 from .verify import ADMISSIBILITY, Counterexample, LawReport
@@ -34,20 +35,19 @@ def _velocities(table: Any, cone: Any, gamma: np.ndarray) -> tuple[np.ndarray, n
     return u_minus, u_minus + (np.asarray(table.W) @ impulses) / float(table.mass)
 
 
-def _counterexample(table: Any, cone: Any, condition: str, rng: np.random.Generator,
-                    ) -> Counterexample | None:
+def _counterexample(table: Any, base: ImpactProblem, cone: Any, condition: str,
+                    rng: np.random.Generator) -> Counterexample | None:
     """The worst candidate of ``cone`` for ``condition``, or None if none violates it."""
     best: Counterexample | None = None
-    masses = np.full(int(table.n_balls), float(table.mass))
     for gamma in _candidates(cone, rng):
         u_minus, u_plus = _velocities(table, cone, gamma)
+        p = base.with_u_minus(u_minus)
         if condition == "non_expansive":  # the pair (u⁻, 0) ↦ (u⁺, 0): the piece is linear
-            p = chain(masses, u_minus)
             amount = p.norm(u_plus) / p.norm(u_minus) - 1.0
             candidate = Counterexample(np.stack([u_minus, 0 * u_minus]),
                                        np.stack([u_plus, 0 * u_plus]), condition, amount)
         else:
-            m = chain(masses, u_minus).admissible_set().contains(u_plus)
+            m = p.admissible_set().contains(u_plus)
             candidate = Counterexample(u_minus, u_plus, condition, m.residuals[condition])
         if candidate.amount > 0 and (best is None or candidate.amount > best.amount):
             best = candidate
@@ -69,10 +69,11 @@ def certify_table_report(table: Any, *, tol: float, seed: int = 0) -> LawReport:
     violations = {k: int(sum(v)) for k, v in flags.items()}
     violations["continuity"] = int(not cert.continuity.passed)
     rng = np.random.default_rng(seed)
+    base = chain(np.full(int(table.n_balls), float(table.mass)), np.zeros(int(table.n_balls)))
     found: dict[str, Counterexample] = {}
     for name in (*ADMISSIBILITY, "non_expansive"):
         for i in np.flatnonzero(flags[name]):
-            ce = _counterexample(table, table.cones[int(i)], name, rng)
+            ce = _counterexample(table, base, table.cones[int(i)], name, rng)
             if ce is not None and ce.amount > tol and \
                     (name not in found or ce.amount > found[name].amount):
                 found[name] = ce

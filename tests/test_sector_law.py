@@ -148,7 +148,7 @@ def test_single_ball_cradle_angle(n: int) -> None:
 
 
 def test_three_ball_angle_on_inconsistent_cones() -> None:
-    """Contact 2 separates (γ⁻₂ > 0) in both cases; the law still acts on both balls pairs."""
+    """Contact 2 separates (γ⁻₂ > 0) in both cases, and sort(u⁻) is still in S."""
     # Moreau's z closes both contacts (z = (½, ½, ½)): the full 30° of §5
     p = iq.chain(np.ones(3), [1.0, 0.0, 0.5])
     r = iq.sector_law(p)
@@ -160,3 +160,15 @@ def test_three_ball_angle_on_inconsistent_cones() -> None:
     r = iq.sector_law(p)
     np.testing.assert_allclose(r.u_plus, iq.moreau(p, eps=1.0).u_plus, atol=1e-12)
     assert r.classification.alpha_deg == pytest.approx(0.0, abs=1e-6)
+
+
+# --------------------------------------------------------------------------- CLI
+def test_sector_law_command(capsys: pytest.CaptureFixture[str]) -> None:
+    from impactqp import cli
+
+    assert cli.main(["sector-law", "--balls", "3"]) == 0
+    out = capsys.readouterr().out
+    assert "6 cones" in out and "u2 ≤ u3 ≤ u1" in out and "[0 1; -1 -1]" in out
+    assert "maximal monotone: True" in out and "FAIL" not in out
+    assert cli.main(["sector-law", "--balls", "9"]) == 2
+    assert "sector_gamma_map" in capsys.readouterr().err
