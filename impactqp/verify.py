@@ -24,6 +24,9 @@ from .result import ImpactResult
 DEFAULT_TOL = 1e-7
 """Tolerance on the dimensionless residuals of :class:`~impactqp.admissible.Membership`."""
 
+MAX_PAIR_SAMPLES = 1500
+"""Non-expansiveness is checked on all pairs of at most this many samples (memory ~ k²)."""
+
 ADMISSIBILITY = ("kinematic", "kinetic", "energetic")
 CONDITIONS = ADMISSIBILITY + ("non_expansive", "law_error")
 
@@ -153,9 +156,9 @@ def admissibility_residuals(law: Law, problem: ImpactProblem,
 
 def _pair_expansion(M: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
                     ) -> tuple[np.ndarray, np.ndarray]:
-    """Relative expansion ‖Δu⁺‖/‖Δu⁻‖ − 1 of every pair i < j (finite rows only), and the
-    pair indices (p × 2)."""
-    keep = np.flatnonzero(np.all(np.isfinite(u_plus), axis=1))
+    """Relative expansion ‖Δu⁺‖/‖Δu⁻‖ − 1 of every pair i < j among the first
+    :data:`MAX_PAIR_SAMPLES` finite rows, and the pair indices (p × 2)."""
+    keep = np.flatnonzero(np.all(np.isfinite(u_plus), axis=1))[:MAX_PAIR_SAMPLES]
     i, j = np.triu_indices(len(keep), k=1)
     i, j = keep[i], keep[j]
 

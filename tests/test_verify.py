@@ -31,9 +31,12 @@ def test_sector_law_passes(n: int) -> None:
     assert rep.summary().startswith("ok")
 
 
-def test_plain_array_law_is_accepted() -> None:
+def test_plain_array_law_is_accepted_and_pairs_are_capped(monkeypatch) -> None:
+    import impactqp.verify as verify
+
+    monkeypatch.setattr(verify, "MAX_PAIR_SAMPLES", 10)
     rep = iq.verify_law(lambda q: np.sort(q.u_minus), CRADLE, samples=20)
-    assert rep.ok
+    assert rep.ok and rep.samples == 20 and rep.pairs == 45
 
 
 # --------------------------------------------------------------------------- Moreau
