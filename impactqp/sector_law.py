@@ -91,6 +91,25 @@ def certify_sector(problem: ImpactProblem, u_plus: np.ndarray, impulses: np.ndar
         tol=tol)
 
 
+def wedge_angles(masses: np.ndarray) -> np.ndarray:
+    """Angle (degrees) of T_C between neighbouring contacts i, i+1 in the kinetic metric:
+    arccos(−G_{i,i+1}/√(G_ii G_{i+1,i+1})), 60° for equal masses (§1, §5)."""
+    inv = 1.0 / masses
+    diag = inv[:-1] + inv[1:]
+    cos = inv[1:-1] / np.sqrt(diag[:-1] * diag[1:])
+    return np.degrees(np.arccos(cos))
+
+
+def _wedge_note(masses: np.ndarray) -> str:
+    """Why: a simultaneous impact is a billiard in the wedge T_C, whose corner outcome is
+    continuous in u⁻ only when the wedge angle is π/k."""
+    if masses.size < 3:
+        return ""
+    angles = ", ".join(f"{a:.4g}°" for a in wedge_angles(masses)[:5])
+    return (f" A simultaneous impact is a billiard in the wedge T_C; its outcome at the corner "
+            f"is continuous only if every wedge angle is 180°/k (here {angles}).")
+
+
 def check_sector_problem(problem: ImpactProblem) -> float:
     """Return the common ball mass of ``problem`` or raise :class:`SectorLawError` saying why
     the sector law does not apply."""
@@ -109,7 +128,7 @@ def check_sector_problem(problem: ImpactProblem) -> float:
             f"the sector law needs equal masses, got {masses[:6].tolist()}"
             f"{' …' if masses.size > 6 else ''}: only for equal masses does an elastic "
             "collision swap velocities, so there is no continuous sorting law for unequal "
-            "masses")
+            f"masses.{_wedge_note(masses)}")
     return float(masses[0])
 
 

@@ -84,6 +84,13 @@ def test_failed_certificate_raises() -> None:
 def test_errors_say_why() -> None:
     with pytest.raises(iq.SectorLawError, match="no continuous sorting law for unequal"):
         iq.sector_law(iq.chain([1.0, 2.0, 1.0], [1.0, 0.0, 0.0]))
+    with pytest.raises(iq.SectorLawError, match=r"180°/k \(here 70.53°\)"):
+        iq.sector_law(iq.chain([1.0, 2.0, 1.0], [1.0, 0.0, 0.0]))  # cos = (1/2)/(3/2)
+    with pytest.raises(iq.SectorLawError, match=r"unequal masses\.$"):
+        iq.sector_law(iq.chain([1.0, 2.0], [1.0, 0.0]))
+    from impactqp.sector_law import wedge_angles
+
+    np.testing.assert_allclose(wedge_angles(np.ones(4)), [60.0, 60.0])  # π/3: k = 3
     with pytest.raises(iq.SectorLawError, match="walls"):
         iq.sector_law(iq.chain([1.0, 1.0], [1.0, 0.0], left_wall=True))
     with pytest.raises(iq.SectorLawError, match="chains"):
