@@ -2,8 +2,9 @@
 
 Problems (:class:`ImpactProblem`, :func:`chain`, :func:`newtons_cradle`), the admissible
 set S (:class:`AdmissibleSet`), impact laws (:func:`moreau`, :func:`newton`,
-:func:`fremond`), LCPs with symmetric matrices (:func:`solve_lcp`) and the geometric
-classification (:func:`classify`). See ``docs`` in the README for the conventions.
+:func:`fremond`, :func:`sector_law` with its table :func:`sector_law_table`), the law
+verifier :func:`verify_law`, LCPs with symmetric matrices (:func:`solve_lcp`) and the
+geometric classification (:func:`classify`). See ``docs`` in the README for the conventions.
 """
 
 from .admissible import AdmissibleSet, Membership
@@ -12,21 +13,30 @@ from .certificate import Certificate
 from .classify import Classification, classify
 from .errors import (BackendUnsuitableError, CertificateError, ImpactError, InputError,
                      MassMatrixError, NoSolutionError, NonConvexLCPError, NonFiniteError,
-                     NonSymmetricLCPError, RestitutionError, ShapeError, SolverError,
-                     UnknownBackendError)
+                     NonSymmetricLCPError, RestitutionError, SectorInputError, SectorLawError,
+                     SectorTableTooLarge, ShapeError, SolverError, UnknownBackendError)
+from .fremond_map import fremond_admissibility_map
 from .laws import fremond, moreau, newton
 from .lcp import LCPResult, solve_lcp
 from .problem import ChainInfo, ImpactProblem, ImpactStructure
 from .problems import chain, newtons_cradle, random_impact
 from .result import ImpactResult
+from .sector import SectorCone, SectorTable, sector_law_table
+from .sector_certificate import SectorCertificate
+from .sector_law import SectorLawCertificate, sector_law
+from .verify import Counterexample, LawReport, verify_law
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "AdmissibleSet", "BatchResult", "BackendUnsuitableError", "Certificate", "CertificateError", "ChainInfo",
-    "Classification", "ImpactError", "ImpactProblem", "ImpactResult", "ImpactStructure",
-    "InputError", "LCPResult", "MassMatrixError", "Membership", "NoSolutionError",
-    "NonConvexLCPError", "NonFiniteError", "NonSymmetricLCPError", "RestitutionError",
-    "ShapeError", "SolverError", "UnknownBackendError", "chain", "classify", "fremond",
-    "moreau", "moreau_batch", "newton", "newtons_cradle", "random_impact", "solve_lcp",
+    "AdmissibleSet", "BackendUnsuitableError", "BatchResult", "Certificate", "CertificateError",
+    "ChainInfo", "Classification", "Counterexample", "ImpactError", "ImpactProblem",
+    "ImpactResult", "ImpactStructure", "InputError", "LCPResult", "LawReport", "MassMatrixError",
+    "Membership", "NoSolutionError", "NonConvexLCPError", "NonFiniteError",
+    "NonSymmetricLCPError", "RestitutionError", "SectorCertificate", "SectorCone",
+    "SectorInputError", "SectorLawCertificate", "SectorLawError", "SectorTable",
+    "SectorTableTooLarge", "ShapeError", "SolverError", "UnknownBackendError", "chain",
+    "classify", "fremond", "fremond_admissibility_map", "moreau", "moreau_batch", "newton",
+    "newtons_cradle", "random_impact", "sector_law", "sector_law_table", "solve_lcp",
+    "verify_law",
 ]

@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .commands import demo
+from .commands import demo, sector
 from .errors import ImpactError
 
-COMMANDS = [demo]
+COMMANDS = [demo, sector]
 
 
 def build_parser() -> argparse.ArgumentParser:

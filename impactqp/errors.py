@@ -62,3 +62,15 @@ class NoSolutionError(ImpactError):
 
 class CertificateError(SolverError):
     """No backend produced an answer within the certificate's tolerance."""
+
+
+class SectorLawError(InputError):
+    """The sector law does not apply to this problem (not a chain, walls, unequal masses)."""
+
+
+class SectorInputError(InputError):
+    """Invalid argument to a sector-law routine (ball count, mass, array shape)."""
+
+
+class SectorTableTooLarge(InputError):
+    """The n! cones of the sector table are too many to enumerate (n_balls > 8)."""

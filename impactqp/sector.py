@@ -23,18 +23,10 @@ from typing import TYPE_CHECKING, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from impactqp.errors import SectorInputError, SectorTableTooLarge
+
 if TYPE_CHECKING:  # pragma: no cover
     from impactqp.sector_certificate import SectorCertificate
-
-
-# --------------------------------------------------------------------------- errors
-class SectorInputError(ValueError):
-    """Invalid argument to a sector-law routine (ball count, mass, array shape)."""
-
-
-class SectorTableTooLarge(ValueError):
-    """The n! cones of the sector table are too many to enumerate (n_balls > 8)."""
-
 
 MAX_TABLE_BALLS = 8
 """Largest ball count for which :func:`sector_law_table` enumerates the n! cones."""

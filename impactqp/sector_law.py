@@ -1,0 +1,171 @@
+"""The sector law as an impact law on a chain problem: ``u⁺ = sort(u⁻)`` (§6).
+
+The sector law is not a complementarity law ``0 ≤ Λ ⟂ γ⁺ + Eγ⁻``, so its results carry a
+:class:`SectorLawCertificate` of their own: the impact equation, Λ ≥ 0, γ⁺ ≥ 0, energy
+conservation and agreement of γ⁺ with the closed-form γ-map of §6.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .certificate import DEFAULT_TOL
+from .errors import CertificateError, InputError, SectorLawError
+from .problem import ImpactProblem
+from .result import ImpactResult
+from .sector import sector_gamma_map, sector_velocity_map
+
+MASS_RTOL = 1e-12
+"""Relative spread of the ball masses below which they count as equal."""
+
+
+@dataclass(frozen=True)
+class SectorLawCertificate:
+    """Recomputed checks of one sector-law result (§1, §2, §6), dimensionless as in
+    :mod:`impactqp.certificate`.
+
+    Attributes
+    ----------
+    momentum : float
+        ‖u⁺ − u⁻ − M⁻¹WΛ‖ / V: the impact equation M(u⁺ − u⁻) = WΛ.
+    impulse_sign : float
+        Largest violation of Λ ≥ 0 (scaled).
+    kinematic : float
+        Largest violation of γ⁺ ≥ 0 (scaled).
+    energy_balance : float
+        |‖u⁺‖² − ‖u⁻‖²| / V²: the sector law conserves kinetic energy.
+    law_residual : float
+        max |γ⁺ − S(γ⁻)| / V with S the closed-form sector map of §6.
+    tol : float
+        Tolerance every residual must meet.
+    """
+
+    momentum: float
+    impulse_sign: float
+    kinematic: float
+    energy_balance: float
+    law_residual: float
+    tol: float
+
+    @property
+    def residuals(self) -> dict[str, float]:
+        return {"momentum": self.momentum, "impulse_sign": self.impulse_sign,
+                "kinematic": self.kinematic, "energy_balance": self.energy_balance,
+                "law_residual": self.law_residual}
+
+    @property
+    def ok(self) -> bool:
+        """True when every residual is within ``tol``."""
+        return all(np.isfinite(v) and v <= self.tol for v in self.residuals.values())
+
+    @property
+    def worst(self) -> tuple[str, float]:
+        name = max(self.residuals, key=lambda k: self.residuals[k])
+        return name, self.residuals[name]
+
+    def __bool__(self) -> bool:
+        return self.ok
+
+    def summary(self) -> str:
+        parts = ", ".join(f"{k}={v:.1e}" for k, v in self.residuals.items())
+        return f"{'ok' if self.ok else 'FAILED'} (tol {self.tol:.0e}): {parts}"
+
+
+def certify_sector(problem: ImpactProblem, u_plus: np.ndarray, impulses: np.ndarray,
+                   *, tol: float = DEFAULT_TOL) -> SectorLawCertificate:
+    """Recompute the checks of a sector-law answer (u⁺, Λ) on a chain problem."""
+    st = problem.structure
+    V = problem.velocity_scale
+    s = np.sqrt(st.delassus_diagonal) if st.m else np.zeros(0)
+    du = u_plus - problem.u_minus - st.solve_mass(st.W_times(impulses))
+    gamma_plus = st.Wt_times(u_plus)
+    expected = sector_gamma_map(problem.gamma_minus) if st.m else np.zeros(0)
+    return SectorLawCertificate(
+        momentum=problem.norm(du) / V,
+        impulse_sign=float(max(0.0, -np.min(impulses * s / V, initial=0.0))),
+        kinematic=float(max(0.0, -np.min(gamma_plus / (s * V), initial=0.0))),
+        energy_balance=abs(problem.norm(u_plus) ** 2 - problem.norm(problem.u_minus) ** 2) / V**2,
+        law_residual=float(np.max(np.abs(gamma_plus - expected), initial=0.0)) / V,
+        tol=tol)
+
+
+def wedge_angles(masses: np.ndarray) -> np.ndarray:
+    """Angle (degrees) of T_C between neighbouring contacts i, i+1 in the kinetic metric:
+    arccos(−G_{i,i+1}/√(G_ii G_{i+1,i+1})), 60° for equal masses (§1, §5)."""
+    inv = 1.0 / masses
+    diag = inv[:-1] + inv[1:]
+    cos = inv[1:-1] / np.sqrt(diag[:-1] * diag[1:])
+    return np.degrees(np.arccos(cos))
+
+
+def _wedge_note(masses: np.ndarray) -> str:
+    """Why: a simultaneous impact is a billiard in the wedge T_C, whose corner outcome is
+    continuous in u⁻ only when the wedge angle is π/k."""
+    if masses.size < 3:
+        return ""
+    angles = ", ".join(f"{a:.4g}°" for a in wedge_angles(masses)[:5])
+    return (f" A simultaneous impact is a billiard in the wedge T_C; its outcome at the corner "
+            f"is continuous only if every wedge angle is 180°/k (here {angles}).")
+
+
+def check_sector_problem(problem: ImpactProblem) -> float:
+    """Return the common ball mass of ``problem`` or raise :class:`SectorLawError` saying why
+    the sector law does not apply."""
+    if not isinstance(problem, ImpactProblem):
+        raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
+    info = problem.chain
+    if info is None:
+        raise SectorLawError("the sector law is defined for 1-D chains of balls; build the "
+                             "problem with impactqp.chain or impactqp.newtons_cradle")
+    if info.left_wall or info.right_wall:
+        raise SectorLawError("the sector law is defined for free chains; walls are not "
+                             "supported (a wall is a ball of infinite mass, see unequal masses)")
+    masses = info.masses
+    if np.ptp(masses) > MASS_RTOL * masses.max():
+        raise SectorLawError(
+            f"the sector law needs equal masses, got {masses[:6].tolist()}"
+            f"{' …' if masses.size > 6 else ''}: only for equal masses does an elastic "
+            "collision swap velocities, so there is no continuous sorting law for unequal "
+            f"masses.{_wedge_note(masses)}")
+    return float(masses[0])
+
+
+def sector_law(problem: ImpactProblem, *, tol: float = DEFAULT_TOL) -> ImpactResult:
+    """The maximal-monotone sector law of Winandy and Leine for equal balls (§6).
+
+    .. math::
+
+        u^+ = \\operatorname{sort}(u^-), \\qquad
+        \\Lambda_k = m \\sum_{j \\le k} (u^-_j - u^+_j)
+
+    (the impulses solve M(u⁺ − u⁻) = WΛ for the chain's W). Any number of balls; O(n log n).
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        A chain of equal masses without walls (``impactqp.chain``, ``newtons_cradle``).
+        Kinematically inconsistent u⁻ are fine: u⁺ is in S for every u⁻.
+    tol : float
+        Tolerance of the recomputed :class:`SectorLawCertificate`.
+
+    Returns
+    -------
+    ImpactResult
+        ``law="sector"``, ``backend="sort"``, ``coefficients=None``.
+
+    Raises
+    ------
+    SectorLawError
+        When the problem is not a chain, has walls, or its masses differ.
+    CertificateError
+        When rounding (e.g. velocities of wildly different magnitudes) breaks the certificate.
+    """
+    mass = check_sector_problem(problem)
+    u_plus = sector_velocity_map(problem.u_minus)
+    impulses = mass * np.cumsum(problem.u_minus - u_plus)[:-1]
+    cert = certify_sector(problem, u_plus, impulses, tol=tol)
+    if not cert.ok:
+        raise CertificateError(f"sector law: certificate failed, {cert.summary()}")
+    return ImpactResult(problem, "sector", None, u_plus, impulses, "sort", cert)
