@@ -71,8 +71,10 @@ def classify(problem: ImpactProblem, u_plus: Any) -> Classification:
     moreau_dir = _unit(problem, -zp)
     zp2 = problem.norm(zp) ** 2
     if zp2 > 0 and intensity > 0:
-        cos = np.clip(problem.inner(direction, moreau_dir), -1.0, 1.0)
-        alpha = float(np.degrees(np.arccos(cos)))
+        # atan2 of the parallel and orthogonal parts: accurate near 0° (arccos is not)
+        cos = problem.inner(direction, moreau_dir)
+        sin = problem.norm(direction - cos * moreau_dir)
+        alpha = float(np.degrees(np.arctan2(sin, cos)))
         ratio = (problem.norm(u) ** 2 - problem.norm(z) ** 2) / zp2
         dissipation = float(np.sign(ratio) * np.sqrt(abs(ratio)))
     else:
