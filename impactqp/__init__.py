@@ -8,7 +8,7 @@ geometric classification (:func:`classify`). See ``docs`` in the README for the 
 """
 
 from .admissible import AdmissibleSet, Membership
-from .batch import BatchResult, moreau_batch
+from .batch import BatchResult, moreau_batch, sector_law_batch
 from .certificate import Certificate
 from .classify import Classification, classify
 from .errors import (BackendUnsuitableError, CertificateError, ImpactError, InputError,
@@ -37,6 +37,6 @@ __all__ = [
     "SectorInputError", "SectorLawCertificate", "SectorLawError", "SectorTable",
     "SectorTableTooLarge", "ShapeError", "SolverError", "UnknownBackendError", "chain",
     "classify", "fremond", "fremond_admissibility_map", "moreau", "moreau_batch", "newton",
-    "newtons_cradle", "random_impact", "sector_law", "sector_law_table", "solve_lcp",
+    "newtons_cradle", "random_impact", "sector_law", "sector_law_batch", "sector_law_table", "solve_lcp",
     "verify_law",
 ]

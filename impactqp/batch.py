@@ -15,10 +15,12 @@ from typing import Any
 import numpy as np
 
 from .certificate import DEFAULT_TOL, law_residuals
-from .errors import ShapeError
+from .errors import CertificateError, ShapeError
 from .fastpaths import applies, moreau_batch_fast
 from .laws import check_backend_name, check_restitution, moreau
 from .problem import ImpactProblem, _finite
+from .sector import sector_velocity_map
+from .sector_law import check_sector_problem, sector_residuals
 
 
 @dataclass(frozen=True)
@@ -104,3 +106,27 @@ def moreau_batch(problem: ImpactProblem, U_minus: Any, eps: float = 0.0,
             res[key][rows] = fixed[key]
     return BatchResult(u_plus=Up, impulses=Lam, residuals=res, backend=used,
                        resolved=int(rows.size if path is not None else 0), tol=tol)
+
+
+def sector_law_batch(problem: ImpactProblem, U_minus: Any, *,
+                     tol: float = DEFAULT_TOL) -> BatchResult:
+    """The sector law u⁺ = sort(u⁻) (§6) for every row of ``U_minus`` on an equal-mass chain.
+
+    Raises
+    ------
+    SectorLawError
+        When the problem is not a free chain of equal masses.
+    CertificateError
+        When a row fails its recomputed certificate (rounding with wildly mixed magnitudes).
+    """
+    mass = check_sector_problem(problem)
+    U = as_rows(problem, U_minus)
+    Up = sector_velocity_map(U)
+    Lam = mass * np.cumsum(U - Up, axis=1)[:, :-1]
+    res = sector_residuals(problem.structure, U, Up, Lam)
+    out = BatchResult(u_plus=Up, impulses=Lam, residuals=res, backend="sort", resolved=0, tol=tol)
+    if not out.ok.all():
+        i = int(np.flatnonzero(~out.ok)[0])
+        raise CertificateError(f"sector law: row {i} fails its certificate: "
+                               + ", ".join(f"{k}={v[i]:.1e}" for k, v in res.items()))
+    return out

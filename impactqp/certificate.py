@@ -8,7 +8,8 @@ impulse that changes the velocity by V along contact i), energies against V².
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -17,8 +18,38 @@ from .problem import ImpactProblem, ImpactStructure
 DEFAULT_TOL = 1e-9
 
 
+class ResidualChecks(ABC):
+    """Verdict shared by every certificate: each residual in :attr:`residuals` ≤ ``tol``."""
+
+    tol: float
+
+    @property
+    @abstractmethod
+    def residuals(self) -> dict[str, float]:
+        """The named dimensionless residuals of this certificate."""
+
+    @property
+    def ok(self) -> bool:
+        """True when every residual is within ``tol``."""
+        return all(v <= self.tol for v in self.residuals.values())  # NaN fails too
+
+    @property
+    def worst(self) -> tuple[str, float]:
+        """The largest residual and its name."""
+        res = self.residuals
+        name = max(res, key=lambda k: res[k])
+        return name, res[name]
+
+    def __bool__(self) -> bool:
+        return self.ok
+
+    def summary(self) -> str:
+        parts = ", ".join(f"{k}={v:.1e}" for k, v in self.residuals.items())
+        return f"{'ok' if self.ok else 'FAILED'} (tol {self.tol:.0e}): {parts}"
+
+
 @dataclass(frozen=True)
-class Certificate:
+class Certificate(ResidualChecks):
     """Recomputed checks of a complementarity impact law ``0 ≤ Λ ⟂ γ⁺ + Eγ⁻ ≥ 0`` (§3).
 
     Attributes
@@ -43,7 +74,6 @@ class Certificate:
     complementarity: float
     energy_balance: float | None
     tol: float
-    details: dict = field(default_factory=dict, compare=False)
 
     @property
     def residuals(self) -> dict[str, float]:
@@ -53,27 +83,27 @@ class Certificate:
             out["energy_balance"] = self.energy_balance
         return out
 
-    @property
-    def ok(self) -> bool:
-        """True when every residual is within ``tol``."""
-        return all(v <= self.tol for v in self.residuals.values())  # NaN fails too
 
-    @property
-    def worst(self) -> tuple[str, float]:
-        name = max(self.residuals, key=lambda k: self.residuals[k])
-        return name, self.residuals[name]
-
-    def __bool__(self) -> bool:
-        return self.ok
-
-    def summary(self) -> str:
-        parts = ", ".join(f"{k}={v:.1e}" for k, v in self.residuals.items())
-        return f"{'ok' if self.ok else 'FAILED'} (tol {self.tol:.0e}): {parts}"
+def kinetic_norms(structure: ImpactStructure, X: np.ndarray) -> np.ndarray:
+    """‖x‖ = sqrt(xᵀMx) of a vector or of every row of X."""
+    return np.sqrt(np.maximum((structure.mass_rows(X) * X).sum(axis=-1), 0.0))
 
 
-def _mass_rows(M, X: np.ndarray) -> np.ndarray:
-    """M applied to every row of X (X of shape (n,) or (k, n); M symmetric)."""
-    return X @ M if isinstance(M, np.ndarray) else np.asarray((M @ X.T).T)
+def impact_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
+                     Lam: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Velocity scale V and the residuals every impact law shares (one impact or rows):
+    the impact equation M(u⁺ − u⁻) = WΛ (§1) and Λ ≥ 0."""
+    st = structure
+    V = kinetic_norms(st, U_minus)
+    V = np.where(V == 0, 1.0, V)
+    du = U_plus - U_minus - np.asarray(st.Minv_W @ Lam.T).T
+    out = {"momentum": kinetic_norms(st, du) / V}
+    if st.m:
+        out["impulse_sign"] = np.maximum(0.0, -(Lam * st.contact_scale / V[..., None])
+                                         .min(axis=-1))
+    else:
+        out["impulse_sign"] = np.zeros(U_minus.shape[:-1])
+    return V, out
 
 
 def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
@@ -85,25 +115,19 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
     ‖u⁺‖² − ‖z‖² − ε²‖z⊥‖² equals −2ε⟨z, z⊥⟩ (§3), which is what is evaluated.
     """
     st = structure
-    V = np.sqrt(np.maximum((_mass_rows(st.M, U_minus) * U_minus).sum(axis=-1), 0.0))
-    V = np.where(V == 0, 1.0, V)
-    du = U_plus - U_minus - np.asarray(st.Minv_W @ Lam.T).T
-    out = {"momentum": np.sqrt(np.maximum((_mass_rows(st.M, du) * du).sum(axis=-1), 0.0)) / V}
-    Vc = V[..., None]
+    V, out = impact_residuals(st, U_minus, U_plus, Lam)
     if st.m:
         s = st.contact_scale
         g_minus = np.asarray(st.W.T @ U_minus.T).T
         E = np.asarray(E, dtype=float)
         w = np.asarray(st.W.T @ U_plus.T).T + (E * g_minus if E.ndim <= 1 else g_minus @ E.T)
-        out["impulse_sign"] = np.maximum(0.0, -(Lam * s / Vc).min(axis=-1))
-        out["law_feasibility"] = np.maximum(0.0, -(w / (s * Vc)).min(axis=-1))
+        out["law_feasibility"] = np.maximum(0.0, -(w / (s * V[..., None])).min(axis=-1))
         out["complementarity"] = np.abs(Lam * w).max(axis=-1) / V**2
     else:
-        zero = np.zeros(U_minus.shape[:-1])
-        out.update(impulse_sign=zero, law_feasibility=zero, complementarity=zero)
+        out["law_feasibility"] = out["complementarity"] = np.zeros(U_minus.shape[:-1])
     if eps is not None:
         z = (U_plus + eps * U_minus) / (1.0 + eps)
-        out["energy_balance"] = 2.0 * eps * np.abs((_mass_rows(st.M, z) * (U_minus - z))
+        out["energy_balance"] = 2.0 * eps * np.abs((st.mass_rows(z) * (U_minus - z))
                                                    .sum(axis=-1)) / V**2
     return out
 

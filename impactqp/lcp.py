@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from .certificate import DEFAULT_TOL
+from .certificate import DEFAULT_TOL, ResidualChecks
 from .backends import parse_backend
 from .dispatch import solve_certified
 from .errors import NonConvexLCPError, NonFiniteError, NonSymmetricLCPError, ShapeError
@@ -47,18 +47,13 @@ class LCPResult:
 
 
 @dataclass(frozen=True)
-class _LCPCertificate:
-    residuals: dict
+class _LCPCertificate(ResidualChecks):
+    values: dict
     tol: float
 
     @property
-    def ok(self) -> bool:
-        return all(np.isfinite(v) and v <= self.tol for v in self.residuals.values())
-
-    @property
-    def worst(self) -> tuple[str, float]:
-        k = max(self.residuals, key=lambda key: self.residuals[key])
-        return k, self.residuals[k]
+    def residuals(self) -> dict[str, float]:
+        return self.values
 
 
 def _residuals(G: np.ndarray, q: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, dict]:

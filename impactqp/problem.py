@@ -136,6 +136,18 @@ class ImpactStructure:
         """Return M u."""
         return self.M @ u
 
+    @cached_property
+    def mass_diagonal(self) -> np.ndarray | None:
+        """The diagonal of M when M is diagonal (chains), else None."""
+        return np.asarray(self.M.diagonal()).ravel() if self.diagonal_mass else None
+
+    def mass_rows(self, X: np.ndarray) -> np.ndarray:
+        """M applied to a vector or to every row of X (M is symmetric)."""
+        d = self.mass_diagonal
+        if d is not None:
+            return X * d
+        return X @ self.M if not self.sparse else np.asarray((self.M @ X.T).T)
+
     def W_times(self, lam: np.ndarray) -> np.ndarray:
         """Return W Λ."""
         return np.asarray(self.W @ lam).ravel() if lam.ndim == 1 else np.asarray(self.W @ lam)

@@ -75,3 +75,16 @@ def test_batch_rejects_bad_rows():
         iq.moreau_batch(p, np.full((2, 3), np.nan))
     with pytest.raises(iq.RestitutionError):
         iq.moreau_batch(p, np.zeros((2, 3)), eps=2.0)
+
+
+def test_sector_law_batch_matches_single_calls():
+    p = iq.newtons_cradle(5)
+    U = np.random.default_rng(4).standard_normal((50, 5))
+    b = iq.sector_law_batch(p, U)
+    assert b.ok.all()
+    for i in range(0, 50, 9):
+        r = iq.sector_law(p.with_u_minus(U[i]))
+        np.testing.assert_array_equal(b.u_plus[i], r.u_plus)
+        np.testing.assert_allclose(b.impulses[i], r.impulses, atol=1e-14)
+    with pytest.raises(iq.SectorLawError):
+        iq.sector_law_batch(iq.chain([1.0, 2.0, 1.0], [1.0, 0, 0]), U[:, :3])
