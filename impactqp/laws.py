@@ -79,9 +79,10 @@ def impulse_program(problem: ImpactProblem, q: np.ndarray,
     """
     st = problem.structure
     if st.sparse:
-        return QuadraticProgram(P=st.delassus, c=q)
+        return QuadraticProgram(P=st.delassus, c=q, cache_owner=st, cache_tag="impulse")
     d = None if moreau_scale is None else moreau_scale * (st.cholesky_factor.T @ problem.u_minus)
-    return QuadraticProgram(P=st.delassus, c=q, factor=st.scaled_W, factor_rhs=d)
+    return QuadraticProgram(P=st.delassus, c=q, factor=st.scaled_W, factor_rhs=d,
+                            cache_owner=st, cache_tag="impulse")
 
 
 def velocity_program(problem: ImpactProblem) -> QuadraticProgram:
@@ -89,7 +90,7 @@ def velocity_program(problem: ImpactProblem) -> QuadraticProgram:
     st = problem.structure
     A = sp.csc_matrix(st.W.T) if st.sparse else st.W.T
     return QuadraticProgram(P=st.M, c=-np.asarray(st.mass_times(problem.u_minus)).ravel(),
-                            A=A, b=np.zeros(st.m))
+                            A=A, b=np.zeros(st.m), cache_owner=st, cache_tag="velocity")
 
 
 def moreau(problem: ImpactProblem, eps: float = 0.0, backend: str = "auto", *,

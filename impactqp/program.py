@@ -38,6 +38,10 @@ class QuadraticProgram:
         A matrix B with P = BᵀB, when known; lets the NNLS path work without refactorizing.
     factor_rhs : (p,) ndarray, optional
         d with c = Bᵀd, when known (Moreau's law: d = (1+ε)Lᵀu⁻).
+    cache_owner, cache_tag : optional
+        Programs with the same owner (an object that outlives them, e.g. the problem
+        structure) and tag share P, A and b and differ only in c; backends that compile
+        (cvxpy) keep one compiled problem per (owner, tag) and re-solve it.
     """
 
     P: Any
@@ -46,7 +50,8 @@ class QuadraticProgram:
     b: np.ndarray | None = None
     factor: np.ndarray | None = None
     factor_rhs: np.ndarray | None = None
-    meta: dict = field(default_factory=dict, compare=False)
+    cache_owner: Any = field(default=None, compare=False)
+    cache_tag: str = ""
 
     @property
     def n_vars(self) -> int:

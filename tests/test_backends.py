@@ -98,3 +98,19 @@ def test_unsolvable_lcp_raises_no_solution():
     assert iq.fremond(p, E).certificate.ok
     with pytest.raises(iq.NoSolutionError):
         iq.solve_lcp(np.zeros((1, 1)), [-1.0])
+
+
+def test_cvxpy_compiles_once_per_structure():
+    from impactqp.backends import cvxpy_
+
+    p = iq.random_impact(6, 4, seed=9)
+    rng = np.random.default_rng(0)
+    answers = []
+    for _ in range(3):
+        q = p.with_u_minus(rng.standard_normal(6))
+        answers.append((q, iq.moreau(q, 0.3, backend="cvxpy:CLARABEL", form="velocity")))
+    cached = cvxpy_._CACHE[p.structure]
+    assert len(cached) == 1  # one compiled problem served all three solves
+    for q, r in answers:  # and each answer is the one for its own u⁻
+        ref = iq.moreau(q, 0.3, backend="exact")
+        assert q.norm(r.u_plus - ref.u_plus) <= 1e-9 * q.velocity_scale
