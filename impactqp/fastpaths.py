@@ -23,20 +23,22 @@ FAST_PATHS = ("isotonic", "kernel")
 def applies(structure: ImpactStructure, backend: str, *, law: str = "moreau") -> str | None:
     """The fast path ``backend`` selects for this structure, or None.
 
+    ``"auto"`` prefers the kernel for small dense impacts (least overhead per call), then
+    isotonic regression for chains (O(N) for long ones).
+
     Raises BackendUnsuitableError when a fast path is named explicitly but cannot be used.
     """
-    if backend == "isotonic" or (backend == "auto" and law == "moreau"):
-        if structure.chain is not None and law == "moreau":
-            return "isotonic"
-        if backend == "isotonic":
-            raise BackendUnsuitableError("'isotonic' solves Moreau's law on chains built by "
-                                         "iq.chain or iq.newtons_cradle only")
-    if backend in ("kernel", "auto"):
-        if not structure.sparse and 0 < structure.m <= MAX_CONTACTS:
+    small = not structure.sparse and 0 < structure.m <= MAX_CONTACTS
+    if backend == "kernel" or (backend == "auto" and small):
+        if small:
             return "kernel"
-        if backend == "kernel":
-            raise BackendUnsuitableError(f"'kernel' takes dense problems with at most "
-                                         f"{MAX_CONTACTS} contacts (got m = {structure.m})")
+        raise BackendUnsuitableError(f"'kernel' takes dense problems with at most "
+                                     f"{MAX_CONTACTS} contacts (got m = {structure.m})")
+    if backend in ("isotonic", "auto") and law == "moreau" and structure.chain is not None:
+        return "isotonic"
+    if backend == "isotonic":
+        raise BackendUnsuitableError("'isotonic' solves Moreau's law on chains built by "
+                                     "iq.chain or iq.newtons_cradle only")
     return None
 
 

@@ -29,6 +29,8 @@ FORMS = ("auto", "velocity", "impulse")
 def check_restitution(name: str, value: Any, m: int, *, matrix: bool = False) -> np.ndarray:
     """Validate ε (scalar), eᵢ (m-vector) or Frémond's E ((m, m)); entries must lie in [0, 1]
     for ε and eᵢ, and be finite for E."""
+    if not matrix and name == "eps" and isinstance(value, (int, float)) and 0.0 <= value <= 1.0:
+        return np.asarray(float(value))  # the common case, without array checks
     arr = np.asarray(value, dtype=float)
     if matrix:
         if arr.shape != (m, m):
