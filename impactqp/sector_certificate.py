@@ -1,7 +1,8 @@
 """Exact certificate of a piecewise-linear impact law on simplicial cones (§7).
 
 Works on any object shaped like :class:`impactqp.sector.SectorTable` (``cones`` with
-``rays``/``Q``/``label``, ``G``, ``W``, ``mass``).  Every check is vectorised over
+``rays``/``Q``/``label``, ``G``, ``W``, ``mass``), or with a mass matrix ``M`` instead of
+``mass`` (unequal masses, :mod:`impactqp.reflection_table`).  Every check is vectorised over
 the cones, so the 40 320 cones of eight balls are certified in seconds.
 
 Checks (impact-geometry.md §7, §6):
@@ -220,7 +221,8 @@ def certify_sector_table(table: Any, exact_energy: bool | None = None) -> Sector
     labels = [c.label for c in cones]
     G = np.asarray(table.G, dtype=float)
     W = np.asarray(table.W, dtype=float)
-    M = float(getattr(table, "mass", 1.0)) * np.eye(W.shape[0])
+    M = np.asarray(table.M, dtype=float) if hasattr(table, "M") else \
+        float(getattr(table, "mass", 1.0)) * np.eye(W.shape[0])
     Gi = np.linalg.inv(G)
     d = G.shape[0]
     Qs = np.stack([c.Q for c in cones])

@@ -57,8 +57,12 @@ class SectorLawCertificate(ResidualChecks):
 
 
 def sector_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
-                     Lam: np.ndarray) -> dict[str, np.ndarray]:
-    """Residuals of :class:`SectorLawCertificate` for one impact or for rows of impacts."""
+                     Lam: np.ndarray, expected: np.ndarray | None = None,
+                     ) -> dict[str, np.ndarray]:
+    """Residuals of :class:`SectorLawCertificate` for one impact or for rows of impacts.
+
+    ``expected`` is the γ⁺ the law must reproduce (default: the sector map of §6 of γ⁻).
+    """
     st = structure
     V, out = impact_residuals(st, U_minus, U_plus, Lam)
     out["energy_balance"] = np.abs(kinetic_norms(st, U_plus) ** 2
@@ -67,7 +71,8 @@ def sector_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np
         out["kinematic"] = out["law_residual"] = np.zeros(U_minus.shape[:-1])
         return out
     gamma_plus = np.asarray(st.W.T @ U_plus.T).T
-    expected = sector_gamma_map(np.asarray(st.W.T @ U_minus.T).T)
+    if expected is None:
+        expected = sector_gamma_map(np.asarray(st.W.T @ U_minus.T).T)
     out["kinematic"] = np.maximum(0.0, -(gamma_plus / (st.contact_scale * V[..., None]))
                                   .min(axis=-1))
     out["law_residual"] = np.abs(gamma_plus - expected).max(axis=-1) / V
