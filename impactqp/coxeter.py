@@ -17,7 +17,7 @@ contact i joins bodies i and i+1 and angle i is at body i+1.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -37,16 +37,15 @@ def extended_masses(masses: np.ndarray, left_wall: bool = False,
                            [math.inf] * right_wall])
 
 
-def contact_angles(G: np.ndarray) -> np.ndarray:
+def contact_angles(G: Any) -> np.ndarray:
     """Dihedral angles θ_i (radians) of T_C between contacts i and i+1 (§1).
 
     ``cos θ_i = −G_{i,i+1}/√(G_ii G_{i+1,i+1})``: π minus the angle between the inward
     normals M⁻¹w_i, M⁻¹w_{i+1} of the facets.  For a chain of balls
     ``cos θ_i = (1/m_{i+1})/√((1/m_i + 1/m_{i+1})(1/m_{i+1} + 1/m_{i+2}))``.
     """
-    G = np.asarray(G, dtype=float)
-    d = np.diag(G)
-    cos = -np.diag(G, 1) / np.sqrt(d[:-1] * d[1:])
+    d = np.asarray(G.diagonal(), dtype=float)  # dense or scipy.sparse
+    cos = -np.asarray(G.diagonal(1), dtype=float) / np.sqrt(d[:-1] * d[1:])
     return np.arccos(np.clip(cos, -1.0, 1.0))
 
 
