@@ -201,6 +201,13 @@ def identify_rays(rays: FloatArray, decimals: int = 8) -> tuple[NDArray[np.intp]
     return ids.reshape(k, r), uniq / np.linalg.norm(uniq, axis=1, keepdims=True)
 
 
+def table_mass_matrix(table: Any) -> FloatArray:
+    """M of a table: its ``M`` (unequal masses) or ``mass·I`` (equal balls, default 1)."""
+    if hasattr(table, "M"):
+        return np.asarray(table.M, dtype=float)
+    return float(getattr(table, "mass", 1.0)) * np.eye(np.shape(table.W)[0])
+
+
 # --------------------------------------------------------------------------- certificate
 def certify_sector_table(table: Any, exact_energy: bool | None = None) -> SectorCertificate:
     """Run every §7 check on ``table`` (a :class:`~impactqp.sector.SectorTable`).
@@ -221,8 +228,7 @@ def certify_sector_table(table: Any, exact_energy: bool | None = None) -> Sector
     labels = [c.label for c in cones]
     G = np.asarray(table.G, dtype=float)
     W = np.asarray(table.W, dtype=float)
-    M = np.asarray(table.M, dtype=float) if hasattr(table, "M") else \
-        float(getattr(table, "mass", 1.0)) * np.eye(W.shape[0])
+    M = table_mass_matrix(table)
     Gi = np.linalg.inv(G)
     d = G.shape[0]
     Qs = np.stack([c.Q for c in cones])

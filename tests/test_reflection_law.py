@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -213,6 +214,15 @@ def test_even_k_consistent_impacts_are_moreau_elastic(k: int) -> None:
 def test_verify_law_reports_ok() -> None:
     rep = iq.verify_law(iq.reflection_law, problem(M6), samples=300, seed=3)
     assert rep.ok, rep.summary()
+    table = reflection_law_table(np.ones(2), left_wall=True)
+    exact = iq.verify_law(table)
+    assert exact.ok and exact.method == "exact" and exact.certificate.maximal_monotone
+    table.cones = [replace(c, Q=1.1 * c.Q) for c in table.cones]  # expands: caught exactly
+    bad = iq.verify_law(table)
+    assert not bad.ok and bad.violations["energetic"] == 8
+    ce = bad.counterexamples["energetic"]  # recheck on the wall problem itself
+    p = problem(np.ones(2), ce.u_minus, left_wall=True)
+    assert p.kinetic_energy(ce.u_plus) > p.kinetic_energy() * (1 + 1e-3)
 
 
 # --------------------------------------------------------------------------- no law
