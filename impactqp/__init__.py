@@ -2,7 +2,9 @@
 
 Problems (:class:`ImpactProblem`, :func:`chain`, :func:`newtons_cradle`), the admissible
 set S (:class:`AdmissibleSet`), impact laws (:func:`moreau`, :func:`newton`,
-:func:`fremond`, :func:`sector_law` with its table :func:`sector_law_table`), the law
+:func:`fremond`, :func:`sector_law` with its table :func:`sector_law_table`, and for
+unequal masses with contact angles π/k :func:`reflection_law`, :func:`reflection_law_table`,
+:func:`continuous_mass_ratios`), the law
 verifier :func:`verify_law`, LCPs with symmetric matrices (:func:`solve_lcp`) and the
 geometric classification (:func:`classify`). See ``docs`` in the README for the conventions.
 """
@@ -11,6 +13,7 @@ from .admissible import AdmissibleSet, Membership
 from .batch import BatchResult, moreau_batch, sector_law_batch
 from .certificate import Certificate
 from .classify import Classification, classify
+from .coxeter import continuous_mass_ratios
 from .errors import (BackendUnsuitableError, CertificateError, ImpactError, InputError,
                      MassMatrixError, NoSolutionError, NonConvexLCPError, NonFiniteError,
                      NonSymmetricLCPError, RestitutionError, SectorInputError, SectorLawError,
@@ -20,6 +23,8 @@ from .laws import fremond, moreau, newton
 from .lcp import LCPResult, solve_lcp
 from .problem import ChainInfo, ImpactProblem, ImpactStructure
 from .problems import chain, newtons_cradle, random_impact
+from .reflection_law import reflection_law
+from .reflection_table import reflection_law_table
 from .result import ImpactResult
 from .sector import SectorCone, SectorTable, sector_law_table
 from .sector_certificate import SectorCertificate
@@ -36,7 +41,8 @@ __all__ = [
     "NonSymmetricLCPError", "RestitutionError", "SectorCertificate", "SectorCone",
     "SectorInputError", "SectorLawCertificate", "SectorLawError", "SectorTable",
     "SectorTableTooLarge", "ShapeError", "SolverError", "UnknownBackendError", "chain",
-    "classify", "fremond", "fremond_admissibility_map", "moreau", "moreau_batch", "newton",
-    "newtons_cradle", "random_impact", "sector_law", "sector_law_batch", "sector_law_table", "solve_lcp",
+    "classify", "continuous_mass_ratios", "fremond", "fremond_admissibility_map", "moreau", "moreau_batch", "newton",
+    "newtons_cradle", "random_impact", "reflection_law",
+    "reflection_law_table", "sector_law", "sector_law_batch", "sector_law_table", "solve_lcp",
     "verify_law",
 ]

@@ -1,7 +1,8 @@
 """Exact certificate of a piecewise-linear impact law on simplicial cones (§7).
 
 Works on any object shaped like :class:`impactqp.sector.SectorTable` (``cones`` with
-``rays``/``Q``/``label``, ``G``, ``W``, ``mass``).  Every check is vectorised over
+``rays``/``Q``/``label``, ``G``, ``W``, ``mass``), or with a mass matrix ``M`` instead of
+``mass`` (unequal masses, :mod:`impactqp.reflection_table`).  Every check is vectorised over
 the cones, so the 40 320 cones of eight balls are certified in seconds.
 
 Checks (impact-geometry.md §7, §6):
@@ -200,6 +201,13 @@ def identify_rays(rays: FloatArray, decimals: int = 8) -> tuple[NDArray[np.intp]
     return ids.reshape(k, r), uniq / np.linalg.norm(uniq, axis=1, keepdims=True)
 
 
+def table_mass_matrix(table: Any) -> FloatArray:
+    """M of a table: its ``M`` (unequal masses) or ``mass·I`` (equal balls, default 1)."""
+    if hasattr(table, "M"):
+        return np.asarray(table.M, dtype=float)
+    return float(getattr(table, "mass", 1.0)) * np.eye(np.shape(table.W)[0])
+
+
 # --------------------------------------------------------------------------- certificate
 def certify_sector_table(table: Any, exact_energy: bool | None = None) -> SectorCertificate:
     """Run every §7 check on ``table`` (a :class:`~impactqp.sector.SectorTable`).
@@ -220,7 +228,7 @@ def certify_sector_table(table: Any, exact_energy: bool | None = None) -> Sector
     labels = [c.label for c in cones]
     G = np.asarray(table.G, dtype=float)
     W = np.asarray(table.W, dtype=float)
-    M = float(getattr(table, "mass", 1.0)) * np.eye(W.shape[0])
+    M = table_mass_matrix(table)
     Gi = np.linalg.inv(G)
     d = G.shape[0]
     Qs = np.stack([c.Q for c in cones])

@@ -57,8 +57,12 @@ class SectorLawCertificate(ResidualChecks):
 
 
 def sector_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
-                     Lam: np.ndarray) -> dict[str, np.ndarray]:
-    """Residuals of :class:`SectorLawCertificate` for one impact or for rows of impacts."""
+                     Lam: np.ndarray, expected: np.ndarray | None = None,
+                     ) -> dict[str, np.ndarray]:
+    """Residuals of :class:`SectorLawCertificate` for one impact or for rows of impacts.
+
+    ``expected`` is the γ⁺ the law must reproduce (default: the sector map of §6 of γ⁻).
+    """
     st = structure
     V, out = impact_residuals(st, U_minus, U_plus, Lam)
     out["energy_balance"] = np.abs(kinetic_norms(st, U_plus) ** 2
@@ -67,7 +71,8 @@ def sector_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np
         out["kinematic"] = out["law_residual"] = np.zeros(U_minus.shape[:-1])
         return out
     gamma_plus = np.asarray(st.W.T @ U_plus.T).T
-    expected = sector_gamma_map(np.asarray(st.W.T @ U_minus.T).T)
+    if expected is None:
+        expected = sector_gamma_map(np.asarray(st.W.T @ U_minus.T).T)
     out["kinematic"] = np.maximum(0.0, -(gamma_plus / (st.contact_scale * V[..., None]))
                                   .min(axis=-1))
     out["law_residual"] = np.abs(gamma_plus - expected).max(axis=-1) / V
@@ -90,14 +95,21 @@ def wedge_angles(masses: np.ndarray) -> np.ndarray:
     return np.degrees(np.arccos(cos))
 
 
-def _wedge_note(masses: np.ndarray) -> str:
+def _wedge_note(problem: ImpactProblem) -> str:
     """Why: a simultaneous impact is a billiard in the wedge T_C, whose corner outcome is
-    continuous in u⁻ only when the wedge angle is π/k."""
-    if masses.size < 3:
-        return ""
-    angles = ", ".join(f"{a:.4g}°" for a in wedge_angles(masses)[:5])
+    continuous in u⁻ only when the wedge angle is π/k; when it is, name reflection_law."""
+    from .coxeter import contact_angles, coxeter_labels
+
+    if problem.n_contacts < 2:
+        return " impactqp.reflection_law gives the elastic law of any two balls."
+    radians = contact_angles(problem.delassus)
+    angles = ", ".join(f"{a:.4g}°" for a in np.degrees(radians)[:5])
+    if None not in coxeter_labels(radians):
+        return (f" Every angle of T_C here is 180°/k ({angles}): impactqp.reflection_law "
+                "gives the continuous elastic law of these masses by reflections.")
     return (f" A simultaneous impact is a billiard in the wedge T_C; its outcome at the corner "
-            f"is continuous only if every wedge angle is 180°/k (here {angles}).")
+            f"is continuous only if every wedge angle is 180°/k (here {angles}); "
+            "impactqp.reflection_law reports the masses that would make it so.")
 
 
 def check_sector_problem(problem: ImpactProblem) -> float:
@@ -111,14 +123,15 @@ def check_sector_problem(problem: ImpactProblem) -> float:
                              "problem with impactqp.chain or impactqp.newtons_cradle")
     if info.left_wall or info.right_wall:
         raise SectorLawError("the sector law is defined for free chains; walls are not "
-                             "supported (a wall is a ball of infinite mass, see unequal masses)")
+                             "supported (a wall is a ball of infinite mass, see unequal masses;"
+                             " impactqp.reflection_law handles one wall)")
     masses = info.masses
     if np.ptp(masses) > MASS_RTOL * masses.max():
         raise SectorLawError(
             f"the sector law needs equal masses, got {masses[:6].tolist()}"
             f"{' …' if masses.size > 6 else ''}: only for equal masses does an elastic "
             "collision swap velocities, so there is no continuous sorting law for unequal "
-            f"masses.{_wedge_note(masses)}")
+            f"masses.{_wedge_note(problem)}")
     return float(masses[0])
 
 

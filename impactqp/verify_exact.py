@@ -1,4 +1,4 @@
-"""Exact verification of a piecewise-linear impact law on a chain of equal balls (§7).
+"""Exact verification of a piecewise-linear impact law on a chain (§7).
 
 The §7 certificate decides every condition on every cone; this module turns it into a
 :class:`~impactqp.verify.LawReport` and, for each failed condition, looks for a concrete
@@ -13,8 +13,7 @@ from typing import Any
 import numpy as np
 
 from .problem import ImpactProblem
-from .problems import chain
-from .sector_certificate import certify_sector_table
+from .sector_certificate import certify_sector_table, table_mass_matrix
 from .verify import ADMISSIBILITY, Counterexample, LawReport
 
 INTERIOR_DIRECTIONS = 64
@@ -29,10 +28,11 @@ def _candidates(cone: Any, rng: np.random.Generator) -> np.ndarray:
 
 
 def _velocities(table: Any, cone: Any, gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """u⁻ = cumulative-sum lift of γ⁻ (u₁ = 0) and u⁺ = u⁻ + M⁻¹WG⁻¹(Q − I)γ⁻ (§1)."""
-    u_minus = np.concatenate([[0.0], np.cumsum(gamma)])
+    """A u⁻ with Wᵀu⁻ = γ⁻ (least squares) and u⁺ = u⁻ + M⁻¹WG⁻¹(Q − I)γ⁻ (§1)."""
+    W = np.asarray(table.W, dtype=float)
+    u_minus = np.linalg.lstsq(W.T, gamma, rcond=None)[0]
     impulses = np.linalg.solve(table.G, cone.Q @ gamma - gamma)
-    return u_minus, u_minus + (np.asarray(table.W) @ impulses) / float(table.mass)
+    return u_minus, u_minus + np.linalg.solve(table_mass_matrix(table), W @ impulses)
 
 
 def _counterexample(table: Any, base: ImpactProblem, cone: Any, condition: str,
@@ -69,7 +69,8 @@ def certify_table_report(table: Any, *, tol: float, seed: int = 0) -> LawReport:
     violations = {k: int(sum(v)) for k, v in flags.items()}
     violations["continuity"] = int(not cert.continuity.passed)
     rng = np.random.default_rng(seed)
-    base = chain(np.full(int(table.n_balls), float(table.mass)), np.zeros(int(table.n_balls)))
+    W = np.asarray(table.W, dtype=float)
+    base = ImpactProblem(table_mass_matrix(table), W, np.zeros(W.shape[0]))
     found: dict[str, Counterexample] = {}
     for name in (*ADMISSIBILITY, "non_expansive"):
         for i in np.flatnonzero(flags[name]):
