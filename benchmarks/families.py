@@ -131,7 +131,7 @@ def _redundant(size: int, seed: int) -> Case:
 
 
 def _mass_ratio(size: int, seed: int) -> Case:
-    n = 1000
+    n = 200
     masses = np.where(np.arange(n) % 2 == 0, 1.0, float(size))
     u = np.zeros(n)
     u[0] = 1.0
@@ -162,8 +162,8 @@ INSTANCES = {"random": 3, "redundant": 3}
 
 SUITES: dict[str, dict[str, list[int]]] = {
     "smoke": {"cradle": [3, 100], "random": [5], "discs": [30], "batch": [1000]},
-    "quick": {"cradle": [3, 100, 10_000], "random": [2, 10, 50], "redundant": [6, 30],
-              "mass-ratio": [1_000_000], "discs": [100, 1000], "batch": [10_000]},
+    "quick": {"cradle": [3, 100, 10_000], "random": [2, 50], "redundant": [6],
+              "mass-ratio": [1_000_000], "discs": [300], "batch": [10_000]},
     "full": {"cradle": [3, 10, 100, 1000, 10_000, 100_000, 1_000_000],
              "random": [2, 5, 10, 20, 50], "redundant": [6, 12, 30, 50],
              "mass-ratio": [10, 1000, 1_000_000], "discs": [100, 1000, 10_000],
