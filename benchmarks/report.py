@@ -136,7 +136,7 @@ def summary_markdown(rows: list[dict], meta: dict) -> str:
             continue
         sizes = sorted({r["size"] for r in fam})
         refs = sorted({r["reference"] for r in fam})
-        lines += ["", f"## {family}", "", f"Reference: {'; '.join(refs)}.", "",
+        lines += ["", f"## {family}", "", f"Exact answer from: {'; '.join(refs)}.", "",
                   "| method | " + " | ".join(f"{label}={s:g}" for s in sizes) + " |",
                   "|---|" + "---|" * len(sizes)]
         for method in dict.fromkeys(r["method"] for r in fam):
