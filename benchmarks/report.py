@@ -127,7 +127,9 @@ def summary_markdown(rows: list[dict], meta: dict) -> str:
              f"timed repeats for up to {meta['timing_budget_s']} s (≤ {meta['max_repeats']}). "
              "Times are medians of the solve only; error = max ‖u⁺ − u⁺_ref‖_M / ‖u⁻‖_M; "
              f"✗k/n = only k of n runs succeeded (error ≤ {meta['accurate_below']:g}, no "
-             "exception). `skip` = size cap or not applicable (see results.csv).", "",
+             "exception). `skip` = size cap or not applicable (see results.csv). peak_mb in "
+             "results.csv (cases with max(n, m) or k ≥ 10⁴): tracemalloc peak of the warm-up "
+             "run, Python/numpy allocations only (native solver memory is not seen).", "",
              "## Targets", "", "| target | measured | verdict |", "|---|---|---|"]
     lines += [f"| {t} | {m} | {v} |" for t, m, v in targets(rows)]
     for family, label in SIZE_LABEL.items():
