@@ -1,0 +1,34 @@
+"""``python -m benchmarks run --suite smoke|quick|full [--out DIR]``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .families import SUITES
+from .peers import SICONOS_PYTHON
+from .runner import run_suite
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Parse the command line and run a suite; return the exit status."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks",
+                                     description="Time impactqp against raw solvers and Siconos.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="run a benchmark suite")
+    run.add_argument("--suite", choices=sorted(SUITES), default="quick")
+    run.add_argument("--out", type=Path, default=Path("benchmarks/results"),
+                     help="output directory (default: benchmarks/results)")
+    run.add_argument("--siconos-python", default=SICONOS_PYTHON,
+                     help="interpreter that imports siconos ('' skips the peer)")
+    run.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    args = parser.parse_args(argv)
+    run_suite(args.suite, args.out, siconos_python=args.siconos_python,
+              progress=not args.no_progress)
+    print(f"wrote {args.out}/results.csv, results.json, summary.md, plot.png")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

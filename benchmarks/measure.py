@@ -1,0 +1,104 @@
+"""Timing one method on one case, its accuracy, and the record the reports are made from."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import time
+import tracemalloc
+import warnings
+from typing import Any, Iterator
+
+import numpy as np
+
+from .families import Case
+from .methods import Method
+
+#: relative velocity error up to which an answer counts as a success
+ACCURATE = 1e-6
+#: cases with at least this bulk (max(n, m), or k) get their peak memory measured
+LARGE = 10_000
+
+
+def relative_error(case: Case, u_plus: np.ndarray, *, law: str = "moreau") -> float:
+    """max ‖u⁺ − u⁺_ref‖_M / ‖u⁻‖_M (over the sampled rows for a batch)."""
+    st = case.problem.structure
+    if case.U is None:
+        diff = np.asarray(u_plus) - case.reference
+        return case.problem.norm(diff) / case.problem.velocity_scale
+    ref = case.extra["sorted"] if law == "sector" else case.reference
+    rows = np.asarray(u_plus)[case.sample]
+    U = case.U[case.sample]
+    num = np.sqrt(np.einsum("ij,ij->i", st.mass_rows(rows - ref), rows - ref))
+    den = np.sqrt(np.einsum("ij,ij->i", st.mass_rows(U), U))
+    return float(np.max(num / np.where(den > 0, den, 1.0)))
+
+
+def record(case: Case, method: str, group: str, *, status: str, message: str = "",
+           times: list[float] | None = None, error: float | None = None,
+           peak_mb: float | None = None, note: str = "") -> dict[str, Any]:
+    """One tidy row: a method on one case instance."""
+    return {"family": case.family, "size": case.size, "instance": case.instance,
+            "method": method, "group": group, "status": status, "message": message[:300],
+            "times": list(times or []), "error": error, "peak_mb": peak_mb,
+            "reference": case.ref_label, "note": note}
+
+
+@contextlib.contextmanager
+def quiet_stdout() -> Iterator[None]:
+    """Silence what native solvers print on file descriptor 1, and Python warnings."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    with open(os.devnull, "w") as null, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        os.dup2(null.fileno(), 1)
+        try:
+            yield
+        finally:
+            sys.stdout.flush()
+            os.dup2(saved, 1)
+            os.close(saved)
+
+
+def _first_run(solve: Any, track_memory: bool) -> tuple[Any, float | None]:
+    """The untimed warm-up (fills the problem's caches); under tracemalloc when asked."""
+    if not track_memory:
+        return solve(), None
+    tracemalloc.start()
+    try:
+        raw = solve()
+        peak = tracemalloc.get_traced_memory()[1] / 2**20
+    finally:
+        tracemalloc.stop()
+    return raw, peak
+
+
+def measure(method: Method, case: Case, *, budget: float, max_repeats: int) -> dict[str, Any]:
+    """Prepare, warm up, then time ``solve()`` until ``budget`` seconds or ``max_repeats``.
+
+    Never raises: an exception in any step is recorded as a failure with its message.
+    """
+    why = method.skip_reason(case)
+    if why is not None:
+        return record(case, method.name, method.group, status="skipped", message=why,
+                      note=method.note)
+    try:
+        with quiet_stdout():
+            solve, finish = method.prepare(case)
+            raw, peak = _first_run(solve, case.work >= LARGE)
+            u_plus = finish(raw)
+            times: list[float] = []
+            start = time.perf_counter()
+            while len(times) < max_repeats and (not times or time.perf_counter() - start < budget):
+                t0 = time.perf_counter()
+                solve()
+                times.append(time.perf_counter() - t0)
+    except Exception as exc:  # a failing method is a result, never an abort
+        return record(case, method.name, method.group, status="failed",
+                      message=f"{type(exc).__name__}: {exc}", note=method.note)
+    err = relative_error(case, u_plus, law=method.law)
+    status = "ok" if err <= ACCURATE else "inaccurate"
+    return record(case, method.name, method.group, status=status, times=times, error=err,
+                  peak_mb=peak, note=method.note,
+                  message="" if status == "ok" else f"relative error {err:.1e}")
