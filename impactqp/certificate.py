@@ -99,7 +99,7 @@ def impact_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np
     du = U_plus - U_minus - np.asarray(st.Minv_W @ Lam.T).T
     out = {"momentum": kinetic_norms(st, du) / V}
     if st.m:
-        out["impulse_sign"] = np.maximum(0.0, -(Lam * st.contact_scale / V[..., None])
+        out["impulse_sign"] = 0.0 + np.maximum(0.0, -(Lam * st.contact_scale / V[..., None])
                                          .min(axis=-1))
     else:
         out["impulse_sign"] = np.zeros(U_minus.shape[:-1])

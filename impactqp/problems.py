@@ -20,18 +20,19 @@ def chain_directions(n_balls: int, *, left_wall: bool = False, right_wall: bool 
     (gap q₁ − wall) has e₁, a right wall (gap wall − q_N) has −e_N.
     """
     n = n_balls
-    rows, cols, vals = [], [], []
-    c = 0
+    gaps = np.arange(n - 1)
+    first = 1 if left_wall else 0
+    m = first + n - 1 + (1 if right_wall else 0)
+    rows = [gaps, gaps + 1]
+    cols = [gaps + first, gaps + first]
+    vals = [np.full(n - 1, -1.0), np.ones(n - 1)]
     if left_wall:
-        rows += [0]; cols += [0]; vals += [1.0]; c = 1
-    idx = np.arange(n - 1)
-    rows += list(idx) + list(idx + 1)
-    cols += list(idx + c) + list(idx + c)
-    vals += [-1.0] * (n - 1) + [1.0] * (n - 1)
-    m = c + n - 1 + (1 if right_wall else 0)
+        rows.append(np.array([0])); cols.append(np.array([0])); vals.append(np.array([1.0]))
     if right_wall:
-        rows += [n - 1]; cols += [m - 1]; vals += [-1.0]
-    W = sp.csc_matrix((vals, (rows, cols)), shape=(n, m))
+        rows.append(np.array([n - 1])); cols.append(np.array([m - 1]))
+        vals.append(np.array([-1.0]))
+    W = sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                      shape=(n, m))
     return W if sparse else W.toarray()
 
 

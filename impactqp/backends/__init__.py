@@ -33,6 +33,22 @@ _MODULES: dict[str, tuple[str, str]] = {
 
 QP_BACKENDS = tuple(_MODULES)
 
+#: how each solver (qpsolvers or cvxpy name, lower case) spells its stopping tolerances
+TOLERANCE_OPTIONS: dict[str, tuple[str, ...]] = {
+    "clarabel": ("tol_gap_abs", "tol_gap_rel", "tol_feas"),
+    "osqp": ("eps_abs", "eps_rel"),
+    "piqp": ("eps_abs", "eps_rel"),
+    "proxqp": ("eps_abs", "eps_rel"),
+    "scs": ("eps_abs", "eps_rel"),
+    "ecos": ("abstol", "reltol", "feastol"),
+}
+
+
+def tolerance_options(solver: str | None, tol: float) -> dict[str, float]:
+    """Keyword arguments that set every stopping tolerance of ``solver`` to ``tol``
+    (empty for solvers without one, such as the active-set solver daqp)."""
+    return {name: tol for name in TOLERANCE_OPTIONS.get((solver or "").lower(), ())}
+
 
 def parse_backend(name: str) -> tuple[str, str | None]:
     """Split ``"family:solver"`` and check that the family exists.

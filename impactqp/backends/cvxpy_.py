@@ -1,4 +1,4 @@
-"""Any QP solver installed for cvxpy (``"cvxpy"`` uses cvxpy's default choice).
+"""Any QP solver installed for cvxpy (``"cvxpy"`` means ``"cvxpy:CLARABEL"``).
 
 Programs that carry a ``cache_owner`` are compiled once per (owner, tag, solver) with c as a
 ``cp.Parameter`` (DPP): later solves on the same structure pay only the re-solve. The cache
@@ -14,9 +14,13 @@ import cvxpy as cp
 import numpy as np
 
 from ..errors import SolverError, UnknownBackendError
+from . import tolerance_options
 from ..program import QPSolution, QuadraticProgram
 
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+#: plain ``"cvxpy"`` runs Clarabel (a dependency of impactqp) through cvxpy
+DEFAULT_SOLVER = "CLARABEL"
 
 
 def _compile(qp: QuadraticProgram):
@@ -44,11 +48,11 @@ def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None
     if solver is not None and solver.upper() not in cp.installed_solvers():
         raise UnknownBackendError(f"cvxpy solver {solver!r} is not installed; installed: "
                                   f"{', '.join(cp.installed_solvers())}")
-    name = solver.upper() if solver else None
+    name = solver.upper() if solver else DEFAULT_SOLVER
     prob, x, c, con = _compiled(qp, name)
     c.value = np.asarray(qp.c, dtype=float)
     try:
-        prob.solve(solver=name)
+        prob.solve(solver=name, **tolerance_options(name, tol))
     except (cp.error.SolverError, ValueError) as exc:
         raise SolverError(f"cvxpy ({solver or 'default'}) failed: {exc}") from exc
     if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:

@@ -6,6 +6,7 @@ import numpy as np
 import qpsolvers
 
 from ..errors import SolverError, UnknownBackendError
+from . import tolerance_options
 from ..program import QPSolution, QuadraticProgram
 
 
@@ -21,7 +22,7 @@ def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None
         G = G.toarray() if hasattr(G, "toarray") else G
     problem = qpsolvers.Problem(P, np.asarray(qp.c, float), G, -qp.constraint_rhs())
     try:
-        sol = qpsolvers.solve_problem(problem, solver=solver)
+        sol = qpsolvers.solve_problem(problem, solver=solver, **tolerance_options(solver, tol))
     except Exception as exc:  # solvers raise their own types; translate them
         raise SolverError(f"qpsolvers:{solver} failed: {exc}") from exc
     if sol.x is None or sol.z is None or not sol.found:
