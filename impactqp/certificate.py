@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .problem import ImpactProblem, ImpactStructure
+from .rowwise import row_max, row_min, row_sum
 
 DEFAULT_TOL = 1e-9
 
@@ -86,7 +87,7 @@ class Certificate(ResidualChecks):
 
 def kinetic_norms(structure: ImpactStructure, X: np.ndarray) -> np.ndarray:
     """‖x‖ = sqrt(xᵀMx) of a vector or of every row of X."""
-    return np.sqrt(np.maximum((structure.mass_rows(X) * X).sum(axis=-1), 0.0))
+    return np.sqrt(np.maximum(row_sum(structure.mass_rows(X) * X), 0.0))
 
 
 def impact_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
@@ -99,8 +100,8 @@ def impact_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np
     du = U_plus - U_minus - np.asarray(st.Minv_W @ Lam.T).T
     out = {"momentum": kinetic_norms(st, du) / V}
     if st.m:
-        out["impulse_sign"] = 0.0 + np.maximum(0.0, -(Lam * st.contact_scale / V[..., None])
-                                         .min(axis=-1))
+        out["impulse_sign"] = 0.0 + np.maximum(0.0, -row_min(Lam * st.contact_scale
+                                                             / V[..., None]))
     else:
         out["impulse_sign"] = np.zeros(U_minus.shape[:-1])
     return V, out
@@ -121,14 +122,13 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
         g_minus = np.asarray(st.W.T @ U_minus.T).T
         E = np.asarray(E, dtype=float)
         w = np.asarray(st.W.T @ U_plus.T).T + (E * g_minus if E.ndim <= 1 else g_minus @ E.T)
-        out["law_feasibility"] = np.maximum(0.0, -(w / (s * V[..., None])).min(axis=-1))
-        out["complementarity"] = np.abs(Lam * w).max(axis=-1) / V**2
+        out["law_feasibility"] = np.maximum(0.0, -row_min(w / (s * V[..., None])))
+        out["complementarity"] = row_max(np.abs(Lam * w)) / V**2
     else:
         out["law_feasibility"] = out["complementarity"] = np.zeros(U_minus.shape[:-1])
     if eps is not None:
         z = (U_plus + eps * U_minus) / (1.0 + eps)
-        out["energy_balance"] = 2.0 * eps * np.abs((st.mass_rows(z) * (U_minus - z))
-                                                   .sum(axis=-1)) / V**2
+        out["energy_balance"] = 2.0 * eps * np.abs(row_sum(st.mass_rows(z) * (U_minus - z))) / V**2
     return out
 
 

@@ -17,6 +17,8 @@ from itertools import combinations
 
 import numpy as np
 
+from .rowwise import row_max, row_min
+
 MAX_CONTACTS = 10
 _TOL = 1e-12
 
@@ -79,17 +81,17 @@ class ActiveSetKernel:
         """
         k = Q.shape[0]
         lam = np.zeros((k, self.m))
-        qs = np.maximum(np.abs(Q).max(axis=1, initial=0.0), 1e-300)
-        done = np.all(Q >= 0, axis=1)
+        qs = np.maximum(row_max(np.abs(Q)), 1e-300)
+        done = row_min(Q) >= 0
         lam_tol, w_tol = -tol * qs / self._scale, -tol * qs
         for J, F, inv, GFJ in self.supports:
             if done.all():
                 break
             full = J.size == self.m
             LJ = (Q if full else Q[:, J]) @ (-inv.T)
-            ok = ~done & (LJ.min(axis=1) >= lam_tol)
+            ok = ~done & (row_min(LJ) >= lam_tol)
             if not full:
-                ok &= (LJ @ GFJ.T + Q[:, F]).min(axis=1) >= w_tol
+                ok &= row_min(LJ @ GFJ.T + Q[:, F]) >= w_tol
             if full:
                 lam[ok] = LJ[ok]
             else:

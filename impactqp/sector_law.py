@@ -14,6 +14,7 @@ import numpy as np
 from .certificate import DEFAULT_TOL, ResidualChecks, impact_residuals, kinetic_norms
 from .errors import CertificateError, InputError, SectorLawError
 from .problem import ImpactProblem, ImpactStructure
+from .rowwise import row_max, row_min
 from .result import ImpactResult
 from .sector import sector_gamma_map, sector_velocity_map
 
@@ -73,9 +74,8 @@ def sector_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np
     gamma_plus = np.asarray(st.W.T @ U_plus.T).T
     if expected is None:
         expected = sector_gamma_map(np.asarray(st.W.T @ U_minus.T).T)
-    out["kinematic"] = np.maximum(0.0, -(gamma_plus / (st.contact_scale * V[..., None]))
-                                  .min(axis=-1))
-    out["law_residual"] = np.abs(gamma_plus - expected).max(axis=-1) / V
+    out["kinematic"] = np.maximum(0.0, -row_min(gamma_plus / (st.contact_scale * V[..., None])))
+    out["law_residual"] = row_max(np.abs(gamma_plus - expected)) / V
     return out
 
 
