@@ -13,6 +13,8 @@ from .errors import (BackendUnsuitableError, CertificateError, ImpactError, Inpu
                      MassMatrixError, NoSolutionError, NonConvexLCPError, NonFiniteError,
                      NonSymmetricLCPError, RestitutionError, ShapeError, SolverError,
                      UnknownBackendError)
+from .errors import OptionalDependencyError, ProblemFileError
+from .files import ProblemFile, load_problem, save_problem
 from .laws import fremond, moreau, newton
 from .lcp import LCPResult, solve_lcp
 from .problem import ChainInfo, ImpactProblem, ImpactStructure
@@ -28,4 +30,5 @@ __all__ = [
     "NonConvexLCPError", "NonFiniteError", "NonSymmetricLCPError", "RestitutionError",
     "ShapeError", "SolverError", "UnknownBackendError", "chain", "classify", "fremond",
     "moreau", "newton", "newtons_cradle", "random_impact", "solve_lcp",
+    "OptionalDependencyError", "ProblemFile", "ProblemFileError", "load_problem", "save_problem",
 ]
