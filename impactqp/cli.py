@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .commands import demo
+from .commands import demo, plot, solve, verify
 from .errors import ImpactError
 
-COMMANDS = [demo]
+COMMANDS = [demo, solve, verify, plot]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -214,7 +214,8 @@ def sector_picture(radius: float = 1.0, sample_radius: float = 0.45) -> list[Wed
         mid = (r1 + r2) / np.linalg.norm(r1 + r2)
         polygon = np.vstack([[0.0, 0.0], _arc(np.zeros(2), radius, r1, r2)])
         sample = sample_radius * radius * mid
-        wedges.append(Wedge(label=cone.label, Q=cone.Q, text=f"{cone.label}\n{_matrix_text(cone.Q)}",
-                            polygon=polygon, anchor=0.78 * radius * mid, sample=sample,
+        wedges.append(Wedge(label=cone.label, Q=cone.Q,
+                            text=f"{cone.label}\n{_matrix_text(cone.Q)}", polygon=polygon,
+                            anchor=0.78 * radius * mid, sample=sample,
                             image=sector_gamma_map(sample)))
     return wedges

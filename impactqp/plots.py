@@ -65,8 +65,8 @@ def draw_plane(picture: PlanePicture, ax: Any, title: str = "") -> None:
     ax.plot(line[:, 0], line[:, 1], color="black", lw=1.4, label="Moreau's half-line")
     for eps, x in picture.moreau_marks.items():
         ax.plot(*x, "o", color="black", ms=5)
-        ax.annotate(f"ε = {eps:g}" + (" (z)" if eps == 0 else ""), x, xytext=(-8, 0), textcoords="offset points",
-                    ha="right", va="center", fontsize=9)
+        ax.annotate(f"ε = {eps:g}" + (" (z)" if eps == 0 else ""), x, xytext=(-8, 0),
+                    textcoords="offset points", ha="right", va="center", fontsize=9)
     ax.plot(*picture.u_minus, "s", color="black", ms=6)
     ax.annotate("u⁻", picture.u_minus, xytext=(6, 4), textcoords="offset points", fontsize=11)
     for cand in picture.candidates:
