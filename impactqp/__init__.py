@@ -14,12 +14,13 @@ from .errors import (BackendUnsuitableError, CertificateError, ImpactError, Inpu
                      NonSymmetricLCPError, RestitutionError, ShapeError, SolverError,
                      UnknownBackendError)
 from .errors import OptionalDependencyError, ProblemFileError
-from .files import ProblemFile, load_problem, save_problem
+from .files import ProblemFile, load_problem
 from .laws import fremond, moreau, newton
 from .lcp import LCPResult, solve_lcp
 from .problem import ChainInfo, ImpactProblem, ImpactStructure
 from .problems import chain, newtons_cradle, random_impact
 from .result import ImpactResult
+from .save import save_problem
 
 __version__ = "0.1.0"
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import impactqp as iq
-from impactqp import files
+from impactqp import files, save
 
 
 @pytest.mark.parametrize("suffix", [".json", ".toml"])
@@ -136,6 +136,6 @@ def test_save_refuses_what_it_could_not_read(tmp_path):
 
 
 def test_toml_writer_formats():
-    text = files.to_toml({"version": 1, "law": "sector", "left_wall": True,
+    text = save.to_toml({"version": 1, "law": "sector", "left_wall": True,
                           "M": [[1e-300, -2.5e17]]})
     assert text == 'version = 1\nlaw = "sector"\nleft_wall = true\nM = [[1e-300, -2.5e+17]]\n'
