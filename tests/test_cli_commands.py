@@ -1,5 +1,7 @@
+import io
 import json
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -7,6 +9,7 @@ import pytest
 import impactqp as iq
 import impactqp.cli as cli
 from impactqp.commands.solve import parse_numbers, sector_law
+from impactqp.progress import progress
 
 
 @pytest.fixture
@@ -149,3 +152,14 @@ def test_plot_errors_exit_2(capsys, tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "matplotlib.figure", None)
     code, _, err = run(capsys, "plot", "sectors", "--out", tmp_path / "x.png")
     assert code == 2 and "pip install 'impactqp[plot]'" in err
+
+
+def test_progress_reports_only_long_steps():
+    quiet, loud = io.StringIO(), io.StringIO()
+    with progress("quick", after=5.0, stream=quiet):
+        pass
+    with progress("slow step", after=0.01, every=0.02, stream=loud):
+        time.sleep(0.1)
+    assert quiet.getvalue() == ""
+    assert loud.getvalue().startswith("impactqp: slow step… 0 s\n")
+    assert loud.getvalue().count("slow step") >= 2

@@ -18,6 +18,7 @@ from ..errors import InputError
 from ..files import COEFFICIENT_KEYS, LAWS, ProblemFile, load_problem
 from ..laws import fremond, moreau, newton
 from ..problem import ImpactProblem
+from ..progress import progress
 from ..report import format_solution, solution_report, to_json
 from ..result import ImpactResult
 from ..sector import sector_velocity_map
@@ -89,8 +90,11 @@ def solve_law(problem: ImpactProblem, law: str, coefficients: Any,
 def run(args: argparse.Namespace) -> int:
     content = load_problem(args.file)
     law, coefficients = choose_law(args, content)
-    result = solve_law(content.problem, law, coefficients, args.backend)
-    report = solution_report(result, str(args.file))
+    n = content.problem.n_dof
+    with progress(f"solving with law {law} (n = {n})"):
+        result = solve_law(content.problem, law, coefficients, args.backend)
+    with progress(f"checking u⁺ ∈ S and classifying it (n = {n})"):
+        report = solution_report(result, str(args.file))
     print(to_json(report) if args.json else format_solution(report))
     return 0
 

@@ -10,6 +10,7 @@ import argparse
 from ..errors import InputError
 from ..files import load_problem
 from ..problem import as_vector
+from ..progress import progress
 from ..report import format_verdict, membership_report, to_json
 from .solve import parse_numbers
 
@@ -24,7 +25,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         raise InputError(f"{args.file}: no candidate u⁺: pass --u-plus v1,v2,... or put "
                          "'u_plus' in the file")
-    report = membership_report(content.problem, u_plus)
+    with progress(f"checking u⁺ ∈ S, exactly and by the SOCP (n = {content.problem.n_dof})"):
+        report = membership_report(content.problem, u_plus)
     print(to_json(report) if args.json else format_verdict(report, str(args.file)))
     return 0 if report["admissible"] else 1
 
