@@ -1,5 +1,6 @@
 import io
 import json
+import subprocess
 import sys
 import time
 
@@ -163,3 +164,11 @@ def test_progress_reports_only_long_steps():
     assert quiet.getvalue() == ""
     assert loud.getvalue().startswith("impactqp: slow step… 0 s\n")
     assert loud.getvalue().count("slow step") >= 2
+
+
+def test_verify_process_exit_status_without_matplotlib(cradle_file):
+    script = ("import sys; from impactqp.cli import main; "
+              f"rc = main(['verify', {str(cradle_file)!r}, '--u-plus', '1,0,0.5']); "
+              "sys.exit(10 + rc if 'matplotlib' in sys.modules else rc)")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert done.returncode == 1 and "NOT ADMISSIBLE" in done.stdout
