@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .commands import demo, sector
+from .commands import demo, plot, sector, solve, verify
 from .errors import ImpactError
 
-COMMANDS = [demo, sector]
+COMMANDS = [demo, solve, verify, plot, sector]
 
 
 def build_parser() -> argparse.ArgumentParser:

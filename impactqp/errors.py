@@ -48,6 +48,14 @@ class NonSymmetricLCPError(NonConvexLCPError):
     """An LCP whose matrix is not symmetric."""
 
 
+class ProblemFileError(InputError):
+    """A problem file that cannot be read: syntax, unknown keys, types, shapes or size."""
+
+
+class OptionalDependencyError(ImpactError, ImportError):
+    """An optional extra (e.g. matplotlib for figures) is needed but not installed."""
+
+
 class BackendUnsuitableError(ImpactError):
     """A backend cannot handle this program (size, structure); try another one."""
 

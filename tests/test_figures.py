@@ -1,0 +1,136 @@
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import impactqp as iq
+from impactqp.geometry2d import clip, plane_picture, sector_picture
+from impactqp.plots import plot_cradle, plot_S, plot_sectors
+from impactqp.sector import sector_law_table
+
+
+@pytest.fixture(scope="module")
+def cradle():
+    p = iq.newtons_cradle(3, v=2.0)
+    return p, plane_picture(p, {"sector": [0.0, 0.0, 2.0]})
+
+
+def test_plane_is_momentum_conserving_and_metric(cradle):
+    p, pic = cradle
+    np.testing.assert_allclose(pic.basis.T @ p.M @ pic.basis, np.eye(2), atol=1e-12)
+    np.testing.assert_allclose(pic.basis.sum(axis=0), 0.0, atol=1e-12)  # u1+u2+u3 = v
+    np.testing.assert_allclose(pic.origin, [2 / 3] * 3)
+    np.testing.assert_allclose(pic.lift(pic.u_minus), p.u_minus, atol=1e-12)
+    assert pic.radius == pytest.approx(np.sqrt(4 - 4 / 3))
+
+
+def test_moreau_marks_are_moreaus_law(cradle):
+    p, pic = cradle
+    for eps, x in pic.moreau_marks.items():
+        np.testing.assert_allclose(pic.lift(x), iq.moreau(p, eps=eps).u_plus, atol=1e-12)
+    assert np.linalg.norm(pic.moreau_marks[1.0]) == pytest.approx(pic.radius, rel=1e-12)
+    assert np.linalg.norm(pic.moreau_marks[0.0] - pic.z) < 1e-12
+    start, end = pic.moreau_line
+    direction = pic.z - pic.u_minus
+    d = end - start
+    assert abs(d[0] * direction[1] - d[1] * direction[0]) < 1e-12 and d @ direction > 0
+    assert np.max(np.abs(end)) == pytest.approx(pic.half_width)
+
+
+def test_sector_point_is_30_degrees_from_moreau(cradle):
+    p, pic = cradle
+    (cand,) = pic.candidates
+    assert cand.alpha_deg == pytest.approx(30.0, abs=1e-9)
+    assert cand.alpha_deg == pytest.approx(iq.classify(p, [0, 0, 2.0]).alpha_deg, abs=1e-9)
+    assert np.linalg.norm(cand.point) == pytest.approx(pic.radius)  # on the energy circle
+    np.testing.assert_allclose(np.linalg.norm(cand.arc - pic.u_minus, axis=1), 0.3 * pic.radius)
+
+
+def test_S_polygon_vertices_are_in_S_and_the_region_is_right(cradle):
+    p, pic = cradle
+    S = p.admissible_set()
+    assert all(S.contains(u) for u in pic.lift(pic.admissible))
+    # the S region of §5 is the circular sector between Moreau's half-line and the T_C face
+    # through the sector point: area (60° / 360°) π r²
+    x, y = pic.admissible.T
+    area = 0.5 * abs(x @ np.roll(y, 1) - y @ np.roll(x, 1))
+    assert area == pytest.approx(np.pi * pic.radius**2 / 6, rel=1e-3)
+    assert all(S.contains(u).kinetic < 1e-12 for u in pic.lift(pic.reaction_cone))
+    assert all(S.contains(u).kinematic < 1e-12 for u in pic.lift(pic.tangent_cone))
+    assert max(S.contains(u).kinematic for u in pic.lift(pic.reaction_cone)) > 0.1
+
+
+def test_general_problem_plane():
+    p = iq.ImpactProblem([[2.0, 0.3, 0], [0.3, 1.0, 0.1], [0, 0.1, 3.0]],
+                         [[-1.0, 0.2], [1.0, -1.0], [0.1, 1.0]], [1.0, -0.5, -0.8])
+    pic = plane_picture(p)
+    S = p.admissible_set()
+    assert len(pic.admissible) > 3 and all(S.contains(u) for u in pic.lift(pic.admissible))
+    assert np.linalg.norm(pic.moreau_marks[1.0]) == pytest.approx(pic.radius, rel=1e-12)
+
+
+@pytest.mark.parametrize("problem, message", [
+    (iq.newtons_cradle(4), "exactly 2 independent contacts"),
+    (iq.chain([1.0, 1.0], [1.0, 0.0]), "exactly 2 independent contacts"),
+    (iq.newtons_cradle(3, v=-1.0), "S = {u⁻}"),
+])
+def test_undrawable_problems(problem, message):
+    with pytest.raises(iq.InputError, match=message):
+        plane_picture(problem)
+
+
+def test_candidate_off_the_plane_is_refused():
+    with pytest.raises(iq.InputError, match="not kinetically compatible"):
+        plane_picture(iq.newtons_cradle(), {"bad": [1.0, 1.0, 1.0]})
+
+
+def test_clip_half_plane():
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    np.testing.assert_allclose(clip(square, np.array([1.0, 0.0]), 0.5),
+                               [[0.5, 0.0], [1.0, 0.0], [1.0, 1.0], [0.5, 1.0]])
+
+
+def test_sector_picture_data():
+    wedges = sector_picture()
+    assert len(wedges) == 6 and len({w.label for w in wedges}) == 6
+    cones = {c.label: c for c in sector_law_table(3).cones}
+    for w in wedges:
+        cone = cones[w.label]
+        assert cone.contains(w.sample) and cone.contains(w.anchor)
+        assert all(cone.contains(x) for x in w.polygon)
+        np.testing.assert_allclose(w.image, cone.Q @ w.sample, atol=1e-12)
+        assert np.all(w.image >= -1e-12)
+        assert w.label in w.text and "Q = [" in w.text
+
+
+def _check_file(path, fmt):
+    data = path.read_bytes()
+    if fmt == "png":
+        assert data.startswith(b"\x89PNG\r\n\x1a\n") and len(data) > 10_000
+    else:
+        assert b"<svg" in data[:2000] and data.rstrip().endswith(b"</svg>")
+
+
+@pytest.mark.parametrize("fmt", ["png", "svg"])
+def test_figures_render(tmp_path, fmt):
+    _check_file(plot_cradle(tmp_path / f"c.{fmt}"), fmt)
+    _check_file(plot_sectors(tmp_path / f"s.{fmt}"), fmt)
+
+
+def test_figure_errors(tmp_path, monkeypatch):
+    with pytest.raises(iq.InputError, match="must end in one of"):
+        plot_sectors(tmp_path / "x.pdf")
+    with pytest.raises(iq.InputError, match="exactly 2 independent"):
+        plot_S(iq.newtons_cradle(4), tmp_path / "x.png")
+    monkeypatch.setitem(sys.modules, "matplotlib.figure", None)
+    with pytest.raises(iq.OptionalDependencyError, match=r"pip install 'impactqp\[plot\]'"):
+        plot_cradle(tmp_path / "x.png")
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_committed_figures_are_small():
+    root = Path(__file__).resolve().parent.parent / "docs" / "figures"
+    for name in ("cradle.png", "sectors.png"):
+        data = (root / name).read_bytes()
+        assert data.startswith(b"\x89PNG") and len(data) < 200_000
