@@ -8,17 +8,20 @@ obtained through the SOCP (distance from u to S), which is how S is handed to op
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
 import clarabel
 import numpy as np
 import scipy.sparse as sp
-from scipy.optimize import lsq_linear, nnls
+import scipy.sparse.linalg as spla
+from scipy.optimize import nnls
 
 from .backends.clarabel_ import run as run_clarabel
 from .certificate import DEFAULT_TOL
 from .errors import InputError
+from .lcp import solve_psd_lcp
 from .problem import ImpactProblem, as_vector
 
 OPTIMIZER_TOL = 1e-6
@@ -72,7 +75,9 @@ class Membership:
 def best_impulses(problem: ImpactProblem, du: np.ndarray) -> tuple[np.ndarray, float]:
     """Λ ≥ 0 minimizing ‖du − M⁻¹WΛ‖ (kinetic norm) and that minimum (§2, kinetic condition).
 
-    ‖M⁻¹WΛ − du‖_M = ‖BΛ − Lᵀdu‖ with M = LLᵀ, B = L⁻¹W: scipy's exact NNLS.
+    Dense: ‖M⁻¹WΛ − du‖_M = ‖BΛ − Lᵀdu‖ with M = LLᵀ, B = L⁻¹W, scipy's exact NNLS.
+    Sparse: the NNLS normal equations, an LCP with the Delassus matrix, by a sparse direct
+    solve when that already gives Λ ≥ 0 and by a certified QP backend otherwise.
     """
     st = problem.structure
     if st.m == 0:
@@ -80,15 +85,22 @@ def best_impulses(problem: ImpactProblem, du: np.ndarray) -> tuple[np.ndarray, f
     if not st.sparse:
         lam, res = nnls(st.scaled_W, st.cholesky_factor.T @ du, maxiter=50 * st.m)
         return lam, float(res)
-    if st.diagonal_mass:
-        root = np.sqrt(st.M.diagonal())
-        B = sp.csr_matrix(sp.diags(1.0 / root) @ st.W)
-        sol = lsq_linear(B, root * du, bounds=(0, np.inf), method="trf", tol=1e-14,
-                         lsmr_tol="auto", max_iter=10000)
-        lam = np.maximum(sol.x, 0.0)
-        return lam, problem.norm(du - st.solve_mass(st.W_times(lam)))
-    raise InputError("exact membership for a sparse non-diagonal M is not supported; "
-                     "pass M as a dense array or use method='optimizer'")
+    # sparse: the normal equations of the NNLS are the LCP 0 ≤ Λ ⟂ GΛ − Wᵀdu ≥ 0 (§3,
+    # impulse form); with independent contacts its unconstrained solution often already
+    # has Λ ≥ 0 (a chain), otherwise a certified QP backend solves it
+    g = st.Wt_times(du)
+    lam = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", spla.MatrixRankWarning)
+        try:
+            lam = spla.splu(sp.csc_matrix(st.delassus)).solve(g)
+        except RuntimeError:  # singular G: redundant contacts
+            lam = None
+    if lam is None or not np.all(np.isfinite(lam)) or \
+            lam.min() < -1e-12 * max(float(np.abs(lam).max(initial=0.0)), 1e-300):
+        lam = solve_psd_lcp(st.delassus, -g).z
+    lam = np.maximum(lam, 0.0)
+    return lam, problem.norm(du - st.solve_mass(st.W_times(lam)))
 
 
 class AdmissibleSet:

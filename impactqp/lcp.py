@@ -56,8 +56,8 @@ class _LCPCertificate(ResidualChecks):
         return self.values
 
 
-def _residuals(G: np.ndarray, q: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, dict]:
-    w = G @ z + q
+def _residuals(G: Any, q: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, dict]:
+    w = np.asarray(G @ z).ravel() + q
     scale = 1.0 + np.linalg.norm(q)
     zs = max(np.abs(z).max(initial=0.0), 1.0)
     return w, {
@@ -118,6 +118,13 @@ def solve_lcp(G: Any, q: Any, backend: str = "auto", *, tol: float = DEFAULT_TOL
     G, q = check_lcp(G, q)
     if backend != "auto":
         parse_backend(backend)
+    return solve_psd_lcp(G, q, backend, tol=tol)
+
+
+def solve_psd_lcp(G: Any, q: np.ndarray, backend: str = "auto", *,
+                  tol: float = DEFAULT_TOL) -> LCPResult:
+    """:func:`solve_lcp` without the input checks, for a G (dense or scipy.sparse) already
+    known to be symmetric positive semidefinite, such as a Delassus matrix."""
     if q.size == 0:
         return LCPResult(np.zeros(0), np.zeros(0), 0.0, {}, "none", tol)
     qp = QuadraticProgram(P=G, c=q)
