@@ -19,18 +19,15 @@ The chambers of a finite reflection group tile the space, so the |group| cones c
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import SectorInputError, SectorTableTooLarge
+from .piecewise import PiecewiseLinearTable
 from .problems import chain
 from .reflection_law import MAX_TABLE_ORDER, ReflectionGroup, check_reflection_problem
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .sector_certificate import SectorCertificate
 
 FloatArray = NDArray[np.float64]
 
@@ -65,7 +62,7 @@ class ReflectionCone:
 
 
 @dataclass(eq=False)
-class ReflectionTable:
+class ReflectionTable(PiecewiseLinearTable):
     """All cones of the reflection law of a chain (interface of SectorTable, §6, §7).
 
     Attributes
@@ -87,18 +84,6 @@ class ReflectionTable:
     n_balls: int
     group: ReflectionGroup
 
-    @cached_property
-    def certificate(self) -> SectorCertificate:
-        """The exact §7 certificate of this table (lazily computed, cached)."""
-        from .sector_certificate import certify_sector_table
-
-        return certify_sector_table(self)
-
-    @cached_property
-    def stacked_Q(self) -> FloatArray:
-        """All Q matrices, shape (order, m, m)."""
-        return np.stack([c.Q for c in self.cones])
-
     def find_cones(self, gammas: ArrayLike) -> NDArray[np.intp]:
         """Index of the cone containing each row of ``gammas``: the one whose smallest
         inequality slack is largest (≥ 0 inside; on a boundary any containing cone gives
@@ -110,12 +95,6 @@ class ReflectionTable:
         slack = np.einsum("cij,kj->kci", self.stacked_Q, g).min(axis=2)
         return np.argmax(slack, axis=1)
 
-    def apply(self, gamma: ArrayLike) -> FloatArray:
-        """``γ⁺ = Q_g γ`` on the cone containing γ; accepts a batch (k × m)."""
-        g = np.asarray(gamma, dtype=float)
-        gb = np.atleast_2d(g)
-        out = np.einsum("kij,kj->ki", self.stacked_Q[self.find_cones(gb)], gb)
-        return out[0] if g.ndim == 1 else out
 
 
 def _key(A: FloatArray) -> bytes:

@@ -18,15 +18,13 @@ import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
-from typing import TYPE_CHECKING, Sequence
+from typing import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from impactqp.errors import SectorInputError, SectorTableTooLarge
-
-if TYPE_CHECKING:  # pragma: no cover
-    from impactqp.sector_certificate import SectorCertificate
+from impactqp.piecewise import PiecewiseLinearTable
 
 MAX_TABLE_BALLS = 8
 """Largest ball count for which :func:`sector_law_table` enumerates the n! cones."""
@@ -144,7 +142,7 @@ def make_cone(permutation: Sequence[int]) -> SectorCone:
 
 
 @dataclass(eq=False)
-class SectorTable:
+class SectorTable(PiecewiseLinearTable):
     """All n! cones of the sector law for ``n_balls`` equal balls (§6).
 
     Attributes
@@ -167,18 +165,6 @@ class SectorTable:
 
     def __post_init__(self) -> None:
         self._index = {c.permutation: i for i, c in enumerate(self.cones)}
-
-    @cached_property
-    def certificate(self) -> SectorCertificate:
-        """The exact §7 certificate of this table (lazily computed, cached)."""
-        from impactqp.sector_certificate import certify_sector_table
-
-        return certify_sector_table(self)
-
-    @cached_property
-    def stacked_Q(self) -> FloatArray:
-        """All ``Q`` matrices stacked, shape (n_cones, n−1, n−1)."""
-        return np.stack([c.Q for c in self.cones])
 
     @cached_property
     def stacked_inequalities(self) -> FloatArray:
@@ -212,15 +198,6 @@ class SectorTable:
             raise SectorInputError("find_cone takes one gamma vector; use find_cones")
         return int(self.find_cones(g[None, :], tol)[0])
 
-    def apply(self, gamma: ArrayLike) -> FloatArray:
-        """``γ⁺ = Q_i γ`` for the cone containing γ; accepts a batch (k × (n−1)).
-
-        On a shared boundary every containing cone gives the same value (continuity).
-        """
-        g = np.asarray(gamma, dtype=float)
-        gb = np.atleast_2d(g)
-        out = np.einsum("kij,kj->ki", self.stacked_Q[self.find_cones(gb)], gb)
-        return out[0] if g.ndim == 1 else out
 
 
 def sector_law_table(n_balls: int = 3, mass: float = 1.0) -> SectorTable:
