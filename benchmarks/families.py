@@ -7,8 +7,8 @@ mass ratio r for the mass-ratio chains, and the number of impacts k for batches.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import Callable, Iterator
 
 import numpy as np
 import scipy.sparse as sp

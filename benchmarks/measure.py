@@ -8,7 +8,8 @@ import sys
 import time
 import tracemalloc
 import warnings
-from typing import Any, Iterator
+from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 

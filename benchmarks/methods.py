@@ -7,8 +7,9 @@ cvxpy problems, closures) and returns ``(solve, finish)``: only ``solve()`` is t
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 import clarabel
 import cvxpy as cp

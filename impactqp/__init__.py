@@ -14,11 +14,26 @@ from .batch import BatchResult, moreau_batch, sector_law_batch
 from .certificate import Certificate
 from .classify import Classification, classify
 from .coxeter import continuous_mass_ratios
-from .errors import (BackendUnsuitableError, CertificateError, ImpactError, InputError,
-                     MassMatrixError, NoSolutionError, NonConvexLCPError, NonFiniteError,
-                     NonSymmetricLCPError, OptionalDependencyError, ProblemFileError,
-                     RestitutionError, SectorInputError, SectorLawError, SectorTableTooLarge,
-                     ShapeError, SolverError, UnknownBackendError)
+from .errors import (
+                     BackendUnsuitableError,
+                     CertificateError,
+                     ImpactError,
+                     InputError,
+                     MassMatrixError,
+                     NonConvexLCPError,
+                     NonFiniteError,
+                     NonSymmetricLCPError,
+                     NoSolutionError,
+                     OptionalDependencyError,
+                     ProblemFileError,
+                     RestitutionError,
+                     SectorInputError,
+                     SectorLawError,
+                     SectorTableTooLarge,
+                     ShapeError,
+                     SolverError,
+                     UnknownBackendError,
+)
 from .files import ProblemFile, load_problem
 from .fremond_map import fremond_admissibility_map
 from .laws import fremond, moreau, newton

@@ -17,7 +17,8 @@ contact i joins bodies i and i+1 and angle i is at body i+1.
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 

@@ -6,7 +6,8 @@ polished before giving up). A failed certificate never becomes a success.
 
 from __future__ import annotations
 
-from typing import Callable, TypeVar
+from collections.abc import Callable
+from typing import TypeVar
 
 import numpy as np
 from scipy.optimize import linprog
@@ -15,8 +16,13 @@ from .backends import get_backend
 from .backends.exact import MAX_CONSTRAINTS
 from .backends.nnls_ import MAX_VARIABLES
 from .certificate import Certificate
-from .errors import (BackendUnsuitableError, CertificateError, NoSolutionError, SolverError,
-                     UnknownBackendError)
+from .errors import (
+    BackendUnsuitableError,
+    CertificateError,
+    NoSolutionError,
+    SolverError,
+    UnknownBackendError,
+)
 from .polish import polish
 from .program import QPSolution, QuadraticProgram
 

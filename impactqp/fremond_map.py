@@ -62,6 +62,6 @@ def fremond_admissibility_map(problem: ImpactProblem, a_values: Any, b_values: A
     for i, a in enumerate(a_values):
         for j, b in enumerate(b_values):
             E = fremond_matrix(a, b, m, family)
-            _, res = admissibility_residuals(lambda q: fremond(q, E), problem, u_minus)
+            _, res = admissibility_residuals(lambda q, E=E: fremond(q, E), problem, u_minus)
             out[i, j] = bool(np.all(res <= tol))  # NaN (the law failed) counts as not in S
     return out

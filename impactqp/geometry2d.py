@@ -10,8 +10,8 @@ Everything here is arrays; :mod:`impactqp.plots` draws them.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Mapping
 
 import numpy as np
 import scipy.sparse as sp

@@ -36,7 +36,8 @@ class ActiveSetKernel:
         G = np.asarray(G, dtype=float)
         m = G.shape[0]
         if m > MAX_CONTACTS:
-            raise ValueError(f"the active-set kernel takes at most {MAX_CONTACTS} contacts, got {m}")
+            raise ValueError(f"the active-set kernel takes at most {MAX_CONTACTS} contacts, "
+                             f"got {m}")
         self.G, self.m = G, m
         scale = max(np.abs(G).max(initial=0.0), 1e-300)
         supports = []

@@ -16,8 +16,7 @@ import scipy.sparse as sp
 from .backends import parse_backend
 from .certificate import DEFAULT_TOL, certify
 from .dispatch import solve_certified
-from .errors import (CertificateError, InputError, NonFiniteError, RestitutionError,
-                     ShapeError)
+from .errors import CertificateError, InputError, NonFiniteError, RestitutionError, ShapeError
 from .fastpaths import FAST_PATHS, applies, lcp_fast, moreau_fast
 from .problem import ImpactProblem
 from .program import QPSolution, QuadraticProgram

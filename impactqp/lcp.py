@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from .certificate import DEFAULT_TOL, ResidualChecks
 from .backends import parse_backend
+from .certificate import DEFAULT_TOL, ResidualChecks
 from .dispatch import solve_certified
 from .errors import NonConvexLCPError, NonFiniteError, NonSymmetricLCPError, ShapeError
 from .program import QPSolution, QuadraticProgram

@@ -16,13 +16,12 @@ result is kept only when the caller's certificate accepts it.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-
 from scipy.optimize import nnls
 from scipy.sparse.linalg import lsqr
 

@@ -34,7 +34,8 @@ class ChainInfo:
 def _finite(name: str, values: np.ndarray) -> None:
     if not np.all(np.isfinite(values)):
         bad = np.argwhere(~np.isfinite(values))[0]
-        raise NonFiniteError(f"{name} must be finite; found {values[tuple(bad)]} at index {tuple(bad)}")
+        raise NonFiniteError(f"{name} must be finite; found {values[tuple(bad)]} "
+                             f"at index {tuple(bad)}")
 
 
 def as_vector(name: str, value: Any, length: int) -> np.ndarray:
@@ -102,8 +103,9 @@ class ImpactStructure:
             self.diagonal_mass = offdiag.nnz == 0 or abs(offdiag).max() == 0
             if self.diagonal_mass:
                 if np.any(diag <= 0):
-                    raise MassMatrixError("M must be positive definite; diagonal entries "
-                                          f"{np.flatnonzero(diag <= 0)[:5].tolist()} are not positive")
+                    bad = np.flatnonzero(diag <= 0)[:5].tolist()
+                    raise MassMatrixError(f"M must be positive definite; diagonal entries {bad} "
+                                          "are not positive")
                 self._diag = diag
                 return
             # LU with diagonal pivoting on a symmetric permutation: all pivots > 0 iff SPD.

@@ -26,11 +26,11 @@ def chain_directions(n_balls: int, *, left_wall: bool = False, right_wall: bool 
     rows = [gaps, gaps + 1]
     cols = [gaps + first, gaps + first]
     vals = [np.full(n - 1, -1.0), np.ones(n - 1)]
-    if left_wall:
-        rows.append(np.array([0])); cols.append(np.array([0])); vals.append(np.array([1.0]))
-    if right_wall:
-        rows.append(np.array([n - 1])); cols.append(np.array([m - 1]))
-        vals.append(np.array([-1.0]))
+    for present, row, col, val in ((left_wall, 0, 0, 1.0), (right_wall, n - 1, m - 1, -1.0)):
+        if present:
+            rows.append(np.array([row]))
+            cols.append(np.array([col]))
+            vals.append(np.array([val]))
     W = sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                       shape=(n, m))
     return W if sparse else W.toarray()

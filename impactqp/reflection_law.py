@@ -26,8 +26,7 @@ from functools import lru_cache
 import numpy as np
 
 from .certificate import DEFAULT_TOL
-from .coxeter import (coxeter_labels, coxeter_type, contact_angles, extended_masses,
-                      shared_mass)
+from .coxeter import contact_angles, coxeter_labels, coxeter_type, extended_masses, shared_mass
 from .errors import CertificateError, InputError, SectorLawError, SolverError
 from .problem import ImpactProblem
 from .result import ImpactResult

@@ -28,8 +28,8 @@ def problem_to_dict(problem: ImpactProblem, *, law: str | None = None, coefficie
         data["masses"] = info.masses.tolist()
         data.update(left_wall=info.left_wall, right_wall=info.right_wall)
     else:
-        dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A))
-        data.update(M=dense(problem.M).tolist(), W=dense(problem.W).tolist())
+        M, W = (A.toarray() if sp.issparse(A) else np.asarray(A) for A in (problem.M, problem.W))
+        data.update(M=M.tolist(), W=W.tolist())
     data["u_minus"] = problem.u_minus.tolist()
     if law is not None:
         data["law"] = law

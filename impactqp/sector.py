@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
-from typing import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -284,7 +284,7 @@ def format_sector_table(table: SectorTable, include_certificate: bool = True) ->
             for c in table.cones]
     head = ("cone (ordering)", "extreme rays in γ-space", "Q  (γ⁺ = Q γ⁻)")
     widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(head)]
-    line = "  ".join("{:<%d}" % w for w in widths)
+    line = "  ".join(f"{{:<{w}}}" for w in widths)
     out = [
         f"Sector law (Winandy–Leine), {table.n_balls} equal balls, m = {_fmt(table.mass)}: "
         f"u⁺ = sort(u⁻), {len(table.cones)} cones",

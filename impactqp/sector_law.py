@@ -14,8 +14,8 @@ import numpy as np
 from .certificate import DEFAULT_TOL, ResidualChecks, impact_residuals, kinetic_norms
 from .errors import CertificateError, InputError, SectorLawError
 from .problem import ImpactProblem, ImpactStructure
-from .rowwise import row_max, row_min
 from .result import ImpactResult
+from .rowwise import row_max, row_min
 from .sector import sector_gamma_map, sector_velocity_map
 
 MASS_RTOL = 1e-12

@@ -11,8 +11,9 @@ samples. A piecewise-linear law (a :class:`~impactqp.sector.SectorTable`, or any
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 

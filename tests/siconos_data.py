@@ -26,11 +26,16 @@ def read_lcp(path: Path) -> tuple[np.ndarray, np.ndarray]:
     else:
         nbblock, nb0, nb1 = (int(t) for t in tok[pos:pos + 3])
         pos += 3
-        rows_end = [int(t) for t in tok[pos:pos + nb0]]; pos += nb0
-        cols_end = [int(t) for t in tok[pos:pos + nb1]]; pos += nb1
-        filled1, filled2 = int(tok[pos]), int(tok[pos + 1]); pos += 2
-        rowptr = [int(t) for t in tok[pos:pos + filled1]]; pos += filled1
-        colidx = [int(t) for t in tok[pos:pos + filled2]]; pos += filled2
+        rows_end = [int(t) for t in tok[pos:pos + nb0]]
+        pos += nb0
+        cols_end = [int(t) for t in tok[pos:pos + nb1]]
+        pos += nb1
+        filled1, filled2 = int(tok[pos]), int(tok[pos + 1])
+        pos += 2
+        rowptr = [int(t) for t in tok[pos:pos + filled1]]
+        pos += filled1
+        colidx = [int(t) for t in tok[pos:pos + filled2]]
+        pos += filled2
         M = np.zeros((rows_end[-1], cols_end[-1]))
         starts_r, starts_c = [0] + rows_end[:-1], [0] + cols_end[:-1]
         for bi in range(nb0):

@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
+from siconos_data import all_files, read_lcp
 
 import impactqp as iq
-from siconos_data import all_files, read_lcp
 
 FILES = all_files()
 

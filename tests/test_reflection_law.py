@@ -9,8 +9,13 @@ import numpy as np
 import pytest
 
 import impactqp as iq
-from impactqp.coxeter import (contact_angles, coxeter_labels, coxeter_type, extended_masses,
-                              shared_mass)
+from impactqp.coxeter import (
+    contact_angles,
+    coxeter_labels,
+    coxeter_type,
+    extended_masses,
+    shared_mass,
+)
 from impactqp.reflection_law import check_reflection_problem, elastic_collisions
 from impactqp.reflection_table import reflection_law_table
 from impactqp.sector import sector_gamma_map, sector_law_table

@@ -14,7 +14,7 @@ A backend is a function ``solve(qp, *, tol, solver=None) -> QPSolution`` for the
 from __future__ import annotations
 
 import importlib
-from typing import Callable
+from collections.abc import Callable
 
 from ..errors import UnknownBackendError
 from ..program import QPSolution, QuadraticProgram

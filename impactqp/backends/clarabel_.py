@@ -16,7 +16,7 @@ from ..program import QPSolution, QuadraticProgram
 _GOOD = {"Solved": "solved", "AlmostSolved": "solved_inaccurate"}
 
 
-def settings(tol: float, max_iter: int = 200) -> "clarabel.DefaultSettings":
+def settings(tol: float, max_iter: int = 200) -> clarabel.DefaultSettings:
     """Clarabel settings with every tolerance at ``tol`` and no printing."""
     s = clarabel.DefaultSettings()
     s.verbose = False

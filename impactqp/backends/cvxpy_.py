@@ -14,8 +14,8 @@ import cvxpy as cp
 import numpy as np
 
 from ..errors import SolverError, UnknownBackendError
-from . import tolerance_options
 from ..program import QPSolution, QuadraticProgram
+from . import tolerance_options
 
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 

@@ -6,8 +6,8 @@ import numpy as np
 import qpsolvers
 
 from ..errors import SolverError, UnknownBackendError
-from . import tolerance_options
 from ..program import QPSolution, QuadraticProgram
+from . import tolerance_options
 
 
 def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
