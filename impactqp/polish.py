@@ -16,6 +16,7 @@ result is kept only when the caller's certificate accepts it.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -23,7 +24,6 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.optimize import nnls
-from scipy.sparse.linalg import lsqr
 
 from .program import QPSolution, QuadraticProgram
 
@@ -32,7 +32,9 @@ REFINEMENT_STEPS = 8
 
 def _regularized_solver(K, shift: np.ndarray) -> Callable[[np.ndarray], np.ndarray] | None:
     """Factor K + diag(shift) once (sparse LU or dense LU); None when that fails."""
-    with np.errstate(all="ignore"):
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", sla.LinAlgWarning)
+        warnings.simplefilter("ignore", spla.MatrixRankWarning)
         try:
             if sp.issparse(K):
                 lu = spla.splu(sp.csc_matrix(K + sp.diags(shift)))
@@ -44,43 +46,71 @@ def _regularized_solver(K, shift: np.ndarray) -> Callable[[np.ndarray], np.ndarr
 
 
 def solve_refined(K, rhs: np.ndarray, shift: np.ndarray) -> np.ndarray | None:
-    """Solve K s = rhs through K + diag(shift) with iterative refinement on K itself."""
-    solve = _regularized_solver(K, shift)
-    if solve is None:
-        return None
-    s = solve(rhs)
-    best, best_res = s, np.inf
-    for _ in range(REFINEMENT_STEPS):
-        r = rhs - K @ s
-        res = float(np.abs(r).max(initial=0.0))
-        if not np.isfinite(res):
-            return None
+    """Solve K s = rhs with iterative refinement against K: through a factorization of K
+    itself when it has one (exact, also when ill-conditioned), else of K + diag(shift)
+    (singular K: redundant contacts). Returns the iterate with the smallest residual."""
+    best, best_res = None, np.inf
+    target = 1e-14 * max(float(np.abs(rhs).max(initial=0.0)), 1e-300)
+    for trial in (np.zeros_like(shift), shift):
+        solve = _regularized_solver(K, trial)
+        if solve is None:
+            continue
+        s, res = _refine(K, rhs, solve)
         if res < best_res:
             best, best_res = s, res
-        if res <= 1e-15 * max(float(np.abs(rhs).max(initial=0.0)), 1e-300):
+        if best_res <= target:
             break
-        s = s + solve(r)
     return best
 
 
-def nonnegative_multipliers(AJ, g: np.ndarray, y0: np.ndarray) -> np.ndarray:
-    """y ≥ 0 with A_Jᵀy ≈ g: the solver's own multipliers y0 (≥ 0, nearly right) plus the
-    least-norm correction (LSQR); scipy's exact NNLS when that correction leaves y ≥ 0
-    violated and the problem is dense."""
-    AT = sp.csr_matrix(AJ.T) if sp.issparse(AJ) else np.asarray(AJ).T
+def _refine(K, rhs: np.ndarray, solve) -> tuple[np.ndarray | None, float]:
+    """Iterative refinement from solve(rhs); the iterate with the smallest residual."""
+    best, best_res = None, np.inf
+    with np.errstate(all="ignore"):
+        s = solve(rhs)
+        for _ in range(REFINEMENT_STEPS):
+            r = rhs - K @ s
+            res = float(np.abs(r).max(initial=0.0))
+            if not np.isfinite(res):
+                break
+            if res < best_res:
+                best, best_res = s, res
+            if res <= 1e-15 * max(float(np.abs(rhs).max(initial=0.0)), 1e-300):
+                break
+            s = s + solve(r)
+    return best, best_res
+
+
+def least_norm_step(B, r: np.ndarray, delta: float) -> np.ndarray | None:
+    """d of least norm with Bᵀd = r (B of shape (j, n)), from the system [I B; Bᵀ 0]."""
+    j, n = B.shape
+    if sp.issparse(B):
+        Bc = sp.csc_matrix(B)
+        K = sp.bmat([[sp.identity(j, format="csc"), Bc], [Bc.T, None]], format="csc")
+    else:
+        K = np.block([[np.eye(j), B], [B.T, np.zeros((n, n))]])
+    shift = np.concatenate([np.zeros(j), np.full(n, -delta)])
+    out = solve_refined(K, np.concatenate([np.zeros(j), r]), shift)
+    return None if out is None else out[:j]
+
+
+def nonnegative_multipliers(AJ, g: np.ndarray, y0: np.ndarray, delta: float) -> np.ndarray:
+    """y ≥ 0 with A_Jᵀy = g: the solver's own multipliers y0 (≥ 0, nearly right) plus the
+    least-norm correction; scipy's exact NNLS when that correction breaks y ≥ 0 on a
+    dense problem."""
     y0 = np.maximum(y0, 0.0)
-    d = lsqr(AT, g - AT @ y0, atol=1e-15, btol=1e-15, iter_lim=20 * AT.shape[1])[0]
-    y = y0 + d
+    d = least_norm_step(AJ, g - np.asarray(AJ.T @ y0).ravel(), delta)
+    y = y0 + (d if d is not None else 0.0)
     if y.min() >= -1e-12 * max(float(np.abs(y).max(initial=0.0)), 1e-300) or sp.issparse(AJ):
         return np.maximum(y, 0.0)
-    return nnls(AT, g, maxiter=50 * AT.shape[1])[0]
+    return nnls(np.asarray(AJ).T, g, maxiter=50 * AJ.shape[0])[0]
 
 
 def polish(qp: QuadraticProgram, sol: QPSolution) -> QPSolution | None:
     """Return the polished solution, or None when the KKT system on the guessed active set
     cannot be solved."""
     slack = qp.slack(sol.x)
-    active = np.flatnonzero(sol.y > slack)
+    active = np.flatnonzero(sol.y >= slack)  # a tie (both 0) is a degenerate active row
     P, c = qp.P, qp.c
     scale = max(float(abs(P).max()), 1e-300)
     delta = 1e-10 * scale
@@ -88,11 +118,15 @@ def polish(qp: QuadraticProgram, sol: QPSolution) -> QPSolution | None:
         free = np.setdiff1d(np.arange(qp.n_vars), active)
         x = np.zeros(qp.n_vars)
         if free.size:
+            # P_FF x_F = −c_F, reached from the solver's x by the least-norm step: the unique
+            # solution when P_FF is invertible, else the nearest point of the solution set
+            # (redundant contacts), which keeps x ≥ 0 when the solver's x is interior
             sub = P[free][:, free] if sp.issparse(P) else P[np.ix_(free, free)]
-            xf = solve_refined(sub, -c[free], np.full(free.size, delta))
-            if xf is None:
+            x0 = np.maximum(sol.x[free], 0.0)
+            d = least_norm_step(sub, -c[free] - np.asarray(sub @ x0).ravel(), delta)
+            if d is None:
                 return None
-            x[free] = xf
+            x[free] = x0 + d
         y = np.asarray(P @ x).ravel() + c
     else:
         AJ = qp.A[active]
@@ -113,6 +147,6 @@ def polish(qp: QuadraticProgram, sol: QPSolution) -> QPSolution | None:
             # redundant active rows: the multipliers are a set, and the regularized solve
             # picked one with negative entries; look for a non-negative one for the same x
             y[active] = nonnegative_multipliers(AJ, np.asarray(P @ x).ravel() + c,
-                                                sol.y[active])
+                                                sol.y[active], 1e-10)
     return QPSolution(x=x, y=y, status=sol.status, backend=sol.backend,
                       iterations=sol.iterations, info={**sol.info, "polished": True})
