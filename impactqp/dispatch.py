@@ -6,6 +6,7 @@ polished before giving up). A failed certificate never becomes a success.
 
 from __future__ import annotations
 
+import importlib.util
 from collections.abc import Callable
 from typing import TypeVar
 
@@ -36,12 +37,20 @@ def auto_backends(qp: QuadraticProgram) -> list[str]:
     names: list[str] = []
     if qp.nonnegative and not qp.sparse and qp.n_vars <= MAX_VARIABLES:
         names.append("nnls")
+    if qp.sparse and _installed("piqp") and _installed("qpsolvers"):
+        # measured (benchmarks/): 3-5x faster than Clarabel on sparse impacts of 10⁴
+        # contacts, and as accurate after polishing; an optional extra ("solvers")
+        names.append("qpsolvers:piqp")
     if qp.n_constraints <= 10:
         names.append("exact")
     names += ["clarabel", "osqp"]
     if qp.n_constraints <= MAX_CONSTRAINTS and "exact" not in names:
         names.append("exact")
     return names
+
+
+def _installed(module: str) -> bool:
+    return importlib.util.find_spec(module) is not None
 
 
 def lcp_feasible(qp: QuadraticProgram) -> bool:
