@@ -65,6 +65,13 @@ class Certificate(ResidualChecks):
         max |Λᵢ (γ⁺ + Eγ⁻)ᵢ| / V².
     energy_balance : float or None
         For Moreau's law: |‖u⁺‖² − ‖z‖² − ε²‖z⊥‖²| / V² (§3), else None.
+    duality_gap : float or None
+        For Moreau's law: (Σᵢ Λᵢ|wᵢ| + ‖u⁺ − u⁻ − M⁻¹WΛ‖²) / V² with w = γ⁺ + εγ⁻, a bound on
+        the squared velocity error ‖u⁺ − u⁺_exact‖² / V² (§3): with Λ* the exact impulses,
+        ‖z̃ − z‖² = (Λ̃ − Λ*)ᵀ(γ(z̃) − γ(z)) ≤ Λ̃ᵀγ(z̃) + Λ*ᵀγ(z̃)₋, and Λ stands in for Λ* in
+        the second term (exact when γ⁺ + εγ⁻ ≥ 0). Small complementarity residuals alone do
+        not bound the velocities on ill-conditioned impacts (long chains, large mass
+        ratios: each contact's residual is tiny, their sum is not); this does.
     tol : float
         Tolerance every residual must meet.
     """
@@ -75,6 +82,7 @@ class Certificate(ResidualChecks):
     complementarity: float
     energy_balance: float | None
     tol: float
+    duality_gap: float | None = None
 
     @property
     def residuals(self) -> dict[str, float]:
@@ -82,7 +90,14 @@ class Certificate(ResidualChecks):
                "law_feasibility": self.law_feasibility, "complementarity": self.complementarity}
         if self.energy_balance is not None:
             out["energy_balance"] = self.energy_balance
+        if self.duality_gap is not None:
+            out["duality_gap"] = self.duality_gap
         return out
+
+    @property
+    def velocity_error_bound(self) -> float | None:
+        """Bound on ‖u⁺ − u⁺_exact‖ / ‖u⁻‖ from the duality gap (Moreau's law only)."""
+        return None if self.duality_gap is None else float(np.sqrt(self.duality_gap))
 
 
 def kinetic_norms(structure: ImpactStructure, X: np.ndarray) -> np.ndarray:
@@ -117,6 +132,7 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
     """
     st = structure
     V, out = impact_residuals(st, U_minus, U_plus, Lam)
+    gap = np.zeros(U_minus.shape[:-1])
     if st.m:
         s = st.contact_scale
         g_minus = np.asarray(st.W.T @ U_minus.T).T
@@ -124,11 +140,13 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
         w = np.asarray(st.W.T @ U_plus.T).T + (E * g_minus if E.ndim <= 1 else g_minus @ E.T)
         out["law_feasibility"] = np.maximum(0.0, -row_min(w / (s * V[..., None])))
         out["complementarity"] = row_max(np.abs(Lam * w)) / V**2
+        gap = row_sum(np.abs(Lam * w)) / V**2
     else:
         out["law_feasibility"] = out["complementarity"] = np.zeros(U_minus.shape[:-1])
     if eps is not None:
         z = (U_plus + eps * U_minus) / (1.0 + eps)
         out["energy_balance"] = 2.0 * eps * np.abs(row_sum(st.mass_rows(z) * (U_minus - z))) / V**2
+        out["duality_gap"] = gap + out["momentum"] ** 2
     return out
 
 
@@ -152,4 +170,5 @@ def certify(problem: ImpactProblem, u_plus: np.ndarray, impulses: np.ndarray, E,
                                                 impulses, E, eps=eps).items()}
     return Certificate(momentum=r["momentum"], impulse_sign=r["impulse_sign"],
                        law_feasibility=r["law_feasibility"], complementarity=r["complementarity"],
-                       energy_balance=r.get("energy_balance"), tol=tol)
+                       energy_balance=r.get("energy_balance"), tol=tol,
+                       duality_gap=r.get("duality_gap"))
