@@ -28,9 +28,9 @@ import numpy as np
 from .certificate import DEFAULT_TOL
 from .coxeter import contact_angles, coxeter_labels, coxeter_type, extended_masses, shared_mass
 from .errors import CertificateError, InputError, SectorLawError, SolverError
-from .problem import ImpactProblem
+from .problem import ChainInfo, ImpactProblem
 from .result import ImpactResult
-from .sector_law import SectorLawCertificate, sector_residuals
+from .sector_law import SectorLawCertificate, require_chain, sector_residuals
 
 COLLISION_TOL = 1e-12
 """A contact collides when γ_i < −COLLISION_TOL·√G_ii·‖u⁻‖ (rounding is not an approach)."""
@@ -55,13 +55,8 @@ class ReflectionGroup:
 
 
 # --------------------------------------------------------------------------- collisions
-def _chain(problem: ImpactProblem):
-    if not isinstance(problem, ImpactProblem):
-        raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
-    info = problem.chain
-    if info is None:
-        raise SectorLawError("the reflection law is defined for 1-D chains of balls; build "
-                             "the problem with impactqp.chain")
+def _chain(problem: ImpactProblem) -> ChainInfo:
+    info = require_chain(problem, "reflection law")
     if info.left_wall and info.right_wall:
         raise SectorLawError(
             "a chain between two walls has T_C = {0}: u⁺ = 0 is the only admissible "

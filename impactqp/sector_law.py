@@ -13,7 +13,7 @@ import numpy as np
 
 from .certificate import DEFAULT_TOL, ResidualChecks, impact_residuals, kinetic_norms
 from .errors import CertificateError, InputError, SectorLawError
-from .problem import ImpactProblem, ImpactStructure
+from .problem import ChainInfo, ImpactProblem, ImpactStructure
 from .result import ImpactResult
 from .rowwise import row_max, row_min
 from .sector import sector_gamma_map, sector_velocity_map
@@ -112,15 +112,20 @@ def _wedge_note(problem: ImpactProblem) -> str:
             "impactqp.reflection_law reports the masses that would make it so.")
 
 
+def require_chain(problem: ImpactProblem, law: str) -> ChainInfo:
+    """The ChainInfo of ``problem``, or an error saying that ``law`` needs a 1-D chain."""
+    if not isinstance(problem, ImpactProblem):
+        raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
+    if problem.chain is None:
+        raise SectorLawError(f"the {law} is defined for 1-D chains of balls; build the "
+                             "problem with impactqp.chain or impactqp.newtons_cradle")
+    return problem.chain
+
+
 def check_sector_problem(problem: ImpactProblem) -> float:
     """Return the common ball mass of ``problem`` or raise :class:`SectorLawError` saying why
     the sector law does not apply."""
-    if not isinstance(problem, ImpactProblem):
-        raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
-    info = problem.chain
-    if info is None:
-        raise SectorLawError("the sector law is defined for 1-D chains of balls; build the "
-                             "problem with impactqp.chain or impactqp.newtons_cradle")
+    info = require_chain(problem, "sector law")
     if info.left_wall or info.right_wall:
         raise SectorLawError("the sector law is defined for free chains; walls are not "
                              "supported (a wall is a ball of infinite mass, see unequal masses;"
