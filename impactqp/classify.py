@@ -75,7 +75,8 @@ def classify(problem: ImpactProblem, u_plus: Any) -> Classification:
         cos = problem.inner(direction, moreau_dir)
         sin = problem.norm(direction - cos * moreau_dir)
         alpha = float(np.degrees(np.arctan2(sin, cos)))
-        ratio = (problem.norm(u) ** 2 - problem.norm(z) ** 2) / zp2
+        # ‖u⁺‖² − ‖z‖² as ⟨u⁺ − z, u⁺ + z⟩: no cancellation for u⁺ near z (small ε)
+        ratio = problem.inner(u - z, u + z) / zp2
         dissipation = float(np.sign(ratio) * np.sqrt(abs(ratio)))
     else:
         alpha, dissipation = float("nan"), float("nan")
