@@ -106,14 +106,13 @@ def nonnegative_multipliers(AJ, g: np.ndarray, y0: np.ndarray, delta: float) -> 
     return nnls(np.asarray(AJ).T, g, maxiter=50 * AJ.shape[0])[0]
 
 
-def polish(qp: QuadraticProgram, sol: QPSolution) -> QPSolution | None:
-    """Return the polished solution, or None when the KKT system on the guessed active set
-    cannot be solved."""
-    slack = qp.slack(sol.x)
-    active = np.flatnonzero(sol.y >= slack)  # a tie (both 0) is a degenerate active row
+ACTIVE_SET_ROUNDS = 6
+
+
+def _solve_on(qp: QuadraticProgram, sol: QPSolution, active: np.ndarray, delta: float,
+              ) -> tuple[np.ndarray, np.ndarray] | None:
+    """(x, y) solving the KKT system with the rows in ``active`` held as equalities."""
     P, c = qp.P, qp.c
-    scale = max(float(abs(P).max()), 1e-300)
-    delta = 1e-10 * scale
     if qp.nonnegative:
         free = np.setdiff1d(np.arange(qp.n_vars), active)
         x = np.zeros(qp.n_vars)
@@ -127,26 +126,58 @@ def polish(qp: QuadraticProgram, sol: QPSolution) -> QPSolution | None:
             if d is None:
                 return None
             x[free] = x0 + d
-        y = np.asarray(P @ x).ravel() + c
+        return x, np.asarray(P @ x).ravel() + c
+    AJ = qp.A[active]
+    k, j = qp.n_vars, active.size
+    if sp.issparse(P) or sp.issparse(AJ):
+        K = sp.bmat([[sp.csc_matrix(P), sp.csc_matrix(AJ).T],
+                     [sp.csc_matrix(AJ), None]], format="csc") if j else sp.csc_matrix(P)
     else:
-        AJ = qp.A[active]
-        k, j = qp.n_vars, active.size
-        if sp.issparse(P) or sp.issparse(AJ):
-            K = sp.bmat([[sp.csc_matrix(P), sp.csc_matrix(AJ).T],
-                         [sp.csc_matrix(AJ), None]], format="csc") if j else sp.csc_matrix(P)
-        else:
-            K = np.block([[P, AJ.T], [AJ, np.zeros((j, j))]])
-        shift = np.concatenate([np.full(k, delta), np.full(j, -delta)])
-        out = solve_refined(K, np.concatenate([-c, qp.constraint_rhs()[active]]), shift)
-        if out is None:
-            return None
-        x = out[:k]
-        y = np.zeros(qp.n_constraints)
-        y[active] = -out[k:]
-        if j and y[active].min() < 0:
-            # redundant active rows: the multipliers are a set, and the regularized solve
-            # picked one with negative entries; look for a non-negative one for the same x
-            y[active] = nonnegative_multipliers(AJ, np.asarray(P @ x).ravel() + c,
-                                                sol.y[active], 1e-10)
+        K = np.block([[P, AJ.T], [AJ, np.zeros((j, j))]])
+    shift = np.concatenate([np.full(k, delta), np.full(j, -delta)])
+    out = solve_refined(K, np.concatenate([-c, qp.constraint_rhs()[active]]), shift)
+    if out is None:
+        return None
+    x = out[:k]
+    y = np.zeros(qp.n_constraints)
+    y[active] = -out[k:]
+    if j and y[active].min() < 0:
+        # redundant active rows: the multipliers are a set, and the regularized solve
+        # picked one with negative entries; look for a non-negative one for the same x
+        y[active] = nonnegative_multipliers(AJ, np.asarray(P @ x).ravel() + c,
+                                            sol.y[active], delta)
+    return x, y
+
+
+def polish(qp: QuadraticProgram, sol: QPSolution) -> QPSolution | None:
+    """Return the polished solution, or None when no KKT system could be solved.
+
+    The first active set is the solver's (multiplier ≥ slack); when its solution violates a
+    sign (x_F < 0 or y_J < 0 in the impulse form, slack < 0 or y_J < 0 otherwise), the
+    offending rows change sides and the system is solved again, a few rounds at most.
+    """
+    slack = qp.slack(sol.x)
+    active = np.flatnonzero(sol.y >= slack)  # a tie (both 0) is a degenerate active row
+    scale = max(float(abs(qp.P).max()), 1e-300)
+    delta = 1e-10 * scale
+    best = None
+    for _ in range(ACTIVE_SET_ROUNDS):
+        found = _solve_on(qp, sol, active, delta)
+        if found is None:
+            break
+        x, y = found
+        best = (x, y)
+        s = qp.slack(x)
+        tiny = 1e-14 * max(float(np.abs(x).max(initial=0.0)), float(np.abs(y).max(initial=0.0)),
+                           1e-300)
+        drop = active[y[active] < -tiny]
+        inactive = np.setdiff1d(np.arange(qp.n_constraints), active)
+        add = inactive[s[inactive] < -tiny]
+        if drop.size == 0 and add.size == 0:
+            break
+        active = np.union1d(np.setdiff1d(active, drop), add)
+    if best is None:
+        return None
+    x, y = best
     return QPSolution(x=x, y=y, status=sol.status, backend=sol.backend,
                       iterations=sol.iterations, info={**sol.info, "polished": True})
