@@ -100,7 +100,7 @@ def best_impulses(problem: ImpactProblem, du: np.ndarray) -> tuple[np.ndarray, f
             lam.min() < -1e-12 * max(float(np.abs(lam).max(initial=0.0)), 1e-300):
         lam = solve_psd_lcp(st.delassus, -g).z
     lam = np.maximum(lam, 0.0)
-    return lam, problem.norm(du - st.solve_mass(st.W_times(lam)))
+    return lam, problem.norm(du - st.impulse_velocity(lam))
 
 
 class AdmissibleSet:

@@ -112,7 +112,7 @@ def impact_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np
     st = structure
     V = kinetic_norms(st, U_minus)
     V = np.where(V == 0, 1.0, V)
-    du = U_plus - U_minus - np.asarray(st.Minv_W @ Lam.T).T
+    du = U_plus - U_minus - st.impulse_velocity(Lam)
     out = {"momentum": kinetic_norms(st, du) / V}
     if st.m:
         out["impulse_sign"] = 0.0 + np.maximum(0.0, -row_min(Lam * st.contact_scale
@@ -135,9 +135,9 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
     gap = np.zeros(U_minus.shape[:-1])
     if st.m:
         s = st.contact_scale
-        g_minus = np.asarray(st.W.T @ U_minus.T).T
+        g_minus = st.Wt_times(U_minus)
         E = np.asarray(E, dtype=float)
-        w = np.asarray(st.W.T @ U_plus.T).T + (E * g_minus if E.ndim <= 1 else g_minus @ E.T)
+        w = st.Wt_times(U_plus) + (E * g_minus if E.ndim <= 1 else g_minus @ E.T)
         out["law_feasibility"] = np.maximum(0.0, -row_min(w / (s * V[..., None])))
         out["complementarity"] = row_max(np.abs(Lam * w)) / V**2
         gap = row_sum(np.abs(Lam * w)) / V**2

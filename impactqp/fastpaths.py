@@ -53,7 +53,7 @@ def moreau_fast(problem: ImpactProblem, eps: float, path: str):
     lam = st.kernel.solve((1.0 + eps) * problem.gamma_minus)
     if lam is None:
         return None
-    u = problem.u_minus + st.Minv_W @ lam
+    u = problem.u_minus + st.impulse_velocity(lam)
     return u, lam, (u + eps * problem.u_minus) / (1.0 + eps)
 
 
@@ -69,6 +69,6 @@ def moreau_batch_fast(structure: ImpactStructure, U: np.ndarray, eps: float, pat
         sol = chain_moreau_batch(c.masses, U, eps, left_wall=c.left_wall,
                                  right_wall=c.right_wall)
         return sol.u_plus, sol.impulses, np.ones(U.shape[0], dtype=bool)
-    Gm = np.asarray(structure.W.T @ U.T).T
+    Gm = structure.Wt_times(U)
     lam, done = structure.kernel.solve_batch((1.0 + eps) * Gm)
-    return U + lam @ np.asarray(structure.Minv_W).T, lam, done
+    return U + structure.impulse_velocity(lam), lam, done

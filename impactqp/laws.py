@@ -90,7 +90,7 @@ def velocity_program(problem: ImpactProblem) -> QuadraticProgram:
     """Velocity form min ½‖v − u⁻‖²_M s.t. Wᵀv ≥ 0 (§3): z = prox_{T_C}(u⁻)."""
     st = problem.structure
     A = sp.csc_matrix(st.W.T) if st.sparse else st.W.T
-    return QuadraticProgram(P=st.M, c=-np.asarray(st.mass_times(problem.u_minus)).ravel(),
+    return QuadraticProgram(P=st.M, c=-st.mass_rows(problem.u_minus),
                             A=A, b=np.zeros(st.m), cache_owner=st, cache_tag="velocity")
 
 
@@ -157,7 +157,7 @@ def moreau(problem: ImpactProblem, eps: float = 0.0, backend: str = "auto", *,
 
         def finish(sol: QPSolution):
             lam = sol.x
-            u = u_m + st.solve_mass(st.W_times(lam))
+            u = u_m + st.impulse_velocity(lam)
             z = (u + e * u_m) / (1.0 + e)
             return (u, lam, z), certify(problem, u, lam, e, eps=e, tol=tol)
 
@@ -176,7 +176,7 @@ def _lcp_law(problem: ImpactProblem, law: str, E: np.ndarray, backend: str,
     if applies(st, backend, law=law) == "kernel":
         lam = lcp_fast(problem, q)
         if lam is not None:
-            u = problem.u_minus + st.Minv_W @ lam
+            u = problem.u_minus + st.impulse_velocity(lam)
             cert = certify(problem, u, lam, E, tol=tol)
             result = _fast_result(problem, law, E, (u, lam, None), "kernel", cert, "impulse")
             if result is not None:
@@ -188,7 +188,7 @@ def _lcp_law(problem: ImpactProblem, law: str, E: np.ndarray, backend: str,
 
     def finish(sol: QPSolution):
         lam = sol.x
-        u = problem.u_minus + st.solve_mass(st.W_times(lam))
+        u = problem.u_minus + st.impulse_velocity(lam)
         return (u, lam), certify(problem, u, lam, E, tol=tol)
 
     (u, lam), cert, used, log = solve_certified(qp, backend, finish)

@@ -134,10 +134,6 @@ class ImpactStructure:
             return self._lu.solve(np.asarray(x, dtype=float))
         return sla.cho_solve((self._chol, True), x)
 
-    def mass_times(self, u: np.ndarray) -> np.ndarray:
-        """Return M u."""
-        return self.M @ u
-
     @cached_property
     def mass_diagonal(self) -> np.ndarray | None:
         """The diagonal of M when M is diagonal (chains), else None."""
@@ -150,13 +146,13 @@ class ImpactStructure:
             return X * d
         return X @ self.M if not self.sparse else np.asarray((self.M @ X.T).T)
 
-    def W_times(self, lam: np.ndarray) -> np.ndarray:
-        """Return W Λ."""
-        return np.asarray(self.W @ lam).ravel() if lam.ndim == 1 else np.asarray(self.W @ lam)
+    def Wt_times(self, U: np.ndarray) -> np.ndarray:
+        """Contact velocities γ = Wᵀu of a vector or of every row of U."""
+        return np.asarray(self.W.T @ U.T).T
 
-    def Wt_times(self, u: np.ndarray) -> np.ndarray:
-        """Return Wᵀu (contact velocities γ of u)."""
-        return np.asarray(self.W.T @ u).ravel() if u.ndim == 1 else np.asarray(self.W.T @ u)
+    def impulse_velocity(self, Lam: np.ndarray) -> np.ndarray:
+        """Velocity jump M⁻¹WΛ of an impulse vector or of every row of Lam (§1)."""
+        return np.asarray(self.Minv_W @ Lam.T).T
 
     @cached_property
     def cholesky_factor(self) -> np.ndarray:
@@ -259,11 +255,11 @@ class ImpactProblem:
 
     def norm(self, u: np.ndarray) -> float:
         """Kinetic norm ‖u‖ = sqrt(uᵀMu)."""
-        return float(np.sqrt(max(float(u @ self.structure.mass_times(u)), 0.0)))
+        return float(np.sqrt(max(float(u @ self.structure.mass_rows(u)), 0.0)))
 
     def inner(self, a: np.ndarray, b: np.ndarray) -> float:
         """Kinetic inner product ⟨a, b⟩ = aᵀMb."""
-        return float(a @ self.structure.mass_times(b))
+        return float(a @ self.structure.mass_rows(b))
 
     def kinetic_energy(self, u: np.ndarray | None = None) -> float:
         """T = ½uᵀMu (of u⁻ when u is omitted)."""

@@ -114,7 +114,7 @@ def elastic_collisions(problem: ImpactProblem, order: str = "left", *,
                 if g[j] < -thresh[j]:
                     heapq.heappush(heap, sign * j)
     impulses = np.array(lam)
-    u_plus = problem.u_minus + np.asarray(st.Minv_W @ impulses).ravel()
+    u_plus = problem.u_minus + st.impulse_velocity(impulses)
     return u_plus, impulses, count
 
 

@@ -71,9 +71,9 @@ def sector_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np
     if st.m == 0:  # a single ball: nothing to check at contacts
         out["kinematic"] = out["law_residual"] = np.zeros(U_minus.shape[:-1])
         return out
-    gamma_plus = np.asarray(st.W.T @ U_plus.T).T
+    gamma_plus = st.Wt_times(U_plus)
     if expected is None:
-        expected = sector_gamma_map(np.asarray(st.W.T @ U_minus.T).T)
+        expected = sector_gamma_map(st.Wt_times(U_minus))
     out["kinematic"] = np.maximum(0.0, -row_min(gamma_plus / (st.contact_scale * V[..., None])))
     out["law_residual"] = row_max(np.abs(gamma_plus - expected)) / V
     return out
