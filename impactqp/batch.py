@@ -17,7 +17,7 @@ import numpy as np
 from .certificate import DEFAULT_TOL, law_residuals
 from .errors import CertificateError, ShapeError
 from .fastpaths import applies, moreau_batch_fast
-from .laws import check_backend_name, check_restitution, moreau
+from .laws import check_backend_name, check_eps, moreau
 from .problem import ImpactProblem, _finite
 from .sector import sector_velocity_map
 from .sector_law import check_sector_problem, sector_residuals
@@ -80,7 +80,7 @@ def moreau_batch(problem: ImpactProblem, U_minus: Any, eps: float = 0.0,
         Certificate tolerance per row.
     """
     U = as_rows(problem, U_minus)
-    e = float(check_restitution("eps", eps, problem.n_contacts))
+    e = check_eps(eps)
     check_backend_name(backend)
     st = problem.structure
     k = U.shape[0]

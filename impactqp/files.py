@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError, ProblemFileError
-from .laws import check_restitution
+from .laws import check_eps, check_restitution
 from .problem import ImpactProblem, as_vector
 from .problems import chain
 
@@ -193,7 +193,7 @@ def _coefficients(law: str | None, data: dict[str, Any], m: int) -> float | np.n
         return None
     value = data[wanted]
     if wanted == "eps":
-        return float(check_restitution("eps", _number("eps", value), m))
+        return check_eps(_number("eps", value))
     if wanted == "e" and not isinstance(value, list):
         return check_restitution("e", _number("e", value), m)
     arr = _vector("e", value) if wanted == "e" else _matrix("E", value)

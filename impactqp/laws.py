@@ -25,11 +25,20 @@ from .result import ImpactResult
 FORMS = ("auto", "velocity", "impulse")
 
 
+def check_eps(value: Any) -> float:
+    """Validate Moreau's global restitution ε ∈ [0, 1]."""
+    try:
+        e = float(value)
+    except (TypeError, ValueError):
+        raise RestitutionError(f"eps must be one number in [0, 1], got {value!r}") from None
+    if not 0.0 <= e <= 1.0:  # NaN fails too
+        raise RestitutionError(f"eps must lie in [0, 1] (and not be NaN), got {value!r}")
+    return e
+
+
 def check_restitution(name: str, value: Any, m: int, *, matrix: bool = False) -> np.ndarray:
-    """Validate ε (scalar), eᵢ (m-vector) or Frémond's E ((m, m)); entries must lie in [0, 1]
-    for ε and eᵢ, and be finite for E."""
-    if not matrix and name == "eps" and isinstance(value, (int, float)) and 0.0 <= value <= 1.0:
-        return np.asarray(float(value))  # the common case, without array checks
+    """Validate local coefficients eᵢ (a scalar for all, or an m-vector, each in [0, 1]) or
+    Frémond's E (a finite (m, m) matrix)."""
     arr = np.asarray(value, dtype=float)
     if matrix:
         if arr.shape != (m, m):
@@ -38,7 +47,7 @@ def check_restitution(name: str, value: Any, m: int, *, matrix: bool = False) ->
             raise NonFiniteError(f"{name} must be finite")
         return arr
     if arr.ndim == 0:
-        arr = np.full(m, float(arr)) if name != "eps" else arr
+        arr = np.full(m, float(arr))
     elif arr.shape != (m,):
         raise ShapeError(f"{name} must be a scalar or have shape ({m},), got {arr.shape}")
     if np.any(np.isnan(arr)) or np.any(arr < 0) or np.any(arr > 1):
@@ -52,11 +61,19 @@ def check_backend_name(backend: str) -> None:
         parse_backend(backend)
 
 
-def _fast_result(problem, law, coef, answer, path, cert, form):
-    """Accept a fast path's answer when its certificate passes; a named path must pass."""
-    if cert.ok:
+def _fast_result(problem: ImpactProblem, law: str, coef, E, answer, path: str, *,
+                 backend: str, eps: float | None, tol: float) -> ImpactResult | None:
+    """A fast path's answer (u⁺, Λ, z) as a result when its certificate passes; None to go on
+    to the QP backends under "auto"; an error when the fast path was named."""
+    if answer is not None:
         u, lam, z = answer
-        return ImpactResult(problem, law, coef, u, lam, path, cert, form=form, z=z)
+        cert = certify(problem, u, lam, E, eps=eps, tol=tol)
+        if cert.ok:
+            form = "impulse" if path == "kernel" and law != "moreau" else path
+            return ImpactResult(problem, law, coef, u, lam, path, cert, form=form, z=z)
+    if backend != "auto":
+        raise CertificateError(f"the {path!r} fast path gave no certified answer (for the "
+                               "kernel: q is not in the range of G); use a QP backend")
     return None
 
 
@@ -124,7 +141,7 @@ def moreau(problem: ImpactProblem, eps: float = 0.0, backend: str = "auto", *,
     RestitutionError, UnknownBackendError, CertificateError
     """
     _check_problem(problem)
-    e = float(check_restitution("eps", eps, problem.n_contacts))
+    e = check_eps(eps)
     check_backend_name(backend)
     if form not in FORMS:
         raise InputError(f"form must be one of {FORMS}, got {form!r}")
@@ -134,14 +151,10 @@ def moreau(problem: ImpactProblem, eps: float = 0.0, backend: str = "auto", *,
     u_m = problem.u_minus
     path = applies(st, backend) if form == "auto" else None
     if path is not None:
-        answer = moreau_fast(problem, e, path)
-        if answer is not None:
-            cert = certify(problem, answer[0], answer[1], e, eps=e, tol=tol)
-            result = _fast_result(problem, "moreau", e, answer, path, cert, path)
-            if result is not None:
-                return result
-        if backend != "auto":
-            raise CertificateError(f"the {path!r} fast path gave no certified answer")
+        result = _fast_result(problem, "moreau", e, e, moreau_fast(problem, e, path), path,
+                              backend=backend, eps=e, tol=tol)
+        if result is not None:
+            return result
     if form == "auto":
         form = "velocity" if st.sparse else "impulse"
 
@@ -175,15 +188,11 @@ def _lcp_law(problem: ImpactProblem, law: str, E: np.ndarray, backend: str,
     q = g + (E * g if E.ndim == 1 else E @ g)
     if applies(st, backend, law=law) == "kernel":
         lam = lcp_fast(problem, q)
-        if lam is not None:
-            u = problem.u_minus + st.impulse_velocity(lam)
-            cert = certify(problem, u, lam, E, tol=tol)
-            result = _fast_result(problem, law, E, (u, lam, None), "kernel", cert, "impulse")
-            if result is not None:
-                return result
-        if backend != "auto":
-            raise CertificateError("the 'kernel' fast path gave no certified answer "
-                                   "(q is not in the range of G); use a QP backend")
+        answer = None if lam is None else (problem.u_minus + st.impulse_velocity(lam), lam, None)
+        result = _fast_result(problem, law, E, E, answer, "kernel", backend=backend, eps=None,
+                              tol=tol)
+        if result is not None:
+            return result
     qp = impulse_program(problem, q)
 
     def finish(sol: QPSolution):
