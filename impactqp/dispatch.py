@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import importlib.util
 from collections.abc import Callable
+from functools import cache
 from typing import TypeVar
 
 import numpy as np
@@ -16,7 +17,7 @@ from scipy.optimize import linprog
 from .backends import get_backend
 from .backends.exact import MAX_CONSTRAINTS
 from .backends.nnls_ import MAX_VARIABLES
-from .certificate import Certificate
+from .certificate import ResidualChecks
 from .errors import (
     BackendUnsuitableError,
     CertificateError,
@@ -29,7 +30,7 @@ from .program import QPSolution, QuadraticProgram
 
 T = TypeVar("T")
 EXACT = ("exact", "nnls")
-Finish = Callable[[QPSolution], tuple[T, Certificate]]
+Finish = Callable[[QPSolution], tuple[T, ResidualChecks]]
 
 
 def auto_backends(qp: QuadraticProgram) -> list[str]:
@@ -49,19 +50,19 @@ def auto_backends(qp: QuadraticProgram) -> list[str]:
     return names
 
 
+@cache
 def _installed(module: str) -> bool:
     return importlib.util.find_spec(module) is not None
 
 
 def lcp_feasible(qp: QuadraticProgram) -> bool:
     """For the impulse form: is there x ≥ 0 with Px + c ≥ 0? (For PSD P: solvable iff so.)"""
-    P = qp.P.toarray() if hasattr(qp.P, "toarray") else np.asarray(qp.P)
-    res = linprog(np.zeros(qp.n_vars), A_ub=-P, b_ub=qp.c, bounds=(0, None), method="highs")
+    res = linprog(np.zeros(qp.n_vars), A_ub=-qp.P, b_ub=qp.c, bounds=(0, None), method="highs")
     return bool(res.status == 0)
 
 
 def solve_certified(qp: QuadraticProgram, backend: str, finish: Finish,
-                    *, tol: float = 1e-10) -> tuple[T, Certificate, str, list[str]]:
+                    *, tol: float = 1e-10) -> tuple[T, ResidualChecks, str, list[str]]:
     """Solve ``qp`` and return (answer, certificate, backend used, log of attempts).
 
     Raises
