@@ -14,11 +14,10 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
 from .errors import InputError
-from .problem import ImpactProblem, as_vector
+from .problem import ImpactProblem, as_dense, as_vector
 from .sector import sector_gamma_map, sector_law_table
 
 MOREAU_EPS = (0.0, 0.5, 1.0)
@@ -96,10 +95,6 @@ def _ray_exit(p: np.ndarray, d: np.ndarray, h: float) -> np.ndarray:
     return p + np.min(t) * d
 
 
-def _dense(A) -> np.ndarray:
-    return A.toarray() if sp.issparse(A) else np.asarray(A, dtype=float)
-
-
 def plane_picture(problem: ImpactProblem, candidates: Mapping[str, ArrayLike] | None = None,
                   *, resolution: int = 360, margin: float = 1.3) -> PlanePicture:
     """Compute the picture of S (§5 generalised) for a problem with two independent contacts.
@@ -122,12 +117,12 @@ def plane_picture(problem: ImpactProblem, candidates: Mapping[str, ArrayLike] | 
         When the problem or a candidate cannot be drawn in the plane, saying why.
     """
     st = problem.structure
-    W = _dense(st.W)
+    W = as_dense(st.W)
     if st.m != 2 or np.linalg.matrix_rank(W) != 2:
         raise InputError(f"the picture of S needs exactly 2 independent contacts (S then lies in "
                          f"the plane u⁻ + range(M⁻¹W)); this problem has n_dof={st.n}, "
                          f"n_contacts={st.m}, rank(W)={np.linalg.matrix_rank(W)}")
-    M = _dense(st.M)
+    M = as_dense(st.M)
     u_m = problem.u_minus
     z, z_perp = problem.moreau_split
     if problem.norm(z_perp) <= 1e-12 * problem.velocity_scale:

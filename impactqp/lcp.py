@@ -17,6 +17,7 @@ from .backends import parse_backend
 from .certificate import DEFAULT_TOL, ResidualChecks
 from .dispatch import solve_certified
 from .errors import NonConvexLCPError, NonFiniteError, NonSymmetricLCPError, ShapeError
+from .problem import as_dense
 from .program import QPSolution, QuadraticProgram
 
 
@@ -70,7 +71,7 @@ def _residuals(G: Any, q: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, dict]:
 
 def check_lcp(G: Any, q: Any) -> tuple[np.ndarray, np.ndarray]:
     """Validate an LCP (G symmetric PSD, q matching) and return float arrays."""
-    G = np.asarray(G.toarray() if hasattr(G, "toarray") else G, dtype=float)
+    G = as_dense(G)
     q = np.asarray(q, dtype=float)
     if G.ndim != 2 or G.shape[0] != G.shape[1]:
         raise ShapeError(f"G must be a square matrix, got shape {G.shape}")

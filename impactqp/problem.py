@@ -38,6 +38,11 @@ def _finite(name: str, values: np.ndarray) -> None:
                              f"at index {tuple(bad)}")
 
 
+def as_dense(A: Any) -> np.ndarray:
+    """A float ndarray view of a dense or scipy.sparse matrix."""
+    return A.toarray() if sp.issparse(A) else np.asarray(A, dtype=float)
+
+
 def as_vector(name: str, value: Any, length: int) -> np.ndarray:
     """Return ``value`` as a finite float vector of the given length or raise InputError."""
     arr = np.asarray(value, dtype=float)
@@ -171,8 +176,7 @@ class ImpactStructure:
         """M⁻¹W (sparse when M is diagonal and W sparse, dense otherwise)."""
         if self.sparse and self.diagonal_mass:
             return sp.csc_matrix(sp.diags(1.0 / self._diag) @ self.W)
-        W = self.W.toarray() if self.sparse else self.W
-        return self.solve_mass(W)
+        return self.solve_mass(as_dense(self.W))
 
     @cached_property
     def delassus(self) -> Matrix:
@@ -196,8 +200,7 @@ class ImpactStructure:
         """The prepared active-set kernel of G (dense problems with few contacts)."""
         from .kernel import ActiveSetKernel
 
-        G = self.delassus
-        return ActiveSetKernel(G.toarray() if sp.issparse(G) else G)
+        return ActiveSetKernel(as_dense(self.delassus))
 
     @cached_property
     def delassus_diagonal(self) -> np.ndarray:

@@ -28,7 +28,7 @@ import numpy as np
 from .certificate import DEFAULT_TOL
 from .coxeter import contact_angles, coxeter_labels, coxeter_type, extended_masses, shared_mass
 from .errors import CertificateError, InputError, SectorLawError, SolverError
-from .problem import ChainInfo, ImpactProblem
+from .problem import ChainInfo, ImpactProblem, as_dense
 from .result import ImpactResult
 from .sector_law import SectorLawCertificate, require_chain, sector_residuals
 
@@ -145,8 +145,7 @@ def _no_law_message(problem: ImpactProblem, angles: np.ndarray, bad: list[int]) 
            f"is 180°/{k} = {180.0 / k:.6g}°, reached with m{ball + 1} = {mass:.6g} (neighbours "
            "kept)")
     msg += "; 90° = 180°/2 would need an infinite mass." if deg > 60.0 else "."
-    W = problem.structure.W
-    W = W.toarray() if hasattr(W, "toarray") else np.asarray(W)
+    W = as_dense(problem.structure.W)
     gamma = np.zeros(W.shape[1])
     gamma[[i, i + 1]] = -1.0
     u = np.round(np.linalg.lstsq(W.T, gamma, rcond=None)[0], 12) + 0.0

@@ -12,11 +12,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 
 from .errors import InputError
 from .files import COEFFICIENT_KEYS, VERSION, file_format, problem_from_dict
-from .problem import ImpactProblem
+from .problem import ImpactProblem, as_dense
 
 
 def problem_to_dict(problem: ImpactProblem, *, law: str | None = None, coefficients: Any = None,
@@ -28,8 +27,7 @@ def problem_to_dict(problem: ImpactProblem, *, law: str | None = None, coefficie
         data["masses"] = info.masses.tolist()
         data.update(left_wall=info.left_wall, right_wall=info.right_wall)
     else:
-        M, W = (A.toarray() if sp.issparse(A) else np.asarray(A) for A in (problem.M, problem.W))
-        data.update(M=M.tolist(), W=W.tolist())
+        data.update(M=as_dense(problem.M).tolist(), W=as_dense(problem.W).tolist())
     data["u_minus"] = problem.u_minus.tolist()
     if law is not None:
         data["law"] = law

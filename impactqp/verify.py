@@ -19,7 +19,7 @@ import numpy as np
 
 from .errors import ImpactError, InputError, ShapeError
 from .laws import moreau
-from .problem import ImpactProblem
+from .problem import ImpactProblem, as_dense
 from .result import ImpactResult
 
 DEFAULT_TOL = 1e-7
@@ -107,9 +107,8 @@ def sample_u_minus(problem: ImpactProblem, samples: int, rng: np.random.Generato
     ker Wᵀ; with redundant contacts u⁻ = −prox_{T_C}(v) (§1), which lies in −T_C.
     """
     st = problem.structure
-    M = st.M.toarray() if st.sparse else st.M
-    W = st.W.toarray() if st.sparse else st.W
-    L = np.linalg.cholesky(M)
+    W = as_dense(st.W)
+    L = np.linalg.cholesky(as_dense(st.M)) if st.sparse else st.cholesky_factor
 
     def isotropic() -> np.ndarray:  # uᵀMu = ξᵀξ
         return np.linalg.solve(L.T, rng.standard_normal((st.n, samples))).T
@@ -118,9 +117,8 @@ def sample_u_minus(problem: ImpactProblem, samples: int, rng: np.random.Generato
     if not consistent_only or st.m == 0:
         return v
     if np.linalg.matrix_rank(W) == st.m:
-        G = W.T @ np.linalg.solve(M, W)
         gamma = -np.abs(isotropic() @ W)
-        lift = np.linalg.solve(M, W) @ np.linalg.inv(G)
+        lift = as_dense(st.Minv_W) @ np.linalg.inv(as_dense(st.delassus))
         return v + (gamma - v @ W) @ lift.T
     return np.array([-moreau(problem.with_u_minus(x), eps=0.0).u_plus for x in v])
 
@@ -215,7 +213,7 @@ def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 10
     u_minus = sample_u_minus(problem, samples, rng, consistent_only=consistent_only)
     u_plus, res = admissibility_residuals(law, problem, u_minus)
     st = problem.structure
-    expansion, pairs = _pair_expansion(st.M.toarray() if st.sparse else st.M, u_minus, u_plus)
+    expansion, pairs = _pair_expansion(as_dense(st.M), u_minus, u_plus)
 
     failed = np.isnan(res[:, 0])
     violations = {name: int(np.sum(res[:, k] > tol)) for k, name in enumerate(ADMISSIBILITY)}

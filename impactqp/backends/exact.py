@@ -13,13 +13,11 @@ from itertools import combinations
 import numpy as np
 
 from ..errors import BackendUnsuitableError, NoSolutionError
+from ..problem import as_dense
 from ..program import QPSolution, QuadraticProgram
 
 MAX_CONSTRAINTS = 14
 
-
-def _dense(a):
-    return a.toarray() if hasattr(a, "toarray") else np.asarray(a, dtype=float)
 
 
 def _nonneg_candidate(P, c, free):
@@ -51,8 +49,8 @@ def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None
     if r > MAX_CONSTRAINTS:
         raise BackendUnsuitableError(f"'exact' enumerates 2^r active sets; r = {r} > "
                                      f"{MAX_CONSTRAINTS} constraints is too many")
-    P, c = _dense(qp.P), np.asarray(qp.c, dtype=float)
-    A, b = _dense(qp.constraint_matrix()), qp.constraint_rhs()
+    P, c = as_dense(qp.P), np.asarray(qp.c, dtype=float)
+    A, b = as_dense(qp.constraint_matrix()), qp.constraint_rhs()
     scale = max(np.abs(c).max(initial=0.0), np.abs(b).max(initial=0.0), 1e-300)
     pscale = max(np.abs(P).max(initial=0.0), 1.0)
     tried = 0

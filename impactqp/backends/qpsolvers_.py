@@ -6,6 +6,7 @@ import numpy as np
 import qpsolvers
 
 from ..errors import SolverError, UnknownBackendError
+from ..problem import as_dense
 from ..program import QPSolution, QuadraticProgram
 from . import tolerance_options
 
@@ -18,8 +19,7 @@ def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None
     sparse_ok = solver in qpsolvers.sparse_solvers
     P, G = qp.P, -qp.constraint_matrix()
     if not sparse_ok:
-        P = P.toarray() if hasattr(P, "toarray") else P
-        G = G.toarray() if hasattr(G, "toarray") else G
+        P, G = as_dense(P), as_dense(G)
     problem = qpsolvers.Problem(P, np.asarray(qp.c, float), G, -qp.constraint_rhs())
     try:
         sol = qpsolvers.solve_problem(problem, solver=solver, **tolerance_options(solver, tol))
