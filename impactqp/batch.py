@@ -19,8 +19,7 @@ from .errors import CertificateError, ShapeError
 from .fastpaths import applies, moreau_batch_fast
 from .laws import check_backend_name, check_eps, moreau
 from .problem import ImpactProblem, _finite
-from .sector import sector_velocity_map
-from .sector_law import check_sector_problem, sector_residuals
+from .sector_law import check_sector_problem, sector_answer, sector_residuals
 
 
 @dataclass(frozen=True)
@@ -50,7 +49,12 @@ class BatchResult:
     @property
     def ok(self) -> np.ndarray:
         """Per-row verdict of the certificate (all True in a returned batch)."""
-        return np.all([v <= self.tol for v in self.residuals.values()], axis=0)
+        return certified_rows(self.residuals, self.tol)
+
+
+def certified_rows(residuals: dict, tol: float) -> np.ndarray:
+    """Rows whose every residual is within ``tol`` (NaN fails)."""
+    return np.all([v <= tol for v in residuals.values()], axis=0)
 
 
 def as_rows(problem: ImpactProblem, U_minus: Any) -> np.ndarray:
@@ -87,20 +91,20 @@ def moreau_batch(problem: ImpactProblem, U_minus: Any, eps: float = 0.0,
     path = applies(st, backend) if st.m else None
     if path is not None:
         Up, Lam, done = moreau_batch_fast(st, U, e, path)
+        res = law_residuals(st, U, Up, Lam, e, eps=e)
+        rows = np.flatnonzero(~done | ~certified_rows(res, tol))
         used = path
-    else:
-        Up, Lam = U.copy(), np.zeros((k, st.m))  # placeholders; every row is solved below
-        done = np.zeros(k, dtype=bool)
-        used = backend
-    res = law_residuals(st, U, Up, Lam, e, eps=e)
-    bad = ~done | ~np.all([v <= tol for v in res.values()], axis=0)
-    rows = np.flatnonzero(bad)
+    else:  # every row goes through the single-impact law
+        Up, Lam = np.empty_like(U), np.zeros((k, st.m))
+        rows, used = np.arange(k), backend
     for i in rows:
         r = moreau(problem.with_u_minus(U[i]), e, "auto" if backend in ("isotonic", "kernel")
                    else backend, tol=tol)
         Up[i], Lam[i] = r.u_plus, r.impulses
         used = used if path is not None else r.backend
-    if rows.size:
+    if path is None:
+        res = law_residuals(st, U, Up, Lam, e, eps=e)
+    elif rows.size:
         fixed = law_residuals(st, U[rows], Up[rows], Lam[rows], e, eps=e)
         for key in res:
             res[key][rows] = fixed[key]
@@ -121,8 +125,7 @@ def sector_law_batch(problem: ImpactProblem, U_minus: Any, *,
     """
     mass = check_sector_problem(problem)
     U = as_rows(problem, U_minus)
-    Up = sector_velocity_map(U)
-    Lam = mass * np.cumsum(U - Up, axis=1)[:, :-1]
+    Up, Lam = sector_answer(mass, U)
     res = sector_residuals(problem.structure, U, Up, Lam)
     out = BatchResult(u_plus=Up, impulses=Lam, residuals=res, backend="sort", resolved=0, tol=tol)
     if not out.ok.all():

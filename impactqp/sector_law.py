@@ -140,6 +140,13 @@ def check_sector_problem(problem: ImpactProblem) -> float:
     return float(masses[0])
 
 
+def sector_answer(mass: float, U_minus: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(u⁺, Λ) of the sector law for one u⁻ or every row: u⁺ = sort(u⁻) and
+    Λ_k = m Σ_{j≤k} (u⁻_j − u⁺_j), the impulses of M(u⁺ − u⁻) = WΛ for the chain's W."""
+    u_plus = sector_velocity_map(U_minus)
+    return u_plus, mass * np.cumsum(U_minus - u_plus, axis=-1)[..., :-1]
+
+
 def sector_law(problem: ImpactProblem, *, tol: float = DEFAULT_TOL) -> ImpactResult:
     """The maximal-monotone sector law of Winandy and Leine for equal balls (§6).
 
@@ -171,8 +178,7 @@ def sector_law(problem: ImpactProblem, *, tol: float = DEFAULT_TOL) -> ImpactRes
         When rounding (e.g. velocities of wildly different magnitudes) breaks the certificate.
     """
     mass = check_sector_problem(problem)
-    u_plus = sector_velocity_map(problem.u_minus)
-    impulses = mass * np.cumsum(problem.u_minus - u_plus)[:-1]
+    u_plus, impulses = sector_answer(mass, problem.u_minus)
     cert = certify_sector(problem, u_plus, impulses, tol=tol)
     if not cert.ok:
         raise CertificateError(f"sector law: certificate failed, {cert.summary()}")
