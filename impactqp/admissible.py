@@ -8,14 +8,12 @@ obtained through the SOCP (distance from u to S), which is how S is handed to op
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 from typing import Any
 
 import clarabel
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from scipy.optimize import nnls
 
 from .backends.clarabel_ import run as run_clarabel
@@ -89,13 +87,8 @@ def best_impulses(problem: ImpactProblem, du: np.ndarray) -> tuple[np.ndarray, f
     # impulse form); with independent contacts its unconstrained solution often already
     # has Λ ≥ 0 (a chain), otherwise a certified QP backend solves it
     g = st.Wt_times(du)
-    lam = None
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", spla.MatrixRankWarning)
-        try:
-            lam = spla.splu(sp.csc_matrix(st.delassus)).solve(g)
-        except RuntimeError:  # singular G: redundant contacts
-            lam = None
+    lu = st.delassus_lu
+    lam = None if lu is None else lu.solve(g)
     if lam is None or not np.all(np.isfinite(lam)) or \
             lam.min() < -1e-12 * max(float(np.abs(lam).max(initial=0.0)), 1e-300):
         lam = solve_psd_lcp(st.delassus, -g).z

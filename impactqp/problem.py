@@ -8,6 +8,7 @@ parameter sweep or a simulator pays for it only once.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
@@ -189,6 +190,16 @@ class ImpactStructure:
             return B.T @ B
         G = np.asarray(self.W.T @ self.Minv_W)
         return 0.5 * (G + G.T)
+
+    @cached_property
+    def delassus_lu(self):
+        """Sparse LU factorization of G, or None when G is singular (redundant contacts)."""
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", spla.MatrixRankWarning)
+            try:
+                return spla.splu(sp.csc_matrix(self.delassus))
+            except RuntimeError:
+                return None
 
     @cached_property
     def contact_scale(self) -> np.ndarray:
