@@ -1,4 +1,5 @@
-"""Reader of the Siconos LCP test files in ../shared/peer-data/siconos-lcp (format: its README)."""
+"""Reader of the Siconos LCP test files kept in tests/data/siconos-lcp (source, license and
+format: the README there)."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "peer-data" / "siconos-lcp"
+DATA = Path(__file__).resolve().parent / "data" / "siconos-lcp"
 
 
 def _tokens(path: Path) -> list[str]:
