@@ -15,10 +15,10 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 import impactqp as iq
-from impactqp.backends.clarabel_ import solve as clarabel_solve
-from impactqp.isotonic import chain_moreau
-from impactqp.laws import velocity_program
-from impactqp.polish import polish
+from impactqp.model.programs import velocity_program
+from impactqp.qp.backends.clarabel_ import solve as clarabel_solve
+from impactqp.qp.isotonic import chain_moreau
+from impactqp.qp.polish import polish
 
 #: how many impacts of a batch case are checked against single exact solves
 BATCH_SAMPLE = 50

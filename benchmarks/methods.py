@@ -18,9 +18,9 @@ import qpsolvers
 import scipy.sparse as sp
 
 import impactqp as iq
-from impactqp.backends.exact import MAX_CONSTRAINTS
-from impactqp.backends.nnls_ import MAX_VARIABLES
-from impactqp.kernel import MAX_CONTACTS
+from impactqp.qp.active_set import MAX_CONTACTS
+from impactqp.qp.backends.exact import MAX_CONSTRAINTS
+from impactqp.qp.backends.nnls_ import MAX_VARIABLES
 
 from .families import Case
 

@@ -2,65 +2,82 @@
 
 Problems (:class:`ImpactProblem`, :func:`chain`, :func:`newtons_cradle`, problem files via
 :func:`load_problem` / :func:`save_problem`), the admissible set S (:class:`AdmissibleSet`),
-impact laws (:func:`moreau`, :func:`newton`, :func:`fremond`, :func:`sector_law` with its
-table :func:`sector_law_table`, :func:`reflection_law` for unequal masses), many impacts at
-once (:func:`moreau_batch`, :func:`sector_law_batch`), the law verifier :func:`verify_law`,
-LCPs with symmetric matrices (:func:`solve_lcp`) and the geometric classification
-(:func:`classify`). Conventions: the README and the geometry note it cites (§1–§7).
+impact laws as objects (:class:`Moreau`, :class:`Newton`, :class:`Fremond`,
+:class:`SectorLaw`, :class:`ReflectionLaw`) solved by the one pipeline :func:`solve` (and its
+one-call forms :func:`moreau`, :func:`newton`, :func:`fremond`, :func:`sector_law`,
+:func:`reflection_law`), many impacts at once (:func:`solve_batch`, :func:`moreau_batch`,
+:func:`sector_law_batch`), the law verifier :func:`verify_law`, LCPs with symmetric matrices
+(:func:`solve_lcp`) and the geometric classification (:func:`classify`). The theory and the
+conventions are in docs/theory.md of the repository.
 """
 
-from .admissible import AdmissibleSet, Membership
-from .batch import BatchResult, moreau_batch, sector_law_batch
-from .certificate import Certificate
-from .classify import Classification, classify
-from .coxeter import continuous_mass_ratios
-from .errors import (
-                     BackendUnsuitableError,
-                     CertificateError,
-                     ImpactError,
-                     InputError,
-                     MassMatrixError,
-                     NonConvexLCPError,
-                     NonFiniteError,
-                     NonSymmetricLCPError,
-                     NoSolutionError,
-                     OptionalDependencyError,
-                     ProblemFileError,
-                     RestitutionError,
-                     SectorInputError,
-                     SectorLawError,
-                     SectorTableTooLarge,
-                     ShapeError,
-                     SolverError,
-                     UnknownBackendError,
-)
-from .files import ProblemFile, load_problem
-from .fremond_map import fremond_admissibility_map
-from .laws import fremond, moreau, newton
-from .lcp import LCPResult, solve_lcp
-from .problem import ChainInfo, ImpactProblem, ImpactStructure
-from .problems import chain, newtons_cradle, random_impact
-from .reflection_law import reflection_law
-from .reflection_table import reflection_law_table
-from .result import ImpactResult
-from .save import save_problem
-from .sector import SectorCone, SectorTable, sector_law_table
-from .sector_certificate import SectorCertificate
-from .sector_law import SectorLawCertificate, sector_law
-from .verify import Counterexample, LawReport, verify_law
+from importlib.metadata import PackageNotFoundError, version
 
-__version__ = "0.1.0"
+from .base.checks import DEFAULT_TOL
+from .errors import (
+    BackendUnsuitableError,
+    CertificateError,
+    ImpactError,
+    InputError,
+    MassMatrixError,
+    NonConvexLCPError,
+    NonFiniteError,
+    NonSymmetricLCPError,
+    NoSolutionError,
+    OptionalDependencyError,
+    ProblemFileError,
+    RestitutionError,
+    SectorInputError,
+    SectorLawError,
+    SectorTableTooLarge,
+    ShapeError,
+    SolverError,
+    UnknownBackendError,
+)
+from .io.files import ProblemFile, load_problem
+from .io.save import save_problem
+from .laws.base import Answer, ImpactLaw
+from .laws.batch import BatchResult, moreau_batch, sector_law_batch, solve_batch
+from .laws.catalogue import available_backends
+from .laws.certificate import Certificate
+from .laws.complementarity import Fremond, Newton
+from .laws.functions import fremond, moreau, newton, reflection_law, sector_law
+from .laws.moreau import Moreau
+from .laws.pipeline import solve
+from .laws.reflection import ReflectionLaw
+from .laws.result import ImpactResult
+from .laws.sector import SectorLaw, SectorLawCertificate
+from .model.admissible import AdmissibleSet, Membership
+from .model.builders import chain, newtons_cradle, random_impact
+from .model.classify import Classification, classify
+from .model.problem import ImpactProblem
+from .model.structure import ChainInfo, ImpactStructure
+from .qp.lcp import LCPResult, solve_lcp
+from .tables.certificate import SectorCertificate
+from .tables.coxeter import continuous_mass_ratios
+from .tables.reflection_table import reflection_law_table
+from .tables.sector_table import SectorCone, SectorTable, sector_law_table
+from .verification.fremond_map import fremond_admissibility_map
+from .verification.report import Counterexample, LawReport
+from .verification.sampled import verify_law
+
+try:
+    __version__ = version("impactqp")
+except PackageNotFoundError:  # running from a source tree that was never installed
+    __version__ = "0+unknown"
 
 __all__ = [
-    "AdmissibleSet", "BackendUnsuitableError", "BatchResult", "Certificate", "CertificateError",
-    "ChainInfo", "Classification", "Counterexample", "ImpactError", "ImpactProblem",
-    "ImpactResult", "ImpactStructure", "InputError", "LCPResult", "LawReport", "MassMatrixError",
-    "Membership", "NoSolutionError", "NonConvexLCPError", "NonFiniteError",
-    "NonSymmetricLCPError", "OptionalDependencyError", "ProblemFile", "ProblemFileError",
-    "RestitutionError", "SectorCertificate", "SectorCone", "SectorInputError",
-    "SectorLawCertificate", "SectorLawError", "SectorTable", "SectorTableTooLarge", "ShapeError",
-    "SolverError", "UnknownBackendError", "chain", "classify", "continuous_mass_ratios",
-    "fremond", "fremond_admissibility_map", "load_problem", "moreau", "moreau_batch", "newton",
-    "newtons_cradle", "random_impact", "reflection_law", "reflection_law_table", "save_problem",
-    "sector_law", "sector_law_batch", "sector_law_table", "solve_lcp", "verify_law",
+    "DEFAULT_TOL", "AdmissibleSet", "Answer", "BackendUnsuitableError", "BatchResult",
+    "Certificate", "CertificateError", "ChainInfo", "Classification", "Counterexample",
+    "Fremond", "ImpactError", "ImpactLaw", "ImpactProblem", "ImpactResult", "ImpactStructure",
+    "InputError", "LCPResult", "LawReport", "MassMatrixError", "Membership", "Moreau",
+    "Newton", "NoSolutionError", "NonConvexLCPError", "NonFiniteError", "NonSymmetricLCPError",
+    "OptionalDependencyError", "ProblemFile", "ProblemFileError", "ReflectionLaw",
+    "RestitutionError", "SectorCertificate", "SectorCone", "SectorInputError", "SectorLaw",
+    "SectorLawCertificate", "SectorLawError", "SectorTable", "SectorTableTooLarge",
+    "ShapeError", "SolverError", "UnknownBackendError", "available_backends", "chain",
+    "classify", "continuous_mass_ratios", "fremond", "fremond_admissibility_map",
+    "load_problem", "moreau", "moreau_batch", "newton", "newtons_cradle", "random_impact",
+    "reflection_law", "reflection_law_table", "save_problem", "sector_law", "sector_law_batch",
+    "sector_law_table", "solve", "solve_batch", "solve_lcp", "verify_law",
 ]

@@ -101,7 +101,7 @@ def test_unsolvable_lcp_raises_no_solution():
 
 
 def test_cvxpy_compiles_once_per_structure():
-    from impactqp.backends import cvxpy_
+    from impactqp.qp.backends import cvxpy_
 
     p = iq.random_impact(6, 4, seed=9)
     rng = np.random.default_rng(0)
@@ -146,7 +146,11 @@ def test_certificate_bounds_velocity_error_on_large_mass_ratios():
     exact = iq.moreau(p, 1.0)  # isotonic regression
     assert exact.certificate.velocity_error_bound < 1e-12
     with pytest.raises(iq.CertificateError, match="duality_gap"):
-        iq.moreau(p, 1.0, backend="clarabel")
+        iq.moreau(p, 1.0, backend="clarabel", form="impulse")
+    # the velocity form, which chains get by default, is well conditioned: certified and right
+    v = iq.moreau(p, 1.0, backend="clarabel")
+    assert v.form == "velocity"
+    assert p.norm(v.u_plus - exact.u_plus) / p.norm(u) <= v.certificate.velocity_error_bound
     # what passes is as accurate as its bound says
     r = iq.moreau(p, 1.0, backend="qpsolvers:piqp")
     err = p.norm(r.u_plus - exact.u_plus) / p.norm(u)

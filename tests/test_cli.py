@@ -2,7 +2,7 @@ import subprocess
 import sys
 
 import impactqp.cli as cli
-from impactqp.demo import cradle_rows
+from impactqp.cli.demo import cradle_rows
 
 
 def test_demo_rows():

@@ -9,8 +9,8 @@ import pytest
 
 import impactqp as iq
 import impactqp.cli as cli
-from impactqp.commands.solve import parse_numbers
-from impactqp.progress import progress
+from impactqp.cli.commands.solve import parse_numbers
+from impactqp.cli.progress import progress
 
 
 @pytest.fixture

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 import impactqp as iq
-from impactqp.geometry2d import clip, plane_picture, sector_picture
-from impactqp.plots import plot_cradle, plot_S, plot_sectors
-from impactqp.sector import sector_law_table
+from impactqp.figures.geometry2d import clip, plane_picture, sector_picture
+from impactqp.figures.plots import plot_cradle, plot_S, plot_sectors
+from impactqp.tables.sector_table import sector_law_table
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import impactqp as iq
-from impactqp import files, save
+from impactqp.io import files, save
 
 
 @pytest.mark.parametrize("suffix", [".json", ".toml"])

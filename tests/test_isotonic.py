@@ -1,4 +1,4 @@
-"""Tests for impactqp.isotonic: exact Moreau impacts on 1-D chains (impact-geometry.md §3, §5)."""
+"""Tests for impactqp.qp.isotonic: exact Moreau impacts on 1-D chains (docs/theory.md §3, §5)."""
 from __future__ import annotations
 
 import clarabel
@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from impactqp.isotonic import ChainSolution, chain_moreau, chain_moreau_batch
+from impactqp.qp.isotonic import ChainSolution, chain_moreau, chain_moreau_batch
 
 WALLS = [(False, False), (True, False), (False, True), (True, True)]
 

@@ -9,18 +9,18 @@ import numpy as np
 import pytest
 
 import impactqp as iq
-from impactqp.coxeter import (
+from impactqp.laws.sector import wedge_angles
+from impactqp.tables.coxeter import (
     contact_angles,
     coxeter_labels,
     coxeter_type,
     extended_masses,
     shared_mass,
 )
-from impactqp.reflection_law import check_reflection_problem, elastic_collisions
-from impactqp.reflection_table import reflection_law_table
-from impactqp.sector import sector_gamma_map, sector_law_table
-from impactqp.sector_law import wedge_angles
-from impactqp.verify import sample_u_minus
+from impactqp.tables.reflection_group import check_reflection_problem, elastic_collisions
+from impactqp.tables.reflection_table import reflection_law_table
+from impactqp.tables.sector_table import sector_gamma_map, sector_law_table
+from impactqp.verification.sampled import sample_u_minus
 
 RNG = np.random.default_rng(11)
 M4, M6 = iq.continuous_mass_ratios(4), iq.continuous_mass_ratios(6)

@@ -13,7 +13,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from impactqp.sector import (
+from impactqp.tables.certificate import (
+    copositive_2x2,
+    copositivity_margins,
+    identify_rays,
+    neighbour_pairs,
+    velocity_matrices,
+)
+from impactqp.tables.sector_table import (
     SectorInputError,
     SectorTable,
     SectorTableTooLarge,
@@ -24,13 +31,6 @@ from impactqp.sector import (
     sector_gamma_map,
     sector_law_table,
     sector_velocity_map,
-)
-from impactqp.sector_certificate import (
-    copositive_2x2,
-    copositivity_margins,
-    identify_rays,
-    neighbour_pairs,
-    velocity_matrices,
 )
 
 RNG = np.random.default_rng(20240611)

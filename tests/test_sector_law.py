@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import impactqp as iq
-from impactqp.sector import sector_law_table
+from impactqp.tables.sector_table import sector_law_table
 
 RNG = np.random.default_rng(7)
 
@@ -63,7 +63,7 @@ def test_certificate_measures_each_condition() -> None:
     cert = iq.sector_law(p).certificate
     assert set(cert.residuals) == {"momentum", "impulse_sign", "kinematic", "energy_balance",
                                    "law_residual"}
-    from impactqp.sector_law import certify_sector
+    from impactqp.laws.sector import certify_sector
 
     # Moreau ε = 1 conserves energy and is kinetically fine, but is not the sector law
     moreau = iq.moreau(p, eps=1.0)
@@ -76,7 +76,14 @@ def test_certificate_measures_each_condition() -> None:
 
 
 def test_failed_certificate_raises() -> None:
+    class Broken(iq.SectorLaw):  # a wrong closed form must never come back as a success
+        def closed_form(self, problem):
+            a = super().closed_form(problem)
+            return iq.Answer(a.u_plus * 1.01, a.impulses)
+
     with pytest.raises(iq.CertificateError, match="certificate failed"):
+        iq.solve(iq.newtons_cradle(3), Broken())
+    with pytest.raises(iq.InputError, match="tol"):
         iq.sector_law(iq.newtons_cradle(3), tol=-1.0)
 
 
@@ -89,7 +96,7 @@ def test_errors_say_why() -> None:
     with pytest.raises(iq.SectorLawError, match=r"unequal masses\. impactqp\.reflection_law "
                        r"gives the elastic law of any two balls\.$"):
         iq.sector_law(iq.chain([1.0, 2.0], [1.0, 0.0]))
-    from impactqp.sector_law import wedge_angles
+    from impactqp.laws.sector import wedge_angles
 
     np.testing.assert_allclose(wedge_angles(np.ones(4)), [60.0, 60.0])  # π/3: k = 3
     with pytest.raises(iq.SectorLawError, match="walls"):

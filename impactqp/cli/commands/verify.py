@@ -1,0 +1,40 @@
+"""``impactqp verify FILE``: is a candidate post-impact velocity admissible (u⁺ ∈ S, §2)?
+
+Exit status: 0 admissible, 1 not admissible, 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from ...base.arrays import as_vector
+from ...errors import InputError
+from ...io.files import load_problem
+from ..progress import progress
+from ..report import format_verdict, membership_report, to_json
+from .solve import parse_numbers
+
+
+def run(args: argparse.Namespace) -> int:
+    content = load_problem(args.file)
+    if args.u_plus is not None:
+        u_plus = as_vector("--u-plus", parse_numbers("--u-plus", args.u_plus),
+                           content.problem.n_dof)
+    elif content.u_plus is not None:
+        u_plus = content.u_plus
+    else:
+        raise InputError(f"{args.file}: no candidate u⁺: pass --u-plus v1,v2,... or put "
+                         "'u_plus' in the file")
+    with progress(f"checking u⁺ ∈ S, exactly and by the SOCP (n = {content.problem.n_dof})"):
+        report = membership_report(content.problem, u_plus)
+    print(to_json(report) if args.json else format_verdict(report, str(args.file)))
+    return 0 if report["admissible"] else 1
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("verify", help="check a candidate u⁺ against S (exit 0 yes, 1 no, 2 bad "
+                                      "input)")
+    p.add_argument("file", help="problem file (.json or .toml)")
+    p.add_argument("--u-plus", help="candidate u⁺ as v1,v2,... (default: the file's u_plus)")
+    p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.set_defaults(func=run)

@@ -1,0 +1,147 @@
+"""Reports of a solved impact and of a verdict on a candidate u⁺, as plain data and as text.
+
+The command line prints these; ``--json`` prints the data itself. Numbers that are undefined
+(e.g. the angle α when there is no impact, §4) are NaN in the data and ``null`` in JSON.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+import numpy as np
+
+from ..laws.result import ImpactResult
+from ..model.admissible import Membership
+from ..model.problem import ImpactProblem
+
+COEFFICIENT_NAMES = {"moreau": "ε", "newton": "e", "fremond": "E"}
+CONDITIONS = ("kinetic", "kinematic", "energetic")
+CONDITION_TEXT = {"kinetic": "u⁺ ∈ u⁻ + N", "kinematic": "u⁺ ∈ T_C",
+                  "energetic": "‖u⁺‖ ≤ ‖u⁻‖"}
+
+
+def jsonable(value: Any) -> Any:
+    """Arrays to lists, numpy scalars to Python numbers, NaN/inf to None (strict JSON)."""
+    if isinstance(value, dict):
+        return {k: jsonable(v) for k, v in value.items()}
+    if isinstance(value, np.ndarray):
+        return jsonable(value.tolist())
+    if isinstance(value, (list, tuple)):
+        return [jsonable(v) for v in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def to_json(report: dict[str, Any]) -> str:
+    """Strict JSON text of a report."""
+    return json.dumps(jsonable(report), indent=2, allow_nan=False)
+
+
+def _numbers(value: Any) -> str:
+    """A scalar, vector or matrix of coefficients in a short form."""
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        return f"{float(arr):g}"
+    if arr.ndim == 1:
+        return vector_text(arr)
+    return "[" + "; ".join(" ".join(f"{x:g}" for x in row) for row in arr) + "]"
+
+
+def vector_text(a: Any, digits: int = 6) -> str:
+    """A short vector as ``(+1, -0.333333, …)``; long ones are elided in the middle."""
+    a = np.asarray(a, dtype=float)
+    items = [f"{x:+.{digits}g}" for x in (a if a.size <= 12 else np.r_[a[:5], a[-5:]])]
+    if a.size > 12:
+        items.insert(5, f"… ({a.size - 10} more) …")
+    return "(" + ", ".join(items) + ")"
+
+
+def membership_report(problem: ImpactProblem, u_plus: np.ndarray, *,
+                      optimizer: bool = True) -> dict[str, Any]:
+    """The verdict u⁺ ∈ S (§2): each condition's exact residual, and the optimizer's distance.
+
+    The exact test is NNLS plus explicit checks; the optimizer one is the SOCP distance from
+    u⁺ to S (:meth:`AdmissibleSet.contains` with ``method="optimizer"``).
+    """
+    S = problem.admissible_set()
+    exact: Membership = S.contains(u_plus)
+    report: dict[str, Any] = {
+        "u_plus": u_plus, "admissible": exact.member, "tolerance": exact.tol,
+        "conditions": {c: {"residual": exact.residuals[c], "ok": exact.residuals[c] <= exact.tol}
+                       for c in CONDITIONS},
+        "failed": exact.failed(), "impulses": exact.impulses,
+    }
+    if optimizer:
+        opt = S.contains(u_plus, method="optimizer")
+        report["optimizer"] = {"distance": opt.distance, "admissible": opt.member,
+                               "tolerance": opt.tol}
+    return report
+
+
+def solution_report(result: ImpactResult, source: str = "") -> dict[str, Any]:
+    """u⁺, impulses, energies, classification (§4), admissibility (§2) and certificate."""
+    c = result.classification
+    cert = result.certificate
+    membership = membership_report(result.problem, result.u_plus, optimizer=False)
+    return {
+        "source": source, "law": result.law, "coefficients": result.coefficients,
+        "backend": result.backend, "u_minus": result.problem.u_minus, "u_plus": result.u_plus,
+        "impulses": result.impulses,
+        "energy": {"before": result.energy_before, "after": result.energy_after},
+        "classification": {"alpha_deg": c.alpha_deg, "dissipation": c.dissipation,
+                           "intensity": c.intensity},
+        "admissibility": {k: v for k, v in membership.items() if k not in ("u_plus", "impulses")},
+        "certificate": {"ok": cert.ok, "tolerance": cert.tol, **cert.residuals},
+    }
+
+
+def _conditions_text(report: dict[str, Any]) -> list[str]:
+    return [f"  {name:<10} {CONDITION_TEXT[name]:<14} residual {cond['residual']:.1e}  "
+            f"{'ok' if cond['ok'] else 'VIOLATED'}"
+            for name, cond in report["conditions"].items()]
+
+
+def format_solution(report: dict[str, Any]) -> str:
+    """Plain text of :func:`solution_report`."""
+    coef = report["coefficients"]
+    coef_text = "" if coef is None else f", {COEFFICIENT_NAMES[report['law']]} = {_numbers(coef)}"
+    e, c, a = report["energy"], report["classification"], report["admissibility"]
+    ratio = e["after"] / e["before"] if e["before"] > 0 else float("nan")
+    cert = report["certificate"]
+    lines = [
+        f"{report['source']}: law {report['law']}{coef_text} (backend {report['backend']})",
+        f"u⁻         {vector_text(report['u_minus'])}",
+        f"u⁺         {vector_text(report['u_plus'])}",
+        f"impulses Λ {vector_text(report['impulses'])}",
+        f"energy     before {e['before']:.6g}, after {e['after']:.6g} (ratio {ratio:.6g})",
+        f"class (§4) α = {c['alpha_deg']:.4g}°, dissipation ε = {c['dissipation']:.4g}, "
+        f"intensity {c['intensity']:.6g}",
+        f"admissible (u⁺ ∈ S): {'yes' if a['admissible'] else 'NO'}",
+        *_conditions_text(a),
+        f"certificate: {'ok' if cert['ok'] else 'FAILED'} (tol {cert['tolerance']:.0e})",
+    ]
+    return "\n".join(lines)
+
+
+def format_verdict(report: dict[str, Any], source: str = "") -> str:
+    """Plain text of :func:`membership_report`."""
+    opt = report["optimizer"]
+    agree = "" if opt["admissible"] == report["admissible"] else \
+        "  (disagrees with the exact test; trust the exact one)"
+    lines = [
+        f"{source}: candidate u⁺ = {vector_text(report['u_plus'])}",
+        f"exact test (NNLS + explicit checks, tol {report['tolerance']:.0e}):",
+        *_conditions_text(report),
+        f"optimizer (SOCP distance to S, tol {opt['tolerance']:.0e}): "
+        f"{opt['distance']:.1e}, {'in S' if opt['admissible'] else 'not in S'}{agree}",
+        f"verdict: {'ADMISSIBLE' if report['admissible'] else 'NOT ADMISSIBLE'}"
+        + ("" if report["admissible"] else f" (fails: {', '.join(report['failed'])})"),
+    ]
+    return "\n".join(lines)

@@ -1,0 +1,273 @@
+"""Problem files: an impact problem (§1), optionally a law, its coefficients and a candidate u⁺.
+
+One flat schema, stored as JSON or TOML (chosen by the file suffix)::
+
+    version  = 1                          # optional; 1 is the only version
+    # either a general problem ...
+    M        = [[1.0, 0.0], [0.0, 2.0]]   # (n, n) mass matrix
+    W        = [[-1.0], [1.0]]            # (n, m) contact directions
+    # ... or a chain of balls (§5)
+    masses     = [1.0, 1.0, 1.0]
+    left_wall  = false                    # optional
+    right_wall = false                    # optional
+    # always
+    u_minus  = [1.0, 0.0, 0.0]
+    # optional
+    law      = "moreau"                   # "moreau" | "newton" | "fremond" | "sector"
+    eps      = 0.5                        # moreau (§3); "e" for newton, "E" for fremond
+    u_plus   = [0.0, 0.0, 1.0]            # a candidate post-impact velocity
+
+Reading is strict: unknown or duplicate keys, wrong types, ragged or mis-shaped arrays and
+non-finite numbers are refused with a :class:`~impactqp.errors.ProblemFileError` that names
+the field. Nothing is evaluated or unpickled; files above :data:`MAX_FILE_BYTES` and
+problems above :data:`MAX_DOF` degrees of freedom are refused before any work is done.
+Writing is in :mod:`impactqp.save`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..base.arrays import as_vector
+from ..errors import InputError, ProblemFileError
+from ..laws.complementarity import check_restitution
+from ..laws.moreau import check_eps
+from ..model.builders import chain
+from ..model.problem import ImpactProblem
+
+MAX_FILE_BYTES = 10 * 1024 * 1024
+"""Largest problem file that is read (10 MB)."""
+
+MAX_DOF = 10_000
+"""Largest number of degrees of freedom (and of contacts) a problem file may declare."""
+
+VERSION = 1
+LAWS = ("moreau", "newton", "fremond", "sector")
+COEFFICIENT_KEYS = {"moreau": "eps", "newton": "e", "fremond": "E"}
+GENERAL_KEYS = ("M", "W")
+CHAIN_KEYS = ("masses", "left_wall", "right_wall")
+KNOWN_KEYS = ("version", *GENERAL_KEYS, *CHAIN_KEYS, "u_minus", "law", "eps", "e", "E",
+              "u_plus")
+FORMATS = {".json": "json", ".toml": "toml"}
+
+
+@dataclass(frozen=True)
+class ProblemFile:
+    """The content of a problem file.
+
+    Attributes
+    ----------
+    problem : ImpactProblem
+    law : str or None
+        ``"moreau"``, ``"newton"``, ``"fremond"``, ``"sector"`` or None when absent.
+    coefficients : float, ndarray or None
+        ε (Moreau), the eᵢ (Newton, an (m,) array) or Frémond's (m, m) matrix E.
+    u_plus : ndarray or None
+        A candidate post-impact velocity.
+    path : Path or None
+        Where it was read from.
+    """
+
+    problem: ImpactProblem
+    law: str | None = None
+    coefficients: float | np.ndarray | None = None
+    u_plus: np.ndarray | None = None
+    path: Path | None = None
+
+
+def file_format(path: Path) -> str:
+    """``"json"`` or ``"toml"`` from the suffix of ``path``."""
+    fmt = FORMATS.get(path.suffix.lower())
+    if fmt is None:
+        raise ProblemFileError(f"{path}: unknown problem file suffix {path.suffix!r}; "
+                               f"use one of {sorted(FORMATS)}")
+    return fmt
+
+
+def _toml_module():
+    """tomllib (Python ≥ 3.11) or the ``tomli`` backport on 3.10."""
+    try:
+        import tomllib
+    except ImportError:
+        try:
+            import tomli as tomllib
+        except ImportError:
+            raise ProblemFileError("reading TOML problem files on Python 3.10 needs the "
+                                   "'tomli' package: pip install tomli (or use JSON)") from None
+    return tomllib
+
+
+def _reject_constant(name: str) -> None:
+    raise ValueError(f"{name} is not a finite number")
+
+
+def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(f"duplicate key {key!r}")
+        out[key] = value
+    return out
+
+
+def _parse(text: str, fmt: str) -> Any:
+    if fmt == "json":
+        return json.loads(text, object_pairs_hook=_no_duplicates,
+                          parse_constant=_reject_constant)
+    return _toml_module().loads(text)
+
+
+def _number(name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ProblemFileError(f"{name} must be a number, got {type(value).__name__} {value!r}")
+    if not math.isfinite(value):
+        raise ProblemFileError(f"{name} must be finite, got {value!r}")
+    return float(value)
+
+
+def _vector(name: str, value: Any) -> np.ndarray:
+    if not isinstance(value, list):
+        raise ProblemFileError(f"{name} must be a list of numbers, got {type(value).__name__}")
+    if len(value) > MAX_DOF:
+        raise ProblemFileError(f"{name} has {len(value)} entries; problem files are limited to "
+                               f"{MAX_DOF} (MAX_DOF)")
+    return np.array([_number(f"{name}[{i}]", x) for i, x in enumerate(value)], dtype=float)
+
+
+def _matrix(name: str, value: Any) -> np.ndarray:
+    if not isinstance(value, list) or not value:
+        raise ProblemFileError(f"{name} must be a non-empty list of rows (a matrix)")
+    if len(value) > MAX_DOF:
+        raise ProblemFileError(f"{name} has {len(value)} rows; problem files are limited to "
+                               f"{MAX_DOF} (MAX_DOF)")
+    rows = [_vector(f"{name}[{i}]", row) for i, row in enumerate(value)]
+    widths = {r.size for r in rows}
+    if len(widths) > 1:
+        raise ProblemFileError(f"{name} is ragged: its rows have lengths {sorted(widths)}")
+    return np.stack(rows)
+
+
+def _bool(name: str, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise ProblemFileError(f"{name} must be true or false, got {value!r}")
+    return value
+
+
+def _problem(data: dict[str, Any]) -> ImpactProblem:
+    general = [k for k in GENERAL_KEYS if k in data]
+    chained = [k for k in CHAIN_KEYS if k in data]
+    if general and chained:
+        raise ProblemFileError(f"give either a general problem (M, W) or a chain (masses), "
+                               f"not both: found {general + chained}")
+    if "u_minus" not in data:
+        raise ProblemFileError("missing key 'u_minus' (the pre-impact velocity)")
+    u_minus = _vector("u_minus", data["u_minus"])
+    if chained:
+        if "masses" not in data:
+            raise ProblemFileError(f"a chain needs 'masses'; found only {chained}")
+        return chain(_vector("masses", data["masses"]), u_minus,
+                     left_wall=_bool("left_wall", data.get("left_wall", False)),
+                     right_wall=_bool("right_wall", data.get("right_wall", False)))
+    if not general:
+        raise ProblemFileError("give either a general problem (keys 'M' and 'W') or a chain "
+                               "(key 'masses')")
+    missing = [k for k in GENERAL_KEYS if k not in data]
+    if missing:
+        raise ProblemFileError(f"a general problem needs 'M' and 'W'; missing {missing}")
+    return ImpactProblem(_matrix("M", data["M"]), _matrix("W", data["W"]), u_minus)
+
+
+def _coefficients(law: str | None, data: dict[str, Any], m: int) -> float | np.ndarray | None:
+    given = [k for k in COEFFICIENT_KEYS.values() if k in data]
+    wanted = COEFFICIENT_KEYS.get(law) if law else None
+    stray = [k for k in given if k != wanted]
+    if stray:
+        where = f"law {law!r}" if law else "no law"
+        raise ProblemFileError(f"coefficient {stray[0]!r} does not fit {where}; "
+                               f"eps goes with moreau, e with newton, E with fremond")
+    if wanted is None or wanted not in data:
+        return None
+    value = data[wanted]
+    if wanted == "eps":
+        return check_eps(_number("eps", value))
+    if wanted == "e" and not isinstance(value, list):
+        return check_restitution("e", _number("e", value), m)
+    arr = _vector("e", value) if wanted == "e" else _matrix("E", value)
+    return check_restitution(wanted, arr, m, matrix=wanted == "E")
+
+
+def problem_from_dict(data: Any) -> ProblemFile:
+    """Validate the parsed content of a problem file (see the module docstring).
+
+    Raises
+    ------
+    ProblemFileError
+        Naming the offending field.
+    """
+    if not isinstance(data, dict):
+        raise ProblemFileError(f"a problem file must hold a table/object at the top level, "
+                               f"got {type(data).__name__}")
+    unknown = sorted(set(data) - set(KNOWN_KEYS))
+    if unknown:
+        raise ProblemFileError(f"unknown key(s) {unknown}; known keys are {list(KNOWN_KEYS)}")
+    if "version" in data and (isinstance(data["version"], bool) or data["version"] != VERSION):
+        raise ProblemFileError(f"version must be {VERSION}, got {data['version']!r}")
+    law = data.get("law")
+    if law is not None and law not in LAWS:
+        raise ProblemFileError(f"law must be one of {list(LAWS)}, got {law!r}")
+    try:
+        problem = _problem(data)
+        coefficients = _coefficients(law, data, problem.n_contacts)
+        u_plus = (as_vector("u_plus", _vector("u_plus", data["u_plus"]), problem.n_dof)
+                  if "u_plus" in data else None)
+    except ProblemFileError:
+        raise
+    except InputError as exc:
+        raise ProblemFileError(str(exc)) from exc
+    return ProblemFile(problem, law, coefficients, u_plus)
+
+
+def load_problem(path: str | Path) -> ProblemFile:
+    """Read a problem file (``.json`` or ``.toml``).
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    ProblemFile
+        The problem, and the law, coefficients and candidate u⁺ when the file has them.
+
+    Raises
+    ------
+    ProblemFileError
+        Unreadable, too large, malformed or invalid; the message names the file and the field.
+    """
+    path = Path(path)
+    fmt = file_format(path)
+    try:
+        size = path.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise ProblemFileError(f"{path}: {size} bytes is more than the "
+                                   f"{MAX_FILE_BYTES // 2**20} MB limit of problem files")
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ProblemFileError(f"{path}: cannot read: {exc}") from exc
+    try:
+        parsed = _parse(text, fmt)
+    except ProblemFileError:
+        raise
+    except ValueError as exc:  # json.JSONDecodeError and tomllib.TOMLDecodeError
+        raise ProblemFileError(f"{path}: not valid {fmt.upper()}: {exc}") from exc
+    try:
+        content = problem_from_dict(parsed)
+    except ProblemFileError as exc:
+        raise ProblemFileError(f"{path}: {exc}") from exc
+    return ProblemFile(content.problem, content.law, content.coefficients, content.u_plus, path)

@@ -1,0 +1,95 @@
+"""Writing problem files in the flat schema of :mod:`impactqp.files` (JSON or TOML).
+
+TOML is written by the small writer :func:`to_toml` (the schema has only top-level keys with
+numbers, booleans, one string and nested arrays), so writing needs no extra package. Every
+file is validated by :func:`impactqp.files.problem_from_dict` before it is written.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..base.arrays import as_dense
+from ..errors import InputError
+from ..model.problem import ImpactProblem
+from .files import COEFFICIENT_KEYS, VERSION, file_format, problem_from_dict
+
+
+def problem_to_dict(problem: ImpactProblem, *, law: str | None = None, coefficients: Any = None,
+                    u_plus: Any = None) -> dict[str, Any]:
+    """The file content of a problem as plain lists and numbers (validated by a re-read)."""
+    data: dict[str, Any] = {"version": VERSION}
+    info = problem.chain
+    if info is not None:
+        data["masses"] = info.masses.tolist()
+        data.update(left_wall=info.left_wall, right_wall=info.right_wall)
+    else:
+        data.update(M=as_dense(problem.M).tolist(), W=as_dense(problem.W).tolist())
+    data["u_minus"] = problem.u_minus.tolist()
+    if law is not None:
+        data["law"] = law
+    if coefficients is not None:
+        key = COEFFICIENT_KEYS.get(law) if law else None
+        if key is None:
+            raise InputError(f"coefficients need a law among {list(COEFFICIENT_KEYS)}, "
+                             f"got law={law!r}")
+        data[key] = np.asarray(coefficients, dtype=float).tolist()
+    if u_plus is not None:
+        data["u_plus"] = np.asarray(u_plus, dtype=float).tolist()
+    problem_from_dict(data)  # refuse to write what could not be read back
+    return data
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(float(value)) if isinstance(value, float) else str(value)
+    if isinstance(value, str):
+        return json.dumps(value)  # a TOML basic string
+    return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+
+
+def to_toml(data: dict[str, Any]) -> str:
+    """TOML text of the flat schema: top-level keys with numbers, booleans, strings and
+    (nested) arrays of numbers. Floats are written with ``repr``, which round-trips exactly."""
+    return "".join(f"{key} = {_toml_value(value)}\n" for key, value in data.items())
+
+
+def to_json(data: dict[str, Any]) -> str:
+    """JSON text with one top-level key per line (matrices stay on one line each)."""
+    return "{\n" + ",\n".join(f" {json.dumps(k)}: {json.dumps(v)}" for k, v in data.items()) \
+        + "\n}\n"
+
+
+def save_problem(problem: ImpactProblem, path: str | Path, *, law: str | None = None,
+                 coefficients: Any = None, u_plus: Any = None) -> Path:
+    """Write a problem file; the format follows the suffix (``.json`` or ``.toml``).
+
+    Chains are written as chains (masses and walls), every other problem as dense M and W.
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+    path : str or Path
+    law : {"moreau", "newton", "fremond", "sector"}, optional
+    coefficients : float or array_like, optional
+        ε, the eᵢ or E of ``law``.
+    u_plus : (n,) array_like, optional
+        A candidate post-impact velocity.
+
+    Returns
+    -------
+    Path
+        The path written.
+    """
+    path = Path(path)
+    fmt = file_format(path)
+    data = problem_to_dict(problem, law=law, coefficients=coefficients, u_plus=u_plus)
+    text = to_json(data) if fmt == "json" else to_toml(data)
+    path.write_text(text, encoding="utf-8")
+    return path

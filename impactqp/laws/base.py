@@ -1,0 +1,119 @@
+"""What an impact law is to impactqp: an object that owns its program, the recovery of u⁺ and
+Λ from the program's solution, and its own residuals (docs/theory.md §3, §8).
+
+A law either emits quadratic programs (one per form it has: ``"velocity"`` or
+``"impulse"``) that any suitable backend solves, or computes its answer in closed form
+(``forms = ()``, e.g. the sector law). The solve pipeline (:func:`impactqp.solve`) does the
+rest: validation, backend choice, polishing, the certificate and the result. A new law plugs
+in by subclassing :class:`ImpactLaw`.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from typing import Any, ClassVar, NamedTuple
+
+import numpy as np
+
+from ..base.checks import ResidualChecks
+from ..model.problem import ImpactProblem
+from ..model.structure import ImpactStructure
+from ..qp.program import QPSolution, QuadraticProgram
+
+
+class Answer(NamedTuple):
+    """A law's answer: post-impact velocity, impulses and (Moreau's family) the projection z."""
+
+    u_plus: np.ndarray
+    impulses: np.ndarray
+    z: np.ndarray | None = None
+
+
+class ImpactLaw(ABC):
+    """Base class of impact laws.
+
+    Class attributes
+    ----------------
+    name : str
+        Short name (``"moreau"``), stored in :attr:`ImpactResult.law`.
+    title : str
+        Human name for messages.
+    forms : tuple of str
+        Program forms the law can emit, in no particular order; ``()`` for closed form.
+    closed_form_backend : str
+        For closed-form laws, the name their results carry as backend (``"sort"``).
+    always_solvable : bool
+        A solution exists for every u⁻ (Moreau's law, the sector law): the pipeline never
+        reports "no solution" for such a law.
+    """
+
+    name: ClassVar[str]
+    title: ClassVar[str]
+    forms: ClassVar[tuple[str, ...]] = ()
+    closed_form_backend: ClassVar[str] = ""
+    always_solvable: ClassVar[bool] = False
+
+    @property
+    def coefficients(self) -> Any:
+        """The law's coefficients as stored in results (ε, eᵢ, E, or None)."""
+        return None
+
+    def coefficients_for(self, problem: ImpactProblem) -> Any:
+        """The coefficients as they act on ``problem`` (a scalar eᵢ spread over contacts)."""
+        return self.coefficients
+
+    def check(self, problem: ImpactProblem) -> None:  # noqa: B027 (optional hook)
+        """Raise an InputError (naming the argument) when the law cannot act on ``problem``;
+        the default accepts every problem."""
+
+    def preferred_forms(self, problem: ImpactProblem) -> tuple[str, ...]:
+        """The forms to try, best first: the velocity form for sparse problems and chains
+        (well posed for any W, and the isotonic path), the impulse form otherwise (smaller
+        when m < n)."""
+        order = ("velocity", "impulse") if problem.structure.sparse or problem.chain \
+            else ("impulse", "velocity")
+        return tuple(f for f in order if f in self.forms)
+
+    def program(self, problem: ImpactProblem, form: str) -> QuadraticProgram:
+        """The program of ``form`` whose solution determines the law's answer."""
+        raise NotImplementedError(f"{self.title} emits no {form} program")
+
+    def recover(self, problem: ImpactProblem, form: str, solution: QPSolution) -> Answer:
+        """u⁺, Λ (and z) from a solution of :meth:`program`."""
+        raise NotImplementedError(f"{self.title} emits no {form} program")
+
+    def closed_form(self, problem: ImpactProblem) -> Answer:
+        """The answer of a closed-form law (``forms == ()``)."""
+        raise NotImplementedError(f"{self.title} is solved through programs")
+
+    def linear_terms(self, problem: ImpactProblem, U_minus: np.ndarray,
+                     form: str) -> np.ndarray:
+        """The linear terms c of :meth:`program` for every row of U_minus (batches): the
+        rest of the program depends on the structure only."""
+        raise NotImplementedError(f"{self.title} has no batched {form} program")
+
+    def recover_rows(self, problem: ImpactProblem, form: str, U_minus: np.ndarray,
+                     X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(U⁺, Λ) from the rows of a batched solution (X primal, Y multipliers)."""
+        raise NotImplementedError(f"{self.title} has no batched {form} program")
+
+    def closed_form_rows(self, problem: ImpactProblem,
+                         U_minus: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(U⁺, Λ) of a closed-form law for every row of U_minus."""
+        raise NotImplementedError(f"{self.title} is solved through programs")
+
+    @abstractmethod
+    def residuals(self, structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
+                  impulses: np.ndarray) -> dict[str, np.ndarray]:
+        """The law's dimensionless residuals for one impact (1-D arrays, float values) or
+        for rows of impacts ((k,) arrays)."""
+
+    @abstractmethod
+    def certificate(self, problem: ImpactProblem, answer: Answer,
+                    tol: float) -> ResidualChecks:
+        """The recomputed certificate of ``answer`` on ``problem``."""
+
+    def __repr__(self) -> str:
+        coef = self.coefficients
+        return f"{type(self).__name__}()" if coef is None else \
+            f"{type(self).__name__}({np.array2string(np.asarray(coef), precision=6)})"

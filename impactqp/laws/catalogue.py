@@ -1,0 +1,54 @@
+"""Which law each registered backend serves: the laws × backends table of the README is
+generated from here (and a test compares the two)."""
+
+from __future__ import annotations
+
+from ..qp import backends
+from ..qp.certified import FAST_PATHS
+from .base import ImpactLaw
+from .complementarity import Fremond, Newton
+from .moreau import Moreau
+from .reflection import ReflectionLaw
+from .sector import SectorLaw
+
+LAWS: tuple[type[ImpactLaw], ...] = (Moreau, Newton, Fremond, SectorLaw, ReflectionLaw)
+"""The law classes impactqp ships."""
+
+
+def laws_served(entry: backends.Backend) -> dict[str, tuple[str, ...]]:
+    """For each shipped law, the forms in which ``entry`` can solve it (empty: not at all)."""
+    return {law.name: tuple(f for f in law.forms if f in entry.forms) for law in LAWS}
+
+
+def available_backends() -> list[dict]:
+    """Every registered backend: whether it is installed, the program forms and laws it
+    serves, and what it is for.
+
+    Returns
+    -------
+    list of dict
+        Keys ``name``, ``installed``, ``forms``, ``exact``, ``serves``, ``install`` and
+        ``laws`` (law name → forms served, empty when the law is out of its reach). Closed-
+        form laws (sector, reflection) are evaluated by ``"auto"`` only.
+    """
+    out = []
+    for item in backends.available_backends():
+        entry = backends.REGISTRY[item["name"]]
+        out.append({**item, "laws": laws_served(entry), "fast_path": entry.name in FAST_PATHS})
+    return out
+
+
+def backend_table() -> str:
+    """The laws × backends table in Markdown (what the README shows)."""
+    names = [law.name for law in LAWS]
+    head = "| backend | " + " | ".join(names) + " | serves |"
+    rows = [head, "|" + "---|" * (len(names) + 2)]
+    rows.append("| `\"auto\"` | " + " | ".join("✓" for _ in names)
+                + " | fast path if one applies, else QP backends, falling back on failure |")
+    for item in available_backends():
+        cells = []
+        for name in names:
+            forms = item["laws"][name]
+            cells.append(", ".join(f[0] for f in forms) if forms else "–")
+        rows.append(f"| `\"{item['name']}\"` | " + " | ".join(cells) + f" | {item['serves']} |")
+    return "\n".join(rows)

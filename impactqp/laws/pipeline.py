@@ -1,0 +1,169 @@
+"""The one solve pipeline: validation → fast path → backend registry → polish → certificate →
+result (docs/theory.md §8, §9).
+
+Every impact law, every backend and every public wrapper (:func:`impactqp.moreau`, …) goes
+through :func:`solve`; nothing else decides which backend runs or whether an answer is good
+enough to return.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+from ..base.arrays import check_tol
+from ..base.checks import DEFAULT_TOL
+from ..errors import (
+    BackendUnsuitableError,
+    CertificateError,
+    InputError,
+    NoSolutionError,
+)
+from ..model.problem import ImpactProblem
+from ..qp import backends
+from ..qp.backends import FORMS
+from ..qp.certified import plan, solve_certified
+from ..qp.program import QPSolution
+from .base import Answer, ImpactLaw
+from .result import ImpactResult
+
+FORM_CHOICES = ("auto",) + FORMS
+
+
+def check_problem(problem: Any) -> ImpactProblem:
+    """``problem`` itself, or InputError when it is not an ImpactProblem."""
+    if not isinstance(problem, ImpactProblem):
+        raise InputError(f"problem must be an ImpactProblem (built by iq.ImpactProblem, "
+                         f"iq.chain, iq.newtons_cradle, ...), got {type(problem).__name__}")
+    return problem
+
+
+def check_law(law: Any) -> ImpactLaw:
+    """``law`` itself, or InputError when it is not an impact law object."""
+    if not isinstance(law, ImpactLaw):
+        raise InputError(f"law must be an impact law object such as iq.Moreau(0.5), "
+                         f"iq.Newton(e), iq.Fremond(E) or iq.SectorLaw(), got "
+                         f"{type(law).__name__}")
+    return law
+
+
+def check_backend(backend: Any) -> str:
+    """``backend`` when it is ``"auto"`` or a registered name, else UnknownBackendError."""
+    if backend != "auto":
+        backends.parse_backend(backend)
+    return backend
+
+
+def check_form(law: ImpactLaw, form: Any) -> str:
+    """``form`` when it is "auto" or a form ``law`` has, else InputError."""
+    if form not in FORM_CHOICES:
+        raise InputError(f"form must be one of {FORM_CHOICES}, got {form!r}")
+    if form != "auto" and form not in law.forms:
+        has = ", ".join(law.forms) if law.forms else "none: it is evaluated in closed form"
+        raise InputError(f"{law.title} has no {form} form (forms: {has})")
+    return form
+
+
+def _result(problem: ImpactProblem, law: ImpactLaw, answer: Answer, backend: str, cert,
+            start: float, *, form: str | None = None,
+            attempts: list[str] | None = None) -> ImpactResult:
+    return ImpactResult(problem, law.name, law.coefficients_for(problem), answer.u_plus,
+                        answer.impulses, backend, cert, form=form, z=answer.z,
+                        attempts=attempts, impact_law=law,
+                        solve_time=time.perf_counter() - start)
+
+
+def _trivial(problem: ImpactProblem) -> Answer:
+    """No contact, or u⁻ = 0 (then γ⁻ = 0 and Λ = 0 solves every law exactly)."""
+    u = problem.u_minus.copy()
+    return Answer(u, np.zeros(problem.n_contacts), u.copy())
+
+
+def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
+          form: str = "auto", tol: float = DEFAULT_TOL) -> ImpactResult:
+    """Solve one impact with any impact law and return a certified result.
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        M, W and u⁻.
+    law : ImpactLaw
+        ``iq.Moreau(eps)``, ``iq.Newton(e)``, ``iq.Fremond(E)``, ``iq.SectorLaw()``,
+        ``iq.ReflectionLaw()`` or any subclass of :class:`impactqp.ImpactLaw`.
+    backend : str
+        ``"auto"`` (exact fast paths first, then QP solvers, falling back on failure) or a
+        registered backend (:func:`impactqp.available_backends`), tried alone.
+    form : {"auto", "velocity", "impulse"}
+        Which program to solve, for laws that have several (they give the same u⁺).
+    tol : float
+        Tolerance of the recomputed certificate, in (0, 1).
+
+    Returns
+    -------
+    ImpactResult
+        Only when its certificate passes; ``result.admissible`` says separately whether u⁺
+        is physically admissible (in S).
+
+    Raises
+    ------
+    InputError
+        Not a problem or not a law, bad ``form`` or ``tol``, coefficients that do not fit the
+        problem (all ``ValueError`` subclasses naming the argument).
+    UnknownBackendError
+        A backend impactqp does not know or that is not installed.
+    BackendUnsuitableError
+        A named backend that cannot take this law, form or problem (the message says why).
+    NoSolutionError
+        The law has no solution for this u⁻ (never for laws that always have one).
+    CertificateError
+        No backend produced an answer that passes the certificate.
+    """
+    start = time.perf_counter()
+    check_problem(problem)
+    check_law(law)
+    if law.forms or backend != law.closed_form_backend:
+        check_backend(backend)
+    check_form(law, form)
+    tol = check_tol(tol)
+    law.check(problem)
+    if problem.n_contacts == 0 or not np.any(problem.u_minus):
+        answer = _trivial(problem)
+        return _result(problem, law, answer, "none", law.certificate(problem, answer, tol),
+                       start, attempts=["no contact or u⁻ = 0: u⁺ = u⁻, Λ = 0"])
+    if not law.forms:
+        return _closed_form(problem, law, backend, tol, start)
+
+    forms = (form,) if form != "auto" else law.preferred_forms(problem)
+    programs = {f: law.program(problem, f) for f in forms}
+
+    def finisher(f: str):
+        def finish(solution: QPSolution):
+            answer = law.recover(problem, f, solution)
+            return answer, law.certificate(problem, answer, tol)
+        return finish
+
+    candidates = plan(programs, {f: finisher(f) for f in forms}, backend)
+    try:
+        out = solve_certified(candidates, named=backend != "auto")
+    except NoSolutionError as exc:
+        if law.always_solvable:  # a solution exists: failing to find it is the solvers'
+            raise CertificateError(f"{law.title} has a solution for every u⁻, but no "
+                                   f"backend certified one: {exc}") from exc
+        raise
+    return _result(problem, law, out.answer, out.backend, out.checks, start, form=out.form,
+                   attempts=out.attempts)
+
+
+def _closed_form(problem: ImpactProblem, law: ImpactLaw, backend: str, tol: float,
+                 start: float) -> ImpactResult:
+    if backend not in ("auto", law.closed_form_backend):
+        raise BackendUnsuitableError(f"{law.title} is evaluated in closed form; pass "
+                                     f"backend='auto', not {backend!r}")
+    answer = law.closed_form(problem)
+    cert = law.certificate(problem, answer, tol)
+    if not cert.ok:
+        raise CertificateError(f"{law.title}: certificate failed, {cert.summary()}")
+    return _result(problem, law, answer, law.closed_form_backend, cert, start,
+                   attempts=[f"{law.closed_form_backend}: certified"])

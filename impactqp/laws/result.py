@@ -1,0 +1,121 @@
+"""The result of one impact law on one impact problem (scipy-style: status, message, time)."""
+
+from __future__ import annotations
+
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from ..base.checks import ResidualChecks
+from ..model.admissible import Membership
+from ..model.classify import Classification, classify
+from ..model.problem import ImpactProblem
+
+
+class ImpactResult:
+    """Post-impact state computed by a law, with its recomputed certificate.
+
+    A result is only returned when ``certificate.ok``; physical admissibility (u⁺ ∈ S) is a
+    separate verdict in :attr:`admissible`, which a law may legitimately fail.
+
+    Attributes
+    ----------
+    problem : ImpactProblem
+    law : str
+        The law's name: ``"moreau"``, ``"newton"``, ``"fremond"``, ``"sector"``, ...
+    impact_law : ImpactLaw
+        The law object that was solved.
+    coefficients : float or ndarray
+        ε, the eᵢ, or Frémond's matrix E.
+    u_plus : (n,) ndarray
+        Post-impact velocity.
+    impulses : (m,) ndarray
+        Impulsive contact forces Λ ≥ 0 with M(u⁺ − u⁻) = WΛ.
+    backend : str
+        What produced the numbers (e.g. ``"nnls"``, ``"clarabel"``, ``"exact"``).
+    certificate : Certificate or SectorLawCertificate
+        Recomputed residuals of the law that was solved.
+    form : str or None
+        ``"velocity"`` or ``"impulse"`` for laws solved through a program.
+    attempts : list of str
+        What the pipeline tried, in order.
+    solve_time : float
+        Seconds from validation to the certified answer.
+    status, message, success, ok
+        ``"solved"``, a human-readable summary, and True: a result is only returned when its
+        certificate passes (as scipy's ``OptimizeResult`` and cvxpy's status, ``ok`` and
+        ``success`` say so).
+    """
+
+    def __init__(self, problem: ImpactProblem, law: str, coefficients, u_plus: np.ndarray,
+                 impulses: np.ndarray, backend: str, certificate: ResidualChecks, *,
+                 form: str | None = None, z: np.ndarray | None = None,
+                 attempts: list[str] | None = None, impact_law: Any = None,
+                 solve_time: float = 0.0) -> None:
+        self.problem = problem
+        self.law = law
+        self.impact_law = impact_law
+        self.solve_time = solve_time
+        self.coefficients = coefficients
+        self.u_plus = u_plus
+        self.impulses = impulses
+        self.backend = backend
+        self.certificate = certificate
+        self.form = form
+        self.attempts = attempts or []
+        self._z = z
+
+    status = "solved"
+
+    @property
+    def ok(self) -> bool:
+        """The certificate's verdict (True for every returned result)."""
+        return self.certificate.ok
+
+    success = ok
+
+    @property
+    def message(self) -> str:
+        form = f", {self.form} form" if self.form else ""
+        return (f"{self.law} solved by {self.backend}{form} in {self.solve_time * 1e3:.3g} ms; "
+                f"certificate {self.certificate.summary()}")
+
+    @cached_property
+    def gamma_plus(self) -> np.ndarray:
+        """Post-impact contact velocities γ⁺ = Wᵀu⁺."""
+        return self.problem.structure.Wt_times(self.u_plus)
+
+    @property
+    def z(self) -> np.ndarray:
+        """z = prox_{T_C}(u⁻), the least-energy point of S (docs/theory.md §3)."""
+        return self._z if self._z is not None else self.problem.moreau_split[0]
+
+    @property
+    def z_perp(self) -> np.ndarray:
+        """z⊥ = u⁻ − z (in −N)."""
+        return self.problem.u_minus - self.z
+
+    @property
+    def energy_before(self) -> float:
+        return self.problem.kinetic_energy()
+
+    @property
+    def energy_after(self) -> float:
+        return self.problem.kinetic_energy(self.u_plus)
+
+    @cached_property
+    def admissible(self) -> Membership:
+        """Whether u⁺ ∈ S (exact test, docs/theory.md §2), with its residuals: the physical
+        verdict, separate from the certificate."""
+        return self.problem.admissible_set().contains(self.u_plus)
+
+    @cached_property
+    def classification(self) -> Classification:
+        """Intensity, topology, angle α and dissipation of u⁺ (docs/theory.md §4)."""
+        return classify(self.problem, self.u_plus)
+
+    def __repr__(self) -> str:
+        return (f"ImpactResult(law={self.law!r}, backend={self.backend!r}, "
+                f"u_plus={np.array2string(self.u_plus, precision=6)}, "
+                f"certificate={self.certificate.summary()})")

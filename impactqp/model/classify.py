@@ -1,0 +1,87 @@
+"""Geometric classification of a post-impact velocity (docs/theory.md §4)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..base.arrays import as_vector
+from .admissible import best_impulses
+from .problem import ImpactProblem
+
+
+@dataclass(frozen=True)
+class Classification:
+    """Invariants of an impact u⁻ ↦ u⁺ (docs/theory.md §4).
+
+    Attributes
+    ----------
+    intensity : float
+        ‖u⁺ − u⁻‖ in the kinetic metric.
+    topology : ndarray
+        Unit impulse direction Λ/‖Λ‖ (the half-line of u⁻ + N through u⁺; with redundant
+        contacts one of several representations).
+    direction : ndarray
+        (u⁺ − u⁻)/‖u⁺ − u⁻‖, the same half-line in velocity space (unique).
+    alpha_deg : float
+        Angle in the metric M between the half-line of u⁺ and Moreau's half-line through z;
+        NaN when there is no impact (z⊥ = 0) or u⁺ = u⁻.
+    dissipation : float
+        The ε whose energy sphere passes through u⁺: ‖u⁺‖² = ‖z‖² + ε²‖z⊥‖²; negative
+        (−sqrt(−ratio)) when u⁺ has less energy than z, NaN when z⊥ = 0.
+    moreau_direction : ndarray
+        (z − u⁻)/‖z − u⁻‖.
+    kinetic_residual : float
+        How far u⁺ is from u⁻ + N (relative); the classification assumes it is ~0.
+    """
+
+    intensity: float
+    topology: np.ndarray
+    direction: np.ndarray
+    alpha_deg: float
+    dissipation: float
+    moreau_direction: np.ndarray
+    impulses: np.ndarray
+    kinetic_residual: float
+
+
+def _unit(p: ImpactProblem, v: np.ndarray) -> np.ndarray:
+    n = p.norm(v)
+    return v / n if n > 0 else np.full_like(v, np.nan)
+
+
+def classify(problem: ImpactProblem, u_plus: Any) -> Classification:
+    """Classify u⁺ by intensity, topology, angle α to Moreau's half-line and dissipation
+    (docs/theory.md §4).
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+    u_plus : (n,) array_like
+        A post-impact velocity, normally in u⁻ + N.
+    """
+    u = as_vector("u_plus", u_plus, problem.n_dof)
+    z, zp = problem.moreau_split
+    du = u - problem.u_minus
+    lam, res = best_impulses(problem, du)
+    intensity = problem.norm(du)
+    lam_norm = np.linalg.norm(lam)
+    topology = lam / lam_norm if lam_norm > 0 else np.full_like(lam, np.nan)
+    direction = _unit(problem, du)
+    moreau_dir = _unit(problem, -zp)
+    zp2 = problem.norm(zp) ** 2
+    if zp2 > 0 and intensity > 0:
+        # atan2 of the parallel and orthogonal parts: accurate near 0° (arccos is not)
+        cos = problem.inner(direction, moreau_dir)
+        sin = problem.norm(direction - cos * moreau_dir)
+        alpha = float(np.degrees(np.arctan2(sin, cos)))
+        # ‖u⁺‖² − ‖z‖² as ⟨u⁺ − z, u⁺ + z⟩: no cancellation for u⁺ near z (small ε)
+        ratio = problem.inner(u - z, u + z) / zp2
+        dissipation = float(np.sign(ratio) * np.sqrt(abs(ratio)))
+    else:
+        alpha, dissipation = float("nan"), float("nan")
+    return Classification(intensity=intensity, topology=topology, direction=direction,
+                          alpha_deg=alpha, dissipation=dissipation, moreau_direction=moreau_dir,
+                          impulses=lam, kinetic_residual=res / problem.velocity_scale)

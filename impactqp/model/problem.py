@@ -1,0 +1,93 @@
+"""The impact problem: M, W and the pre-impact velocity u⁻ (docs/theory.md §1)."""
+
+from __future__ import annotations
+
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from ..base.arrays import Matrix, as_vector
+from .admissible import AdmissibleSet
+from .structure import ImpactStructure
+
+
+class ImpactProblem:
+    """One frictionless impact: M, W and the pre-impact velocity u⁻ (docs/theory.md §1).
+
+    Parameters
+    ----------
+    M : (n, n) array_like or scipy.sparse matrix
+        Mass matrix, symmetric positive definite (the kinetic metric).
+    W : (n, m) array_like or scipy.sparse matrix
+        Generalized force directions of the closed contacts; ``m = 0`` means no contact.
+    u_minus : (n,) array_like
+        Pre-impact generalized velocity. Kinematically inconsistent values (a closed contact
+        already separating, γ⁻ᵢ > 0) are legal.
+
+    Raises
+    ------
+    ShapeError, NonFiniteError, MassMatrixError
+        On malformed input; all are ``ValueError`` subclasses.
+    """
+
+    def __init__(self, M: Matrix, W: Matrix, u_minus: Any, *,
+                 structure: ImpactStructure | None = None) -> None:
+        self.structure = structure if structure is not None else ImpactStructure(M, W)
+        self.u_minus = as_vector("u_minus", u_minus, self.structure.n)
+        self.u_minus.setflags(write=False)
+
+    @classmethod
+    def from_structure(cls, structure: ImpactStructure, u_minus: Any) -> ImpactProblem:
+        """A problem on an already validated structure (no re-factorization)."""
+        return cls(None, None, u_minus, structure=structure)
+
+    def with_u_minus(self, u_minus: Any) -> ImpactProblem:
+        """The same M and W (sharing factorizations) with another pre-impact velocity."""
+        return ImpactProblem.from_structure(self.structure, u_minus)
+
+    # --- data ------------------------------------------------------------------------
+    M = property(lambda self: self.structure.M, doc="Mass matrix (n, n).")
+    W = property(lambda self: self.structure.W, doc="Force directions (n, m).")
+    n_dof = property(lambda self: self.structure.n, doc="Number of degrees of freedom n.")
+    n_contacts = property(lambda self: self.structure.m, doc="Number of closed contacts m.")
+    chain = property(lambda self: self.structure.chain, doc="ChainInfo for 1-D chains, else None.")
+    delassus = property(lambda self: self.structure.delassus, doc="Delassus matrix G = WᵀM⁻¹W.")
+
+    @cached_property
+    def gamma_minus(self) -> np.ndarray:
+        """Pre-impact contact velocities γ⁻ = Wᵀu⁻ (γ > 0 separates)."""
+        return self.structure.Wt_times(self.u_minus)
+
+    def norm(self, u: np.ndarray) -> float:
+        """Kinetic norm ‖u‖ = sqrt(uᵀMu) (no overflow or underflow)."""
+        return float(self.structure.kinetic_norms(np.asarray(u, dtype=float)))
+
+    def inner(self, a: np.ndarray, b: np.ndarray) -> float:
+        """Kinetic inner product ⟨a, b⟩ = aᵀMb."""
+        return float(a @ self.structure.mass_rows(b))
+
+    def kinetic_energy(self, u: np.ndarray | None = None) -> float:
+        """T = ½uᵀMu (of u⁻ when u is omitted)."""
+        u = self.u_minus if u is None else u
+        return 0.5 * self.norm(u) ** 2
+
+    @property
+    def velocity_scale(self) -> float:
+        """‖u⁻‖, the natural velocity unit of certificates (1 when u⁻ = 0)."""
+        s = self.norm(self.u_minus)
+        return s if s > 0 else 1.0
+
+    @cached_property
+    def moreau_split(self) -> tuple[np.ndarray, np.ndarray]:
+        """(z, z⊥): z = prox_{T_C}(u⁻) in the metric M and z⊥ = u⁻ − z (docs/theory.md §1,
+        §3), by the exact projection of :meth:`AdmissibleSet.moreau_split`; cached."""
+        return self.admissible_set().moreau_split()
+
+    def admissible_set(self) -> AdmissibleSet:
+        """The admissible set S of this impact (docs/theory.md §2)."""
+        return AdmissibleSet(self)
+
+    def __repr__(self) -> str:
+        kind = "sparse" if self.structure.sparse else "dense"
+        return f"ImpactProblem(n_dof={self.n_dof}, n_contacts={self.n_contacts}, {kind})"

@@ -1,0 +1,45 @@
+"""The two programs of an impact (docs/theory.md §3, §9), which the complementarity laws
+emit and the projection onto T_C solves.
+
+* velocity form: ``min ½‖v − u⁻‖²_M  s.t.  Wᵀv ≥ 0`` (z = prox_{T_C}(u⁻), Moreau's law);
+* impulse form: ``min ½ΛᵀGΛ + qᵀΛ  s.t.  Λ ≥ 0`` (the LCP ``0 ≤ Λ ⟂ GΛ + q ≥ 0``).
+
+Both take an ImpactProblem (anything with ``structure``, ``u_minus`` and ``chain``).
+Programs of one structure share their owner and tag, so backends that prepare or compile
+(the kernel, cvxpy) do it once per structure.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..qp.program import ChainShape, QuadraticProgram
+
+
+def impulse_program(problem: Any, q: np.ndarray,
+                    moreau_scale: float | None = None) -> QuadraticProgram:
+    """Impulse form min ½ΛᵀGΛ + qᵀΛ, Λ ≥ 0, with the factor B = L⁻¹W when dense.
+
+    For Moreau's law (q = (1+ε)γ⁻, ``moreau_scale`` = 1+ε) q = Bᵀd with d = (1+ε)Lᵀu⁻,
+    which lets the NNLS backend work without refactorizing.
+    """
+    st = problem.structure
+    if st.sparse:
+        return QuadraticProgram(P=st.delassus, c=q, cache_owner=st, cache_tag="impulse")
+    d = None if moreau_scale is None else moreau_scale * (st.cholesky_factor.T @ problem.u_minus)
+    return QuadraticProgram(P=st.delassus, c=q, factor=st.scaled_W, factor_rhs=d,
+                            cache_owner=st, cache_tag="impulse")
+
+
+def velocity_program(problem: Any) -> QuadraticProgram:
+    """Velocity form min ½‖v − u⁻‖²_M s.t. Wᵀv ≥ 0: its solution is z = prox_{T_C}(u⁻)
+    and its multipliers are the impulses Λ_z of M(z − u⁻) = WΛ_z."""
+    st = problem.structure
+    A = sp.csc_matrix(st.W.T) if st.sparse else st.W.T
+    c = problem.chain
+    shape = None if c is None else ChainShape(c.masses, c.left_wall, c.right_wall)
+    return QuadraticProgram(P=st.M, c=-st.mass_rows(problem.u_minus), A=A, b=np.zeros(st.m),
+                            cache_owner=st, cache_tag="velocity", chain=shape)

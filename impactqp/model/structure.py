@@ -1,0 +1,194 @@
+"""The data of an impact that do not depend on u⁻: M and W, validated and factorized once
+(docs/theory.md §1).
+
+An :class:`ImpactStructure` is shared by every problem built with
+:meth:`~impactqp.ImpactProblem.with_u_minus`, so a parameter sweep or a simulator pays for
+validation, the factorization of M and the Delassus matrix only once.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..base.arrays import Matrix, as_dense, as_matrix
+from ..base.rowwise import row_max, row_sum
+from ..errors import MassMatrixError, ShapeError
+
+
+@dataclass(frozen=True)
+class ChainInfo:
+    """Marks a problem as a 1-D chain (§5): ball masses and the fixed walls, if any."""
+
+    masses: np.ndarray
+    left_wall: bool = False
+    right_wall: bool = False
+
+
+class ImpactStructure:
+    """M and W of an impact, validated and factorized once (§1).
+
+    Parameters
+    ----------
+    M : (n, n) array_like or scipy.sparse matrix
+        Mass matrix, symmetric positive definite.
+    W : (n, m) array_like or scipy.sparse matrix
+        Generalized force directions, one column per closed contact; ``m = 0`` is allowed.
+    """
+
+    def __init__(self, M: Matrix, W: Matrix, *, chain: ChainInfo | None = None) -> None:
+        M, W = as_matrix("M", M), as_matrix("W", W)
+        self.sparse = sp.issparse(M) or sp.issparse(W)
+        if self.sparse:
+            M, W = sp.csc_matrix(M), sp.csc_matrix(W)
+        if M.ndim != 2 or M.shape[0] != M.shape[1] or M.shape[0] == 0:
+            raise ShapeError(f"M must be a non-empty square (n, n) matrix, got shape {M.shape}")
+        n = M.shape[0]
+        if W.ndim == 1 and W.size == 0:
+            W = np.zeros((n, 0))
+        if W.ndim != 2 or W.shape[0] != n:
+            raise ShapeError(f"W must have shape (n, m) = ({n}, m) to match M, got {W.shape}")
+        self.M, self.W = M, W
+        self.n, self.m = n, W.shape[1]
+        self.chain = chain
+        self._check_symmetric()
+        self._factorize()
+        col_norms = np.sqrt(np.asarray(abs(W).power(2).sum(axis=0)).ravel()) if self.sparse \
+            else np.linalg.norm(W, axis=0)
+        if np.any(col_norms == 0):
+            raise ShapeError(f"W column(s) {np.flatnonzero(col_norms == 0).tolist()} are zero: "
+                             "every contact needs a non-zero force direction")
+
+    def _check_symmetric(self) -> None:
+        M = self.M
+        scale = abs(M).max() if self.sparse else np.abs(M).max()
+        asym = abs(M - M.T).max() if self.sparse else np.abs(M - M.T).max()
+        if asym > 1e-12 * max(scale, 1e-300):
+            raise MassMatrixError(f"M must be symmetric; max |M - Mᵀ| = {asym:.3g} "
+                                  f"(largest entry {scale:.3g})")
+
+    def _factorize(self) -> None:
+        if self.sparse:
+            diag = self.M.diagonal()
+            offdiag = self.M - sp.diags(diag)
+            self.diagonal_mass = offdiag.nnz == 0 or abs(offdiag).max() == 0
+            if self.diagonal_mass:
+                if np.any(diag <= 0):
+                    bad = np.flatnonzero(diag <= 0)[:5].tolist()
+                    raise MassMatrixError(f"M must be positive definite; diagonal entries {bad} "
+                                          "are not positive")
+                self._diag = diag
+                return
+            # LU with diagonal pivoting on a symmetric permutation: all pivots > 0 iff SPD.
+            lu = spla.splu(self.M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                           options={"SymmetricMode": True})
+            pivots = lu.U.diagonal()
+            if np.any(pivots <= 0) or not np.array_equal(lu.perm_r, lu.perm_c):
+                raise MassMatrixError("M must be positive definite; its LDLᵀ factorization has "
+                                      "a non-positive pivot")
+            self._lu = lu
+        else:
+            self.diagonal_mass = bool(np.count_nonzero(self.M - np.diag(np.diag(self.M))) == 0)
+            try:
+                self._chol = sla.cholesky(self.M, lower=True)
+            except np.linalg.LinAlgError:
+                eig = np.linalg.eigvalsh(self.M).min()
+                raise MassMatrixError("M must be positive definite; its smallest eigenvalue is "
+                                      f"{eig:.3g}") from None
+
+    # --- linear algebra in the kinetic metric -------------------------------------------
+    def solve_mass(self, x: np.ndarray) -> np.ndarray:
+        """Return M⁻¹x for a vector or a matrix of right-hand sides."""
+        if self.sparse:
+            if self.diagonal_mass:
+                return x / self._diag[:, None] if x.ndim == 2 else x / self._diag
+            return self._lu.solve(np.asarray(x, dtype=float))
+        return sla.cho_solve((self._chol, True), x)
+
+    @cached_property
+    def mass_diagonal(self) -> np.ndarray | None:
+        """The diagonal of M when M is diagonal (chains), else None."""
+        return np.asarray(self.M.diagonal()).ravel() if self.diagonal_mass else None
+
+    def mass_rows(self, X: np.ndarray) -> np.ndarray:
+        """M applied to a vector or to every row of X (M is symmetric)."""
+        d = self.mass_diagonal
+        if d is not None:
+            return X * d
+        return X @ self.M if not self.sparse else np.asarray((self.M @ X.T).T)
+
+    def kinetic_norms(self, X: np.ndarray) -> np.ndarray:
+        """‖x‖ = sqrt(xᵀMx) of a vector or of every row of X, without overflow or underflow
+        (each row is divided by its largest entry before it is squared)."""
+        s = row_max(np.abs(X))
+        safe = np.where(s > 0, s, 1.0)
+        Y = X / (safe[..., None] if X.ndim == 2 else safe)
+        return s * np.sqrt(np.maximum(row_sum(self.mass_rows(Y) * Y), 0.0))
+
+    def Wt_times(self, U: np.ndarray) -> np.ndarray:
+        """Contact velocities γ = Wᵀu of a vector or of every row of U."""
+        return np.asarray(self.W.T @ U.T).T
+
+    def impulse_velocity(self, Lam: np.ndarray) -> np.ndarray:
+        """Velocity jump M⁻¹WΛ of an impulse vector or of every row of Lam (§1)."""
+        return np.asarray(self.Minv_W @ Lam.T).T
+
+    @cached_property
+    def cholesky_factor(self) -> np.ndarray:
+        """Lower Cholesky factor L of a dense M (M = LLᵀ)."""
+        if self.sparse:
+            raise ValueError("the dense Cholesky factor is only kept for dense problems")
+        return self._chol
+
+    @cached_property
+    def scaled_W(self) -> np.ndarray:
+        """B = L⁻¹W, so that G = BᵀB (dense problems): the basis of the NNLS paths."""
+        return sla.solve_triangular(self.cholesky_factor, self.W, lower=True)
+
+    @cached_property
+    def Minv_W(self) -> Matrix:
+        """M⁻¹W (sparse when M is diagonal and W sparse, dense otherwise)."""
+        if self.sparse and self.diagonal_mass:
+            return sp.csc_matrix(sp.diags(1.0 / self._diag) @ self.W)
+        return self.solve_mass(as_dense(self.W))
+
+    @cached_property
+    def delassus(self) -> Matrix:
+        """Delassus matrix G = WᵀM⁻¹W (§1), symmetric positive semidefinite."""
+        if self.sparse and self.diagonal_mass:
+            G = sp.csc_matrix(self.W.T @ self.Minv_W)
+            return (G + G.T) * 0.5
+        if not self.sparse:
+            B = self.scaled_W
+            return B.T @ B
+        G = np.asarray(self.W.T @ self.Minv_W)
+        return 0.5 * (G + G.T)
+
+    @cached_property
+    def delassus_lu(self):
+        """Sparse LU factorization of G, or None when G is singular (redundant contacts)."""
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", spla.MatrixRankWarning)
+            try:
+                return spla.splu(sp.csc_matrix(self.delassus))
+            except RuntimeError:
+                return None
+
+    @cached_property
+    def contact_scale(self) -> np.ndarray:
+        """sᵢ = sqrt(Gᵢᵢ): |γᵢ| ≤ sᵢ‖u‖ (the unit of contact velocities in certificates)."""
+        return np.sqrt(self.delassus_diagonal)
+
+    @cached_property
+    def delassus_diagonal(self) -> np.ndarray:
+        """Diagonal of G: the squared M⁻¹-length of each contact direction."""
+        G = self.delassus
+        return np.asarray(G.diagonal()).ravel() if sp.issparse(G) else np.diag(G).copy()
+
+

@@ -1,0 +1,176 @@
+"""The backend registry: every way impactqp can solve a program, exact paths included.
+
+A backend is a module with ``solve(qp, *, tol, solver=None) -> QPSolution`` and, where it
+serves only some programs, ``unsuitable(qp) -> str | None`` (why it cannot take ``qp``).
+Backends that solve many right-hand sides at once also have ``solve_many``. Backends know
+programs only (:mod:`impactqp.qp.program`), never impacts or laws (docs/theory.md §9).
+
+Each entry declares the program forms it serves (``"velocity"``: general ``Ax ≥ b``;
+``"impulse"``: ``x ≥ 0``, an LCP), whether its answers are exact (no polishing needed),
+and what it is for. :func:`available_backends` lists them with their install state.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+from dataclasses import dataclass
+from functools import cache
+from types import ModuleType
+
+from ...errors import BackendUnsuitableError, UnknownBackendError
+from ..program import QuadraticProgram
+
+FORMS = ("velocity", "impulse")
+
+
+@dataclass(frozen=True)
+class Backend:
+    """One registered backend.
+
+    Attributes
+    ----------
+    name : str
+        The name users pass (``"clarabel"``); families with sub-solvers take ``"name:SOLVER"``.
+    module : str
+        Module in this package that implements it.
+    requires : str
+        Python package that must be importable.
+    install : str
+        What to install when it is missing.
+    forms : tuple of str
+        Program forms served (see :data:`FORMS`).
+    exact : bool
+        Answers are exact active-set solutions (never polished).
+    serves : str
+        One line on what it takes (sizes, structure).
+    sub_solver : {"none", "optional", "required"}
+        Whether ``"name:SOLVER"`` is accepted.
+    """
+
+    name: str
+    module: str
+    requires: str
+    install: str
+    forms: tuple[str, ...]
+    exact: bool
+    serves: str
+    sub_solver: str = "none"
+
+    @property
+    def installed(self) -> bool:
+        return _importable(self.requires)
+
+
+REGISTRY: dict[str, Backend] = {b.name: b for b in (
+    Backend("kernel", "kernel", "numpy", "numpy", ("impulse",), True,
+            "prepared active-set kernel: dense impulse form, at most 10 contacts"),
+    Backend("isotonic", "isotonic", "scipy", "scipy", ("velocity",), True,
+            "weighted isotonic regression: velocity form of 1-D chains, O(N)"),
+    Backend("exact", "exact", "numpy", "numpy", FORMS, True,
+            "active-set enumeration, at most 14 constraints: the reference"),
+    Backend("nnls", "nnls_", "scipy", "scipy", ("impulse",), True,
+            "scipy NNLS on the Cholesky-scaled impulse form: dense, at most 400 contacts"),
+    Backend("clarabel", "clarabel_", "clarabel", "clarabel", FORMS, False,
+            "Clarabel's own API (interior point), sparse"),
+    Backend("osqp", "osqp_", "osqp", "osqp", FORMS, False, "OSQP (operator splitting), sparse"),
+    Backend("cvxpy", "cvxpy_", "cvxpy", "cvxpy", FORMS, False,
+            "any solver installed for cvxpy ('cvxpy:SOLVER'; default Clarabel)",
+            sub_solver="optional"),
+    Backend("qpsolvers", "qpsolvers_", "qpsolvers", "qpsolvers (pip install 'impactqp[solvers]' "
+            "adds daqp, piqp, ecos, quadprog)", FORMS, False,
+            "any solver installed for qpsolvers ('qpsolvers:NAME', e.g. daqp, piqp, highs)",
+            sub_solver="required"),
+)}
+
+QP_BACKENDS = tuple(REGISTRY)
+
+#: how each solver (qpsolvers or cvxpy name, lower case) spells its stopping tolerances
+TOLERANCE_OPTIONS: dict[str, tuple[str, ...]] = {
+    "clarabel": ("tol_gap_abs", "tol_gap_rel", "tol_feas"),
+    "osqp": ("eps_abs", "eps_rel"),
+    "piqp": ("eps_abs", "eps_rel"),
+    "proxqp": ("eps_abs", "eps_rel"),
+    "scs": ("eps_abs", "eps_rel"),
+    "ecos": ("abstol", "reltol", "feastol"),
+}
+
+
+def tolerance_options(solver: str | None, tol: float) -> dict[str, float]:
+    """Keyword arguments that set every stopping tolerance of ``solver`` to ``tol``
+    (empty for solvers without one, such as the active-set solver daqp)."""
+    return {name: tol for name in TOLERANCE_OPTIONS.get((solver or "").lower(), ())}
+
+
+@cache
+def _importable(package: str) -> bool:
+    return importlib.util.find_spec(package) is not None
+
+
+def parse_backend(name: object) -> tuple[Backend, str | None]:
+    """The registry entry of ``"family"`` or ``"family:solver"`` and the sub-solver name.
+
+    Raises
+    ------
+    UnknownBackendError
+        For a name impactqp does not know (the message lists the known ones).
+    """
+    if not isinstance(name, str):
+        raise UnknownBackendError(f"backend must be a string, got {type(name).__name__}")
+    family, _, sub = name.partition(":")
+    family = family.strip().lower()
+    entry = REGISTRY.get(family)
+    if entry is None:
+        raise UnknownBackendError(
+            f"unknown backend {name!r}; choose one of 'auto', "
+            + ", ".join(repr(k) for k in REGISTRY) + " (or 'cvxpy:SOLVER', 'qpsolvers:NAME')")
+    sub = sub.strip() or None
+    if sub and entry.sub_solver == "none":
+        raise UnknownBackendError(f"backend {family!r} takes no sub-solver, got {name!r}")
+    if not sub and entry.sub_solver == "required":
+        raise UnknownBackendError(f"backend {family!r} needs a solver name, e.g. "
+                                  f"'{family}:daqp'")
+    return entry, sub
+
+
+def load(entry: Backend) -> ModuleType:
+    """Import a backend's module.
+
+    Raises
+    ------
+    UnknownBackendError
+        When the solver it wraps is not installed (the message says what to install).
+    """
+    try:
+        return importlib.import_module(f".{entry.module}", __name__)
+    except ImportError as exc:  # a missing optional solver must not break impactqp
+        raise UnknownBackendError(f"backend {entry.name!r} is not installed ({exc}); "
+                                  f"install {entry.install}") from exc
+
+
+def unsuitable(entry: Backend, qp: QuadraticProgram, form: str) -> str | None:
+    """Why ``entry`` cannot solve ``qp`` (a program of ``form``), or None when it can."""
+    if form not in entry.forms:
+        return f"{entry.name!r} does not solve the {form} form (it serves: {entry.serves})"
+    module = load(entry)
+    check = getattr(module, "unsuitable", None)
+    return None if check is None else check(qp)
+
+
+def check_suitable(entry: Backend, qp: QuadraticProgram, form: str) -> None:
+    """Raise BackendUnsuitableError naming why ``entry`` cannot take ``qp``."""
+    reason = unsuitable(entry, qp, form)
+    if reason is not None:
+        raise BackendUnsuitableError(reason)
+
+
+def available_backends() -> list[dict]:
+    """Every registered backend with what it serves and whether it is installed.
+
+    Returns
+    -------
+    list of dict
+        Keys ``name``, ``installed``, ``forms``, ``exact``, ``serves``, ``install``.
+    """
+    return [{"name": b.name, "installed": b.installed, "forms": b.forms, "exact": b.exact,
+             "serves": b.serves, "install": b.install} for b in REGISTRY.values()]

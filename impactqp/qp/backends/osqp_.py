@@ -1,0 +1,32 @@
+"""OSQP (operator splitting): l ≤ Ax ≤ u with u = +∞; OSQP's y is ≤ 0 on active lower bounds.
+
+OSQP's own polishing prints to stdout; impactqp polishes every answer itself instead
+(:mod:`impactqp.polish`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import osqp
+import scipy.sparse as sp
+
+from ...errors import SolverError
+from ..program import QPSolution, QuadraticProgram
+
+
+def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
+    P = sp.triu(sp.csc_matrix(qp.P), format="csc")
+    A = sp.csc_matrix(qp.constraint_matrix())
+    upper = np.full(qp.n_constraints, np.inf)
+    prob = osqp.OSQP()
+    try:
+        prob.setup(P, np.asarray(qp.c, float), A, qp.constraint_rhs(), upper, verbose=False,
+                   eps_abs=tol, eps_rel=tol, max_iter=200000, polishing=False)
+        res = prob.solve()
+    except Exception as exc:
+        raise SolverError(f"osqp failed: {exc}") from exc
+    status = str(res.info.status)
+    if res.x is None or "solved" not in status.lower() or "unsolved" in status.lower():
+        raise SolverError(f"osqp ended with status {status!r}")
+    return QPSolution(x=np.array(res.x), y=-np.array(res.y), status=status, backend="osqp",
+                      iterations=int(res.info.iter))

@@ -1,0 +1,67 @@
+"""Which Frémond matrices keep u⁺ in S? A sampled map over a 2-parameter family (§3).
+
+Frémond's law ``0 ≤ Λ ⟂ γ⁺ + Eγ⁻ ≥ 0`` is not guaranteed to land in S (§3); this module
+scans a grid of matrices E(a, b) and reports, for each, whether every sampled u⁻ gives an
+admissible u⁺ (kinematic, kinetic and energetic residuals within the tolerance).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ..laws.functions import fremond
+from ..model.problem import ImpactProblem
+from .sampled import DEFAULT_TOL, admissibility_residuals, sample_u_minus
+
+FAMILIES = ("symmetric", "triangular")
+
+
+def fremond_matrix(a: float, b: float, m: int, family: str = "symmetric") -> np.ndarray:
+    """E(a, b) of size m: ``"symmetric"`` aI + b(J − I) (for m = 2, [[a, b], [b, a]]);
+    ``"triangular"`` aI + b·(ones above the diagonal) (for m = 2, [[a, b], [0, a]])."""
+    if family not in FAMILIES:
+        raise InputError(f"family must be one of {FAMILIES}, got {family!r}")
+    off = np.ones((m, m)) - np.eye(m) if family == "symmetric" else np.triu(np.ones((m, m)), 1)
+    return a * np.eye(m) + b * off
+
+
+def fremond_admissibility_map(problem: ImpactProblem, a_values: Any, b_values: Any,
+                              samples: int = 200, seed: int = 0, *,
+                              family: str = "symmetric", consistent_only: bool = True,
+                              tol: float = DEFAULT_TOL) -> np.ndarray:
+    """Boolean grid: ``out[i, j]`` is True when E(a_values[i], b_values[j]) keeps u⁺ ∈ S
+    for every sampled u⁻.
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        Supplies M and W.
+    a_values, b_values : 1-D array_like
+        Grid of the two parameters of :func:`fremond_matrix`.
+    samples, seed : int
+        The same seeded u⁻ are used for every cell.
+    family : {"symmetric", "triangular"}
+    consistent_only : bool
+        Sample only γ⁻ ≤ 0 (default), where Moreau's E = εI is known to be admissible.
+    tol : float
+        Tolerance on the dimensionless residuals of the membership test.
+    """
+    a_values = np.atleast_1d(np.asarray(a_values, dtype=float))
+    b_values = np.atleast_1d(np.asarray(b_values, dtype=float))
+    if a_values.ndim != 1 or b_values.ndim != 1:
+        raise InputError("a_values and b_values must be 1-D")
+    m = problem.n_contacts
+    if family not in FAMILIES:
+        raise InputError(f"family must be one of {FAMILIES}, got {family!r}")
+    u_minus = sample_u_minus(problem, samples, np.random.default_rng(seed),
+                             consistent_only=consistent_only)
+    out = np.zeros((a_values.size, b_values.size), dtype=bool)
+    for i, a in enumerate(a_values):
+        for j, b in enumerate(b_values):
+            E = fremond_matrix(a, b, m, family)
+            _, res = admissibility_residuals(lambda q, E=E: fremond(q, E), problem, u_minus)
+            out[i, j] = bool(np.all(res <= tol))  # NaN (the law failed) counts as not in S
+    return out

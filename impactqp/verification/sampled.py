@@ -1,0 +1,168 @@
+"""A verifier for any impact law: is u⁺ in S (§2), is the law non-expansive (§6)?
+
+A law is sampled: pre-impact velocities u⁻ are drawn (seeded) for the M and W of a problem,
+the law is run on each, and every answer is checked for the three conditions of S
+(kinematic γ⁺ ≥ 0, kinetic u⁺ − u⁻ ∈ N, energetic T⁺ ≤ T⁻) by the exact membership test of
+:class:`~impactqp.admissible.AdmissibleSet`. Maximal monotonicity is equivalent to
+non-expansiveness of u⁻ ↦ u⁺ in the metric M (§6); its evidence is checked on every pair of
+samples. A piecewise-linear law (a :class:`~impactqp.sector.SectorTable`, or any object with
+``cones``, ``G`` and ``W``) is certified exactly instead (§7).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ..base.arrays import as_dense
+from ..errors import ImpactError, InputError, ShapeError
+from ..laws.functions import moreau
+from ..laws.result import ImpactResult
+from ..model.problem import ImpactProblem
+from ..tables.piecewise_table import PiecewiseLinearTable
+from .exact import certify_table_report
+from .report import ADMISSIBILITY, DEFAULT_TOL, Counterexample, LawReport
+
+Law = Callable[[ImpactProblem], Any]
+
+MAX_PAIR_SAMPLES = 1500
+"""Non-expansiveness is checked on all pairs of at most this many samples (memory ~ k²)."""
+
+
+# --------------------------------------------------------------------------- sampling
+def sample_u_minus(problem: ImpactProblem, samples: int, rng: np.random.Generator, *,
+                   consistent_only: bool = False) -> np.ndarray:
+    """Draw u⁻ isotropic in the metric M, or (``consistent_only``) with γ⁻ = Wᵀu⁻ ≤ 0.
+
+    Consistent samples: with independent W (G invertible) γ⁻ = −|Wᵀv'| is drawn from the
+    folded normal of covariance G and u⁻ = v + M⁻¹WG⁻¹(γ⁻ − Wᵀv) keeps an isotropic part in
+    ker Wᵀ; with redundant contacts u⁻ = −prox_{T_C}(v) (§1), which lies in −T_C.
+    """
+    st = problem.structure
+    W = as_dense(st.W)
+    L = np.linalg.cholesky(as_dense(st.M)) if st.sparse else st.cholesky_factor
+
+    def isotropic() -> np.ndarray:  # uᵀMu = ξᵀξ
+        return np.linalg.solve(L.T, rng.standard_normal((st.n, samples))).T
+
+    v = isotropic()
+    if not consistent_only or st.m == 0:
+        return v
+    if np.linalg.matrix_rank(W) == st.m:
+        gamma = -np.abs(isotropic() @ W)
+        lift = as_dense(st.Minv_W) @ np.linalg.inv(as_dense(st.delassus))
+        return v + (gamma - v @ W) @ lift.T
+    return np.array([-moreau(problem.with_u_minus(x), eps=0.0).u_plus for x in v])
+
+
+def run_law(law: Law, problem: ImpactProblem) -> np.ndarray:
+    """u⁺ of ``law`` on ``problem``: from an ImpactResult or an array of shape (n,)."""
+    out = law(problem)
+    u = out.u_plus if isinstance(out, ImpactResult) else np.asarray(out, dtype=float)
+    if u.shape != (problem.n_dof,):
+        raise ShapeError(f"the law must return an ImpactResult or u_plus of shape "
+                         f"({problem.n_dof},), got {u.shape}")
+    return u
+
+
+def admissibility_residuals(law: Law, problem: ImpactProblem,
+                            u_minus: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Run ``law`` from every row of ``u_minus``; return u⁺ (k × n) and the residuals
+    (k × 3: kinematic, kinetic, energetic) of the exact test u⁺ ∈ S. A law that raises an
+    ImpactError gets u⁺ = NaN and residuals NaN."""
+    u_plus = np.full_like(u_minus, np.nan)
+    res = np.full((len(u_minus), 3), np.nan)
+    for i, u in enumerate(u_minus):
+        q = problem.with_u_minus(u)
+        try:
+            u_plus[i] = run_law(law, q)
+        except ShapeError:
+            raise
+        except ImpactError:
+            continue
+        m = q.admissible_set().contains(u_plus[i])
+        res[i] = m.kinematic, m.kinetic, m.energetic
+    return u_plus, res
+
+
+def _pair_expansion(M: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Relative expansion ‖Δu⁺‖/‖Δu⁻‖ − 1 of every pair i < j among the first
+    :data:`MAX_PAIR_SAMPLES` finite rows, and the pair indices (p × 2)."""
+    keep = np.flatnonzero(np.all(np.isfinite(u_plus), axis=1))[:MAX_PAIR_SAMPLES]
+    i, j = np.triu_indices(len(keep), k=1)
+    i, j = keep[i], keep[j]
+
+    def dist(u: np.ndarray) -> np.ndarray:
+        gram = u @ M @ u.T
+        d2 = np.diag(gram)[i] + np.diag(gram)[j] - 2 * gram[i, j]
+        return np.sqrt(np.maximum(d2, 0.0))
+
+    before, after = dist(u_minus), dist(u_plus)
+    scale = max(float(before.max(initial=0.0)), 1e-300)
+    return (after - before) / np.maximum(before, 1e-12 * scale), np.stack([i, j], axis=1)
+
+
+# --------------------------------------------------------------------------- entry point
+def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 1000,
+               seed: int = 0, consistent_only: bool = False, *,
+               tol: float = DEFAULT_TOL) -> LawReport:
+    """Check an impact law against S (§2) and for non-expansiveness (§6).
+
+    Parameters
+    ----------
+    law : callable or SectorTable
+        ``law(problem)`` returns an :class:`ImpactResult` or u⁺ as an (n,) array. A
+        piecewise-linear law (``cones`` with ``rays``, ``Q``, ``label``; ``G``; ``W``) is
+        certified exactly by :func:`~impactqp.sector_certificate.certify_sector_table`.
+    problem : ImpactProblem
+        Supplies M and W (its u⁻ is not used); not needed for an exact certificate.
+    samples : int
+        Number of pre-impact velocities.
+    seed : int
+        Seed of the sampling.
+    consistent_only : bool
+        Sample only kinematically consistent u⁻ (γ⁻ ≤ 0).
+    tol : float
+        Tolerance on the dimensionless residuals.
+
+    Returns
+    -------
+    LawReport
+    """
+    if isinstance(law, PiecewiseLinearTable) or (hasattr(law, "cones") and hasattr(law, "G")):
+        return certify_table_report(law, tol=tol)
+    if not callable(law):
+        raise InputError(f"law must be callable or a piecewise-linear table, got "
+                         f"{type(law).__name__}")
+    if not isinstance(problem, ImpactProblem):
+        raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
+    if not isinstance(samples, (int, np.integer)) or samples < 2:
+        raise InputError(f"samples must be an integer ≥ 2, got {samples!r}")
+    rng = np.random.default_rng(seed)
+    u_minus = sample_u_minus(problem, samples, rng, consistent_only=consistent_only)
+    u_plus, res = admissibility_residuals(law, problem, u_minus)
+    st = problem.structure
+    expansion, pairs = _pair_expansion(as_dense(st.M), u_minus, u_plus)
+
+    failed = np.isnan(res[:, 0])
+    violations = {name: int(np.sum(res[:, k] > tol)) for k, name in enumerate(ADMISSIBILITY)}
+    violations["non_expansive"] = int(np.sum(expansion > tol))
+    violations["law_error"] = int(failed.sum())
+    found: dict[str, Counterexample] = {}
+    for k, name in enumerate(ADMISSIBILITY):
+        if violations[name]:
+            i = int(np.nanargmax(res[:, k]))
+            found[name] = Counterexample(u_minus[i], u_plus[i], name, float(res[i, k]))
+    if violations["non_expansive"]:
+        a, b = pairs[int(np.argmax(expansion))]
+        found["non_expansive"] = Counterexample(u_minus[[a, b]], u_plus[[a, b]],
+                                                "non_expansive", float(expansion.max()))
+    if violations["law_error"]:
+        i = int(np.flatnonzero(failed)[0])
+        found["law_error"] = Counterexample(u_minus[i], u_plus[i], "law_error", float("inf"))
+    return LawReport(ok=not any(violations.values()), violations=violations,
+                     counterexamples=found, samples=int(samples), pairs=len(pairs),
+                     method="sampled")
