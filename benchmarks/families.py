@@ -206,7 +206,8 @@ def attach_reference(case: Case) -> None:
         case.extra["sorted"] = np.sort(rows, axis=1)
         case.ref_label = "exact (sampled rows); sort for the sector law"
     elif case.family == "cradle":
-        case.reference = np.full(p.n_dof, 1.0 / p.n_dof)  # ε = 0: all balls at v/N (§5)
+        # ε = 0: all balls at v/N (docs/theory.md §5)
+        case.reference = np.full(p.n_dof, 1.0 / p.n_dof)
         case.ref_label = "closed form v/N"
     elif p.chain is not None:
         c = p.chain

@@ -59,7 +59,8 @@ def test_solve_json_flags_override_the_file(capsys, cradle_file, flags, law, u_p
 
 
 def test_solve_reports_inadmissible_newton(capsys, tmp_path):
-    # local Newton is not guaranteed to stay in S (§3): here kinetic energy grows from 1 to 4/3
+    # local Newton is not guaranteed to stay in S (docs/theory.md §3): here kinetic energy grows
+    # from 1 to 4/3
     p = iq.chain([1.0, 1.0, 1.0], [1.0, -1.0, 0.0])
     path = iq.save_problem(p, tmp_path / "n.json", law="newton", coefficients=[1.0, 0.0])
     code, out, _ = run(capsys, "solve", path, "--json")

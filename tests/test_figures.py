@@ -51,7 +51,8 @@ def test_S_polygon_vertices_are_in_S_and_the_region_is_right(cradle):
     p, pic = cradle
     S = p.admissible_set()
     assert all(S.contains(u) for u in pic.lift(pic.admissible))
-    # the S region of §5 is the circular sector between Moreau's half-line and the T_C face
+    # the S region of docs/theory.md §5 is the circular sector between Moreau's half-line and the
+    # T_C face
     # through the sector point: area (60° / 360°) π r²
     x, y = pic.admissible.T
     area = 0.5 * abs(x @ np.roll(y, 1) - y @ np.roll(x, 1))

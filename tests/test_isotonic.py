@@ -36,7 +36,8 @@ def qp_reference(m, u, left, right):
 
 
 def check_kkt(m, u, eps, left, right, s: ChainSolution, tol=1e-10):
-    """§1/§3 conditions: impact equation, Λ >= 0, γ⁺+εγ⁻ >= 0, complementarity, energy."""
+    """docs/theory.md §1/docs/theory.md §3 conditions: impact equation, Λ >= 0, γ⁺+εγ⁻ >= 0,
+    complementarity, energy."""
     W = chain_W(len(m), left, right)
     scale = 1.0 + np.max(np.abs(m * u))
     lam, w = s.impulses, W.T @ s.u_plus + eps * (W.T @ u)
@@ -52,7 +53,7 @@ def check_kkt(m, u, eps, left, right, s: ChainSolution, tol=1e-10):
 
 @pytest.mark.parametrize("v", [1.0, -2.5, 3.0])
 def test_cradle_reference_numbers(v):
-    # §5, equal masses m = 2 scale Λ by m
+    # docs/theory.md §5, equal masses m = 2 scale Λ by m
     s0 = chain_moreau([2.0, 2.0, 2.0], [v, 0.0, 0.0], 0.0)
     s1 = chain_moreau([2.0, 2.0, 2.0], [v, 0.0, 0.0], 1.0)
     if v > 0:
@@ -91,7 +92,8 @@ def test_walls_vs_qp(left, right, seed):
 
 
 def test_clip_claim_is_the_bounded_regression():
-    """The clip of the unbounded isotonic regression equals the QP with a wall (§3)."""
+    """The clip of the unbounded isotonic regression equals the QP with a wall (docs/theory.md
+    §3)."""
     rng = np.random.default_rng(42)
     for _ in range(40):
         n = int(rng.integers(2, 12))

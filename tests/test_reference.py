@@ -1,4 +1,4 @@
-"""Reference numbers of the 3-ball cradle (impact-geometry.md §5) on every backend and form."""
+"""Reference numbers of the 3-ball cradle (docs/theory.md §5) on every backend and form."""
 
 import numpy as np
 import pytest
@@ -11,7 +11,8 @@ BACKENDS = ["auto", "exact", "nnls", "clarabel", "osqp", "cvxpy", "cvxpy:CLARABE
 
 def expected(eps, v=1.0, m=1.0):
     """u⁺ and Λ of Moreau's law on the 3-ball cradle, by linear interpolation along the
-    half-line u⁺ = (1+ε)z − εu⁻ between the ε = 0 and ε = 1 reference points of §5."""
+    half-line u⁺ = (1+ε)z − εu⁻ between the ε = 0 and ε = 1 reference points of docs/theory.md
+    §5."""
     u0, l0 = np.array([v / 3, v / 3, v / 3]), np.array([2 * m * v / 3, m * v / 3])
     u1, l1 = np.array([-v / 3, 2 * v / 3, 2 * v / 3]), np.array([4 * m * v / 3, 2 * m * v / 3])
     return u0 + eps * (u1 - u0), l0 + eps * (l1 - l0)

@@ -1,4 +1,4 @@
-"""The reflection law of chains with contact angles π/k (impact-geometry.md §1, §2, §6, §7)."""
+"""The reflection law of chains with contact angles π/k (docs/theory.md §1, §2, §6, §7)."""
 
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ M4, M6 = iq.continuous_mass_ratios(4), iq.continuous_mass_ratios(6)
 
 def path_masses(ks: tuple[int, ...], x2: float) -> np.ndarray:
     """Masses of a free chain with angles π/k_i: 1/m₁ = 1, 1/m₂ = x2, then each next inverse
-    mass solves cos²(π/k)(x_{i}+x_{i+1})(x_{i+1}+x_{i+2}) = x_{i+1}² (§1)."""
+    mass solves cos²(π/k)(x_{i}+x_{i+1})(x_{i+1}+x_{i+2}) = x_{i+1}² (docs/theory.md §1)."""
     x = [1.0, x2]
     for k in ks:
         a, b = x[-2], x[-1]
@@ -51,7 +51,7 @@ def samples(p: iq.ImpactProblem, k: int) -> np.ndarray:
 
 # --------------------------------------------------------------------------- geometry
 def test_one_collision_is_the_textbook_elastic_collision() -> None:
-    """The reflection u − 2(γ/G₁₁)M⁻¹w of §1 is the two-body elastic collision."""
+    """The reflection u − 2(γ/G₁₁)M⁻¹w of docs/theory.md §1 is the two-body elastic collision."""
     for m1, m2, v1, v2 in RNG.uniform(0.2, 3.0, size=(20, 4)):
         u, lam, n = elastic_collisions(problem(np.array([m1, m2]), [v1, -v2]))
         assert n == 1 and lam[0] > 0

@@ -1,4 +1,4 @@
-"""Tests of the N-ball sector law (impact-geometry.md §5–§7)."""
+"""Tests of the N-ball sector law (docs/theory.md §5–§7)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""The sector law as an impact law, checked against the admissible set S (§2, §4, §6)."""
+"""The sector law as an impact law, checked against the admissible set S (docs/theory.md §2, §4,
+§6)."""
 
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ def lift(gamma: np.ndarray) -> np.ndarray:
 def test_classic_cradle() -> None:
     r = iq.sector_law(iq.newtons_cradle(3, v=2.0))
     np.testing.assert_allclose(r.u_plus, [0, 0, 2])
-    np.testing.assert_allclose(r.impulses, [2, 2])  # Λ = (mv, mv), §5
+    np.testing.assert_allclose(r.impulses, [2, 2])  # Λ = (mv, mv), docs/theory.md §5
     assert (r.law, r.backend, r.coefficients) == ("sector", "sort", None)
     assert r.certificate.ok and "ok" in r.certificate.summary()
     assert r.classification.alpha_deg == pytest.approx(30.0, abs=1e-9)
@@ -145,7 +146,7 @@ def test_sector_velocity_is_in_S_in_every_cone(n: int, per_cone: int,
         assert c.dissipation == pytest.approx(1.0, abs=1e-9), label
         # α < 90°: ⟨u⁺ − u⁻, −z⊥⟩ = ⟨u⁺, −z⊥⟩ + ‖z⊥‖² ≥ ‖z⊥‖² as u⁺ ∈ T_C and −z⊥ ∈ N
         assert 0.0 <= c.alpha_deg < 90.0
-        if n == 3:  # §5: 30° is the largest deviation three equal balls can show
+        if n == 3:  # docs/theory.md §5: 30° is the largest deviation three equal balls can show
             assert c.alpha_deg <= 30.0 + 1e-6, (label, u, c.alpha_deg)
 
 
@@ -153,7 +154,7 @@ def test_sector_velocity_is_in_S_in_every_cone(n: int, per_cone: int,
 def test_single_ball_cradle_angle(n: int) -> None:
     """(v, 0, …, 0) ↦ (0, …, 0, v): z = (v/n, …), so cos α = √(n / (2(n − 1))).
 
-    30° for three balls, 35.26° for four, → 45° for many: the 30° bound of §5 is a
+    30° for three balls, 35.26° for four, → 45° for many: the 30° bound of docs/theory.md §5 is a
     three-ball fact.
     """
     r = iq.sector_law(iq.newtons_cradle(n))
@@ -164,7 +165,7 @@ def test_single_ball_cradle_angle(n: int) -> None:
 
 def test_three_ball_angle_on_inconsistent_cones() -> None:
     """Contact 2 separates (γ⁻₂ > 0) in both cases, and sort(u⁻) is still in S."""
-    # Moreau's z closes both contacts (z = (½, ½, ½)): the full 30° of §5
+    # Moreau's z closes both contacts (z = (½, ½, ½)): the full 30° of docs/theory.md §5
     p = iq.chain(np.ones(3), [1.0, 0.0, 0.5])
     r = iq.sector_law(p)
     np.testing.assert_array_equal(r.u_plus, [0.0, 0.5, 1.0])

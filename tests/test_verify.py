@@ -1,4 +1,4 @@
-"""verify_law and the Frémond admissibility map (§2, §3, §6, §7)."""
+"""verify_law and the Frémond admissibility map (docs/theory.md §2, §3, §6, §7)."""
 
 from __future__ import annotations
 
@@ -107,7 +107,7 @@ def test_fremond_map_cells() -> None:
     b = [-0.5, 0.0, 0.5]
     grid = iq.fremond_admissibility_map(CRADLE, a, b, samples=60, seed=0)
     assert grid.shape == (3, 3) and grid.dtype == bool
-    # b = 0: E = aI is Moreau's law, in S for every consistent u⁻ (§3)
+    # b = 0: E = aI is Moreau's law, in S for every consistent u⁻ (docs/theory.md §3)
     assert grid[:, 1].all()
     # b < 0 lets a contact stay penetrating: classic cradle, a = 0, b = −½ ends with γ⁺₂ = −½
     r = iq.fremond(CRADLE, [[0.0, -0.5], [-0.5, 0.0]])

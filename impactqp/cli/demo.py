@@ -1,4 +1,5 @@
-"""The main job: Newton's cradle through Moreau's law, verified and classified (§5)."""
+"""The main job: Newton's cradle through Moreau's law, verified and classified (docs/theory.md
+§5)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ def _vec(a: np.ndarray) -> str:
 
 
 def cradle_rows(n_balls: int = 3, v: float = 1.0, backend: str = "auto") -> list[dict]:
-    """Solve the cradle with Moreau ε = 0 and ε = 1 and check the observed outcome (§5).
+    """Solve the cradle with Moreau ε = 0 and ε = 1 and check the observed outcome (docs/theory.md
+    §5).
 
     Returns one row per post-impact velocity: the two Moreau points and the velocity of the
     real cradle (the last ball leaves at v), each with its classification and verdict.

@@ -1,7 +1,8 @@
 """Reports of a solved impact and of a verdict on a candidate u⁺, as plain data and as text.
 
 The command line prints these; ``--json`` prints the data itself. Numbers that are undefined
-(e.g. the angle α when there is no impact, §4) are NaN in the data and ``null`` in JSON.
+(e.g. the angle α when there is no impact, docs/theory.md §4) are NaN in the data and ``null`` in
+JSON.
 """
 
 from __future__ import annotations
@@ -65,7 +66,8 @@ def vector_text(a: Any, digits: int = 6) -> str:
 
 def membership_report(problem: ImpactProblem, u_plus: np.ndarray, *,
                       optimizer: bool = True) -> dict[str, Any]:
-    """The verdict u⁺ ∈ S (§2): each condition's exact residual, and the optimizer's distance.
+    """The verdict u⁺ ∈ S (docs/theory.md §2): each condition's exact residual, and the optimizer's
+    distance.
 
     The exact test is NNLS plus explicit checks; the optimizer one is the SOCP distance from
     u⁺ to S (:meth:`AdmissibleSet.contains` with ``method="optimizer"``).
@@ -86,7 +88,8 @@ def membership_report(problem: ImpactProblem, u_plus: np.ndarray, *,
 
 
 def solution_report(result: ImpactResult, source: str = "") -> dict[str, Any]:
-    """u⁺, impulses, energies, classification (§4), admissibility (§2) and certificate."""
+    """u⁺, impulses, energies, classification (docs/theory.md §4), admissibility (docs/theory.md
+    §2) and certificate."""
     c = result.classification
     cert = result.certificate
     membership = membership_report(result.problem, result.u_plus, optimizer=False)
@@ -121,7 +124,7 @@ def format_solution(report: dict[str, Any]) -> str:
         f"u⁺         {vector_text(report['u_plus'])}",
         f"impulses Λ {vector_text(report['impulses'])}",
         f"energy     before {e['before']:.6g}, after {e['after']:.6g} (ratio {ratio:.6g})",
-        f"class (§4) α = {c['alpha_deg']:.4g}°, dissipation ε = {c['dissipation']:.4g}, "
+        f"classification: α = {c['alpha_deg']:.4g}°, dissipation ε = {c['dissipation']:.4g}, "
         f"intensity {c['intensity']:.6g}",
         f"admissible (u⁺ ∈ S): {'yes' if a['admissible'] else 'NO'}",
         *_conditions_text(a),

@@ -1,10 +1,12 @@
-"""The data of the figures, without drawing: S in its plane (§2–§5) and the sector cones (§6).
+"""The data of the figures, without drawing: S in its plane (docs/theory.md §2–§5) and the sector
+cones (docs/theory.md §6).
 
 With two independent contacts, ``u⁻ + N`` and hence S lie in the 2-D affine plane
 ``u⁻ + range(M⁻¹W)`` (for the 3-ball cradle: the momentum-conserving velocities
 u₁ + u₂ + u₃ = v). Coordinates in that plane are taken in an M-orthonormal basis, so
-Euclidean lengths and angles of the picture are the kinetic ones of §1: the energy ball
-becomes a true circle and the angle α of §4 is the angle seen on paper.
+Euclidean lengths and angles of the picture are the kinetic ones of docs/theory.md §1: the energy
+ball
+becomes a true circle and the angle α of docs/theory.md §4 is the angle seen on paper.
 Everything here is arrays; :mod:`impactqp.plots` draws them.
 """
 
@@ -27,7 +29,8 @@ MOREAU_EPS = (0.0, 0.5, 1.0)
 
 @dataclass(frozen=True)
 class Candidate:
-    """A post-impact velocity drawn in the plane, with its angle α to Moreau's half-line (§4).
+    """A post-impact velocity drawn in the plane, with its angle α to Moreau's half-line
+    (docs/theory.md §4).
 
     ``arc`` is a circular arc around u⁻ from Moreau's direction to the candidate's.
     """
@@ -40,7 +43,7 @@ class Candidate:
 
 @dataclass(frozen=True)
 class PlanePicture:
-    """S and its ingredients in plane coordinates (§2–§4).
+    """S and its ingredients in plane coordinates (docs/theory.md §2–§4).
 
     A velocity u of the plane is ``origin + basis @ x``; ``origin`` is the point of the plane
     nearest to 0 in the kinetic metric, so the energy sphere cuts the plane in the circle
@@ -98,7 +101,8 @@ def _ray_exit(p: np.ndarray, d: np.ndarray, h: float) -> np.ndarray:
 
 def plane_picture(problem: ImpactProblem, candidates: Mapping[str, ArrayLike] | None = None,
                   *, resolution: int = 360, margin: float = 1.3) -> PlanePicture:
-    """Compute the picture of S (§5 generalised) for a problem with two independent contacts.
+    """Compute the picture of S (docs/theory.md §5 generalised) for a problem with two independent
+    contacts.
 
     Parameters
     ----------
@@ -180,7 +184,8 @@ def plane_picture(problem: ImpactProblem, candidates: Mapping[str, ArrayLike] | 
                         moreau_marks=marks, candidates=drawn)
 
 
-# --- the sector law in the γ plane (§6) ------------------------------------------------------
+# --- the sector law in the γ plane (docs/theory.md §6)
+# ------------------------------------------------------
 @dataclass(frozen=True)
 class Wedge:
     """One cone of the 3-ball sector law, drawn as a circular sector of the γ plane.
@@ -203,7 +208,7 @@ def _matrix_text(Q: np.ndarray) -> str:
 
 def sector_picture(radius: float = 1.0, sample_radius: float = 0.45) -> list[Wedge]:
     """The six cones of the (γ₁⁻, γ₂⁻) plane for three equal balls, each with its Q and
-    one sample point mapped by the law (§6)."""
+    one sample point mapped by the law (docs/theory.md §6)."""
     wedges = []
     for cone in sector_law_table(3).cones:
         r1, r2 = cone.rays

@@ -1,4 +1,5 @@
-"""Figures of S (§2–§5) and of the sector law (§6), drawn from :mod:`impactqp.geometry2d`.
+"""Figures of S (docs/theory.md §2–§5) and of the sector law (docs/theory.md §6), drawn from
+:mod:`impactqp.geometry2d`.
 
 matplotlib is an optional extra (``pip install 'impactqp[plot]'``), imported only here and
 only when a figure is drawn. Figures are built on a bare :class:`matplotlib.figure.Figure`
@@ -50,7 +51,8 @@ def _save(fig: Any, path: str | Path) -> Path:
 
 
 def draw_plane(picture: PlanePicture, ax: Any, title: str = "") -> None:
-    """Draw S, u⁻ + N, T_C, the energy circle, Moreau's half-line and the candidates (§5)."""
+    """Draw S, u⁻ + N, T_C, the energy circle, Moreau's half-line and the candidates
+    (docs/theory.md §5)."""
     from matplotlib.colors import to_rgba
 
     def fill(poly: np.ndarray, color: str, alpha: float, label: str) -> None:
@@ -90,7 +92,8 @@ def draw_plane(picture: PlanePicture, ax: Any, title: str = "") -> None:
 
 
 def draw_sectors(wedges: list[Wedge], ax: Any, radius: float = 1.0) -> None:
-    """Draw the six cones of the γ⁻ plane with their Q and sample points γ⁻ ↦ γ⁺ (§6)."""
+    """Draw the six cones of the γ⁻ plane with their Q and sample points γ⁻ ↦ γ⁺ (docs/theory.md
+    §6)."""
     colors = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown"]
     for wedge, color in zip(wedges, colors):
         ax.fill(wedge.polygon[:, 0], wedge.polygon[:, 1], color=color, alpha=0.18, lw=0)
@@ -123,7 +126,8 @@ def plot_S(problem: ImpactProblem, path: str | Path,
 
 
 def plot_cradle(path: str | Path, v: float = 1.0) -> Path:
-    """Write the picture of §5: the 3-ball cradle's S, Moreau's half-line and the sector-law
+    """Write the picture of docs/theory.md §5: the 3-ball cradle's S, Moreau's half-line and the
+    sector-law
     point (0, 0, v) at α = 30°, in the plane u₁ + u₂ + u₃ = v."""
     p = newtons_cradle(3, v=v)
     return plot_S(p, path, {"sector law u⁺ = (0, 0, v)": sector_velocity_map(p.u_minus)},
@@ -132,7 +136,7 @@ def plot_cradle(path: str | Path, v: float = 1.0) -> Path:
 
 
 def plot_sectors(path: str | Path) -> Path:
-    """Write the figure of the six cones of the 3-ball sector law (§6)."""
+    """Write the figure of the six cones of the 3-ball sector law (docs/theory.md §6)."""
     _format(path)
     fig = _figure()
     draw_sectors(sector_picture(), fig.add_subplot())

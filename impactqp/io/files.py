@@ -1,4 +1,5 @@
-"""Problem files: an impact problem (§1), optionally a law, its coefficients and a candidate u⁺.
+"""Problem files: an impact problem (docs/theory.md §1), optionally a law, its coefficients and a
+candidate u⁺.
 
 One flat schema, stored as JSON or TOML (chosen by the file suffix)::
 
@@ -6,7 +7,7 @@ One flat schema, stored as JSON or TOML (chosen by the file suffix)::
     # either a general problem ...
     M        = [[1.0, 0.0], [0.0, 2.0]]   # (n, n) mass matrix
     W        = [[-1.0], [1.0]]            # (n, m) contact directions
-    # ... or a chain of balls (§5)
+    # ... or a chain of balls (docs/theory.md §5)
     masses     = [1.0, 1.0, 1.0]
     left_wall  = false                    # optional
     right_wall = false                    # optional
@@ -14,7 +15,8 @@ One flat schema, stored as JSON or TOML (chosen by the file suffix)::
     u_minus  = [1.0, 0.0, 0.0]
     # optional
     law      = "moreau"                   # "moreau" | "newton" | "fremond" | "sector"
-    eps      = 0.5                        # moreau (§3); "e" for newton, "E" for fremond
+    eps      = 0.5                        # moreau (docs/theory.md §3); "e" for newton, "E" for
+    fremond
     u_plus   = [0.0, 0.0, 1.0]            # a candidate post-impact velocity
 
 Reading is strict: unknown or duplicate keys, wrong types, ragged or mis-shaped arrays and

@@ -38,7 +38,7 @@ METHODS = ("exact", "optimizer")
 
 @dataclass(frozen=True)
 class Membership:
-    """Verdict on u ∈ S with the residual of each condition (dimensionless, §2).
+    """Verdict on u ∈ S with the residual of each condition (dimensionless, docs/theory.md §2).
 
     Attributes
     ----------
@@ -104,7 +104,7 @@ def _best_impulses_unit(problem: Any, du: np.ndarray) -> tuple[np.ndarray, float
     if not st.sparse:
         lam, res = nnls(st.scaled_W, st.cholesky_factor.T @ du, maxiter=50 * st.m)
         return lam, float(res)
-    # sparse: the normal equations of the NNLS are the LCP 0 ≤ Λ ⟂ GΛ − Wᵀdu ≥ 0 (§3,
+    # sparse: the normal equations of the NNLS are the LCP 0 ≤ Λ ⟂ GΛ − Wᵀdu ≥ 0 (docs/theory.md §3,
     # impulse form); with independent contacts its unconstrained solution often already
     # has Λ ≥ 0 (a chain), otherwise a certified QP backend solves it
     g = st.Wt_times(du)

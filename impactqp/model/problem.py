@@ -81,7 +81,8 @@ class ImpactProblem:
     @cached_property
     def moreau_split(self) -> tuple[np.ndarray, np.ndarray]:
         """(z, z⊥): z = prox_{T_C}(u⁻) in the metric M and z⊥ = u⁻ − z (docs/theory.md §1,
-        §3), by the exact projection of :meth:`AdmissibleSet.moreau_split`; cached."""
+        docs/theory.md §3), by the exact projection of :meth:`AdmissibleSet.moreau_split`;
+        cached."""
         return self.admissible_set().moreau_split()
 
     def admissible_set(self) -> AdmissibleSet:

@@ -24,7 +24,8 @@ from ..errors import MassMatrixError, ShapeError
 
 @dataclass(frozen=True)
 class ChainInfo:
-    """Marks a problem as a 1-D chain (§5): ball masses and the fixed walls, if any."""
+    """Marks a problem as a 1-D chain (docs/theory.md §5): ball masses and the fixed walls, if
+    any."""
 
     masses: np.ndarray
     left_wall: bool = False
@@ -32,7 +33,7 @@ class ChainInfo:
 
 
 class ImpactStructure:
-    """M and W of an impact, validated and factorized once (§1).
+    """M and W of an impact, validated and factorized once (docs/theory.md §1).
 
     Parameters
     ----------
@@ -136,7 +137,7 @@ class ImpactStructure:
         return np.asarray(self.W.T @ U.T).T
 
     def impulse_velocity(self, Lam: np.ndarray) -> np.ndarray:
-        """Velocity jump M⁻¹WΛ of an impulse vector or of every row of Lam (§1)."""
+        """Velocity jump M⁻¹WΛ of an impulse vector or of every row of Lam (docs/theory.md §1)."""
         return np.asarray(self.Minv_W @ Lam.T).T
 
     @cached_property
@@ -160,7 +161,7 @@ class ImpactStructure:
 
     @cached_property
     def delassus(self) -> Matrix:
-        """Delassus matrix G = WᵀM⁻¹W (§1), symmetric positive semidefinite."""
+        """Delassus matrix G = WᵀM⁻¹W (docs/theory.md §1), symmetric positive semidefinite."""
         if self.sparse and self.diagonal_mass:
             G = sp.csc_matrix(self.W.T @ self.Minv_W)
             return (G + G.T) * 0.5

@@ -1,14 +1,16 @@
-"""Exact O(N) Moreau impacts for 1-D chains of balls (impact-geometry.md §1, §3, §5).
+"""Exact O(N) Moreau impacts for 1-D chains of balls (docs/theory.md §1, §3, §5).
 
 A chain of ``N`` balls with masses ``m`` has every neighbour contact closed: gap
 ``g_i = q_{i+1} - q_i``, ``W`` column ``e_{i+1} - e_i``.  Optional fixed walls add the
 columns ``e_1`` (left, gap ``q_1 - wall``) and ``-e_N`` (right, gap ``wall - q_N``).  Contact
 order everywhere: ``[left wall, gaps 1..N-1, right wall]``.
 
-Moreau's projection (§3) ``z = argmin sum_i m_i (v_i - u⁻_i)^2`` s.t. ``Wᵀv >= 0`` is the
+Moreau's projection (docs/theory.md §3) ``z = argmin sum_i m_i (v_i - u⁻_i)^2`` s.t. ``Wᵀv >= 0``
+is the
 weighted isotonic regression of ``u⁻`` (``v_1 <= ... <= v_N``); a wall bound ``v_1 >= 0``
 or ``v_N <= 0`` is applied by clipping the unbounded regression (checked against a QP in
-the tests).  Impulses follow from ``M(u⁺ - u⁻) = WΛ`` (§1) by a cumulative sum anchored at
+the tests).  Impulses follow from ``M(u⁺ - u⁻) = WΛ`` (docs/theory.md §1) by a cumulative sum
+anchored at
 contacts known to be inactive, where ``Λ = 0`` exactly.
 """
 from __future__ import annotations
@@ -23,7 +25,7 @@ __all__ = ["ChainSolution", "chain_moreau", "chain_moreau_batch"]
 
 @dataclass(frozen=True)
 class ChainSolution:
-    """Result of a chain impact (§3).
+    """Result of a chain impact (docs/theory.md §3).
 
     Attributes
     ----------
@@ -118,7 +120,7 @@ def _finish(m, u, z, eps, left: bool, right: bool) -> ChainSolution:
     # L[:, j] is the impulse of the contact left of ball j (j = 0: left wall, j = n: right
     # wall); m_j (z_j - u_j) = L_j - L_{j+1}, so L_j = L_a + C_a - C_j for any anchor a,
     # where C_j = sum_{i<j} m_i (z_i - u_i).  Anchors have L_a = 0: absent walls and
-    # inactive contacts (z strictly separating), per complementarity (§3).
+    # inactive contacts (z strictly separating), per complementarity (docs/theory.md §3).
     c = np.zeros((k, n + 1))
     c[:, 1:] = _prefix_sums(m * (z - u))
     if left and right:
@@ -149,7 +151,8 @@ def _finish(m, u, z, eps, left: bool, right: bool) -> ChainSolution:
 def chain_moreau(
     masses, u_minus, eps: float = 0.0, *, left_wall: bool = False, right_wall: bool = False
 ) -> ChainSolution:
-    """Moreau impact (§3) of a chain of balls with all contacts closed, exact in O(N).
+    """Moreau impact (docs/theory.md §3) of a chain of balls with all contacts closed, exact in
+    O(N).
 
     Parameters
     ----------
@@ -172,14 +175,14 @@ def chain_moreau(
     -----
     ``z`` is the mass-weighted isotonic regression of ``u⁻`` (PAVA, O(N)), clipped at 0 on
     a wall side; ``u⁺ = (1+ε) z - ε u⁻`` and ``Λ = (1+ε) Λ_z`` with ``M(z - u⁻) = W Λ_z``
-    (§1, §3).  With one or no wall ``W`` has full column rank and ``Λ`` is unique.  With
-    both walls ``z = 0`` and the valid impulses (``Λ >= 0``, complementary with
+    (docs/theory.md §1, §3).  With one or no wall ``W`` has full column rank and ``Λ`` is
+    unique.  With both walls ``z = 0`` and the valid impulses (``Λ >= 0``, complementary with
     ``γ⁺ + εγ⁻``) form the half-line ``Λ_min + t (1, ..., 1)``, ``t >= 0``; the one returned
     is ``Λ_min``, the componentwise least, hence the least in max-norm (and every norm).
 
     Examples
     --------
-    >>> chain_moreau([1.0, 1.0, 1.0], [3.0, 0.0, 0.0]).u_plus  # §5, ε = 0
+    >>> chain_moreau([1.0, 1.0, 1.0], [3.0, 0.0, 0.0]).u_plus  # docs/theory.md §5, ε = 0
     array([1., 1., 1.])
     """
     m, u, e = _check(masses, u_minus, eps, 1)
@@ -197,7 +200,8 @@ def chain_moreau_batch(
     right_wall: bool = False,
     pava_max_n: int = 64,
 ) -> ChainSolution:
-    """Moreau impacts (§3) of k chains sharing ``masses``, one per row of ``U_minus``.
+    """Moreau impacts (docs/theory.md §3) of k chains sharing ``masses``, one per row of
+    ``U_minus``.
 
     Parameters
     ----------

@@ -1,11 +1,11 @@
-"""Exact certificate of a piecewise-linear impact law on simplicial cones (§7).
+"""Exact certificate of a piecewise-linear impact law on simplicial cones (docs/theory.md §7).
 
 Works on any object shaped like :class:`impactqp.sector.SectorTable` (``cones`` with
 ``rays``/``Q``/``label``, ``G``, ``W``, ``mass``), or with a mass matrix ``M`` instead of
 ``mass`` (unequal masses, :mod:`impactqp.reflection_table`).  Every check is vectorised over
 the cones, so the 40 320 cones of eight balls are certified in seconds.
 
-Checks (impact-geometry.md §7, §6):
+Checks (docs/theory.md §7, §6):
 
 * kinematic   ``Q r_k ≥ 0`` for every extreme ray;
 * kinetic     ``G⁻¹(Q − I) r_k ≥ 0`` (the impulse Λ is compressive);
@@ -16,7 +16,7 @@ Checks (impact-geometry.md §7, §6):
   velocity map ``A = I + M⁻¹WG⁻¹(Q − I)Wᵀ``.
 
 A continuous piecewise-linear map whose pieces are non-expansive is non-expansive,
-which for impact laws is maximal monotonicity (§6).
+which for impact laws is maximal monotonicity (docs/theory.md §6).
 """
 
 from __future__ import annotations
@@ -36,7 +36,8 @@ TOL = 1e-12
 
 @dataclass(frozen=True)
 class ConeCheck:
-    """§7 results for one cone; margins are minima (≥ 0 passes) or maxima (≤ 1 passes)."""
+    """docs/theory.md §7 results for one cone; margins are minima (≥ 0 passes) or maxima (≤ 1
+    passes)."""
 
     label: str
     kinematic_margin: float  # min_k min_i (Q r_k)_i
@@ -70,7 +71,7 @@ class CheckResult:
 
 @dataclass(frozen=True)
 class SectorCertificate:
-    """Exact §7 certificate of a sector table.
+    """Exact docs/theory.md §7 certificate of a sector table.
 
     ``maximal_monotone`` is True iff the law is continuous across every pair of
     neighbouring cones and every piece is non-expansive in ``G⁻¹`` and in ``M``;
@@ -92,7 +93,8 @@ class SectorCertificate:
 
     @property
     def admissible(self) -> bool:
-        """Kinematically, kinetically and energetically consistent on every cone (§2)."""
+        """Kinematically, kinetically and energetically consistent on every cone (docs/theory.md
+        §2)."""
         return self.kinematic.passed and self.kinetic.passed and self.energetic.passed
 
     @property
@@ -103,8 +105,8 @@ class SectorCertificate:
 
     def summary(self) -> str:
         """Plain-text summary, one line per check."""
-        head = (f"Certificate (§7), {self.n_balls} balls, {self.n_cones} cones, "
-                f"{self.n_neighbour_pairs} neighbour pairs:")
+        head = (f"Exact certificate of the piecewise-linear law, {self.n_balls} balls, "
+                f"{self.n_cones} cones, {self.n_neighbour_pairs} neighbour pairs:")
         verdict = f"  maximal monotone: {self.maximal_monotone} — {self.reason}"
         return "\n".join([head, *(c.line() for c in self.checks), verdict])
 
@@ -155,7 +157,8 @@ def _lambda_max(A: FloatArray, B: FloatArray) -> FloatArray:
 
 
 def velocity_matrices(Qs: FloatArray, W: FloatArray, G: FloatArray, M: FloatArray) -> FloatArray:
-    """Velocity map of each piece: ``A = I + M⁻¹WG⁻¹(Q − I)Wᵀ`` (§1: Λ = G⁻¹(γ⁺ − γ⁻))."""
+    """Velocity map of each piece: ``A = I + M⁻¹WG⁻¹(Q − I)Wᵀ`` (docs/theory.md §1: Λ = G⁻¹(γ⁺ −
+    γ⁻))."""
     n, m = W.shape
     K = np.linalg.solve(M, W) @ np.linalg.inv(G)
     return np.eye(n) + K @ (Qs - np.eye(m)) @ W.T
@@ -210,7 +213,7 @@ def table_mass_matrix(table: Any) -> FloatArray:
 
 # --------------------------------------------------------------------------- certificate
 def certify_sector_table(table: Any, exact_energy: bool | None = None) -> SectorCertificate:
-    """Run every §7 check on ``table`` (a :class:`~impactqp.sector.SectorTable`).
+    """Run every docs/theory.md §7 check on ``table`` (a :class:`~impactqp.sector.SectorTable`).
 
     Parameters
     ----------
@@ -305,7 +308,7 @@ def certify_sector_table(table: Any, exact_energy: bool | None = None) -> Sector
     else:
         reason = (f"continuous across all {len(pairs)} neighbour pairs and every piece is "
                   "non-expansive in G⁻¹ and M, so the law is non-expansive, hence maximal "
-                  "monotone (§6, §7)")
+                  "monotone")
     for c in (kinematic, kinetic, energetic):
         if not c.passed:
             reason += f"; note: {c.name} consistency fails on cone '{c.worst}'"

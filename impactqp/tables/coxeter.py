@@ -1,7 +1,7 @@
 """Angles of a chain's tangent cone and the reflection (Coxeter) group they generate.
 
 An elastic collision at contact i alone is the M-orthogonal reflection across the facet
-γ_i = 0 of T_C (§1).  Neighbouring facets i, i+1 meet at the dihedral angle
+γ_i = 0 of T_C (docs/theory.md §1).  Neighbouring facets i, i+1 meet at the dihedral angle
 ``θ_i = arccos(−G_{i,i+1}/√(G_ii G_{i+1,i+1}))`` in the kinetic metric; facets further
 apart are orthogonal (G_{i,i+2} = 0).  When every θ_i is π/k_i the reflections generate a
 Coxeter group whose diagram is a path with labels k_i, and T_C (a simplicial cone) is its
@@ -39,7 +39,7 @@ def extended_masses(masses: np.ndarray, left_wall: bool = False,
 
 
 def contact_angles(G: Any) -> np.ndarray:
-    """Dihedral angles θ_i (radians) of T_C between contacts i and i+1 (§1).
+    """Dihedral angles θ_i (radians) of T_C between contacts i and i+1 (docs/theory.md §1).
 
     ``cos θ_i = −G_{i,i+1}/√(G_ii G_{i+1,i+1})``: π minus the angle between the inward
     normals M⁻¹w_i, M⁻¹w_{i+1} of the facets.  For a chain of balls
@@ -103,7 +103,7 @@ def shared_mass(theta: float, m_left: float, m_right: float) -> float:
 
 
 def continuous_mass_ratios(k: int, m1: float = 1.0, m3: float = 1.0) -> np.ndarray:
-    """Masses (m1, m2, m3) of three balls whose contact angle is exactly π/k (§1).
+    """Masses (m1, m2, m3) of three balls whose contact angle is exactly π/k (docs/theory.md §1).
 
     For m1 = m3 = 1: ``cos θ = 1/(1 + m2)``, so ``m2 = 1/cos(π/k) − 1``: 1 for k = 3
     (equal masses), √2 − 1 for k = 4, √5 − 2 for k = 5, 2/√3 − 1 for k = 6.  k = 2 (90°)

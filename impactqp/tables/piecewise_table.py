@@ -1,7 +1,8 @@
-"""What every piecewise-linear impact law table shares: γ⁺ = Q_i γ⁻ on cone i (§6, §7).
+"""What every piecewise-linear impact law table shares: γ⁺ = Q_i γ⁻ on cone i (docs/theory.md §6,
+§7).
 
 A table class provides ``cones`` (each with ``Q``) and ``find_cones``; this mixin adds the
-stacked matrices, evaluation of the map and the exact certificate of §7.
+stacked matrices, evaluation of the map and the exact certificate of docs/theory.md §7.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ class PiecewiseLinearTable:
 
     @cached_property
     def certificate(self) -> SectorCertificate:
-        """The exact §7 certificate of this table (computed once, on first use)."""
+        """The exact docs/theory.md §7 certificate of this table (computed once, on first use)."""
         return certify_sector_table(self)
 
     @cached_property

@@ -12,7 +12,8 @@ exactly one reflecting hyperplane of the group from those separating u from T_C,
 order of collisions stops after the same number of steps at the same velocity: the unique
 point u⁺ of the orbit of u⁻ in T_C.  On the chamber g·T_C the law is the M-orthogonal map
 g⁻¹, so ``u⁻ ↦ u⁺`` is continuous, piecewise linear, energy conserving and non-expansive,
-and u⁺ − u⁻ is a non-negative combination of the M⁻¹w_i: u⁺ ∈ S for every u⁻ (§2, §6).
+and u⁺ − u⁻ is a non-negative combination of the M⁻¹w_i: u⁺ ∈ S for every u⁻ (docs/theory.md §2,
+§6).
 For equal masses (all angles 60°) this is ``sort(u⁻)``, the sector law.
 """
 

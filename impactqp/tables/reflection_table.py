@@ -1,6 +1,6 @@
 """The table of the reflection law: one cone of γ-space per element of the Coxeter group.
 
-In contact velocities γ = Wᵀu (§1) the collision at contact i acts linearly:
+In contact velocities γ = Wᵀu (docs/theory.md §1) the collision at contact i acts linearly:
 ``γ ← S_i γ`` with ``S_i = I − (2/G_ii) G e_i e_iᵀ`` (it sends γ_i to −γ_i), an orthogonal
 map in the metric G⁻¹.  T_C is the first orthant of γ-space.  For a group element
 ``g = s_{i1} ⋯ s_{il}`` with matrix ``A_g = S_{i1} ⋯ S_{il}``, the chamber g·T_C is the cone
@@ -13,7 +13,7 @@ orthant), so on K_g
 The chambers of a finite reflection group tile the space, so the |group| cones cover
 γ-space with disjoint interiors.  The table has the interface of
 :class:`impactqp.sector.SectorTable` and is certified by
-:func:`impactqp.sector_certificate.certify_sector_table` (§7).
+:func:`impactqp.sector_certificate.certify_sector_table` (docs/theory.md §7).
 """
 
 from __future__ import annotations
@@ -63,13 +63,14 @@ class ReflectionCone:
 
 @dataclass(eq=False)
 class ReflectionTable(PiecewiseLinearTable):
-    """All cones of the reflection law of a chain (interface of SectorTable, §6, §7).
+    """All cones of the reflection law of a chain (interface of SectorTable,
+    docs/theory.md §6, §7).
 
     Attributes
     ----------
     cones : list of ReflectionCone
     G, W, M : ndarray
-        Delassus matrix, contact directions and mass matrix (§1).
+        Delassus matrix, contact directions and mass matrix (docs/theory.md §1).
     masses : ndarray
     n_balls : int
     group : ReflectionGroup
@@ -131,7 +132,8 @@ def group_matrices(G: FloatArray, order: int) -> list[tuple[tuple[int, ...], Flo
 
 def reflection_law_table(masses: Any, *, left_wall: bool = False,
                          right_wall: bool = False) -> ReflectionTable:
-    """Enumerate the cones of the reflection law of a chain (angles π/k, §1, §6).
+    """Enumerate the cones of the reflection law of a chain (angles π/k,
+    docs/theory.md §1, §6).
 
     Parameters
     ----------

@@ -1,12 +1,12 @@
 """The Winandy–Leine maximal-monotone sector law for a chain of N equal balls.
 
-Pure numpy core (impact-geometry.md §1, §5, §6).  For equal masses an elastic
+Pure numpy core (docs/theory.md §1, §5, §6).  For equal masses an elastic
 collision of two neighbours swaps their velocities, so the law is
 ``u⁺ = sort(u⁻)`` (ascending).  In gap-velocity coordinates ``γ = Wᵀu`` the law
 is piecewise linear: every ordering π of the velocities is one simplicial cone
 ``K_π = {γ : H_π γ ≥ 0}`` of γ-space (dimension n−1), on which ``γ⁺ = Q_π γ⁻``.
 All matrices are derived from ``W``, a permutation matrix and the cumulative-sum
-lift; none is typed by hand.  The exact certificate (§7) lives in
+lift; none is typed by hand.  The exact certificate (docs/theory.md §7) lives in
 :mod:`impactqp.sector_certificate` and is attached lazily as
 ``SectorTable.certificate``.
 """
@@ -34,7 +34,7 @@ FloatArray = NDArray[np.float64]
 
 # --------------------------------------------------------------------------- matrices
 def chain_matrices(n_balls: int, mass: float = 1.0) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Mass matrix, contact directions and Delassus matrix of a chain (§1, §5).
+    """Mass matrix, contact directions and Delassus matrix of a chain (docs/theory.md §1, §5).
 
     Gaps ``g_i = q_{i+1} − q_i``, so column i of ``W`` is ``∂g_i/∂q = e_{i+1} − e_i``.
 
@@ -68,7 +68,7 @@ def permutation_matrix(permutation: Sequence[int]) -> FloatArray:
 
 
 def cone_inequalities(permutation: Sequence[int]) -> FloatArray:
-    """Matrix ``H`` with ``K_π = {γ : Hγ ≥ 0}`` (§6).
+    """Matrix ``H`` with ``K_π = {γ : Hγ ≥ 0}`` (docs/theory.md §6).
 
     Row k states ``u_{π(k+1)} − u_{π(k)} ≥ 0`` written in gaps:
     ``u_j − u_i = Σ_{l=i}^{j−1} γ_l`` for ``j > i`` (and minus that sum for ``j < i``).
@@ -83,7 +83,7 @@ def cone_inequalities(permutation: Sequence[int]) -> FloatArray:
 
 
 def gamma_map_matrix(permutation: Sequence[int]) -> FloatArray:
-    """``Q_π = Wᵀ P_π R``: the linear piece of the law on ``K_π`` (§6).
+    """``Q_π = Wᵀ P_π R``: the linear piece of the law on ``K_π`` (docs/theory.md §6).
 
     Adding a constant to every velocity commutes with ``P_π`` and is annihilated by
     ``Wᵀ``, so the choice ``u_1 = 0`` in the lift ``R`` does not matter.
@@ -101,7 +101,7 @@ def ordering_label(permutation: Sequence[int]) -> str:
 # --------------------------------------------------------------------------- cones
 @dataclass(frozen=True, eq=False)
 class SectorCone:
-    """One cone ``K_π`` of the sector law and its linear piece (§6).
+    """One cone ``K_π`` of the sector law and its linear piece (docs/theory.md §6).
 
     Attributes
     ----------
@@ -143,17 +143,17 @@ def make_cone(permutation: Sequence[int]) -> SectorCone:
 
 @dataclass(eq=False)
 class SectorTable(PiecewiseLinearTable):
-    """All n! cones of the sector law for ``n_balls`` equal balls (§6).
+    """All n! cones of the sector law for ``n_balls`` equal balls (docs/theory.md §6).
 
     Attributes
     ----------
     cones : list of SectorCone
     G, W : ndarray
-        Delassus matrix and contact directions (§1).
+        Delassus matrix and contact directions (docs/theory.md §1).
     n_balls : int
     mass : float
     certificate : SectorCertificate
-        Exact §7 certificate, computed on first access.
+        Exact docs/theory.md §7 certificate, computed on first access.
     """
 
     cones: list[SectorCone]
@@ -201,7 +201,7 @@ class SectorTable(PiecewiseLinearTable):
 
 
 def sector_law_table(n_balls: int = 3, mass: float = 1.0) -> SectorTable:
-    """Enumerate the n! cones of the sector law for ``n_balls`` equal balls (§6).
+    """Enumerate the n! cones of the sector law for ``n_balls`` equal balls (docs/theory.md §6).
 
     Raises
     ------
@@ -237,7 +237,7 @@ def _all_cones(n: int, W: FloatArray) -> list[SectorCone]:
 
 # --------------------------------------------------------------------------- maps
 def sector_velocity_map(u_minus: ArrayLike) -> FloatArray:
-    """Post-impact velocities of equal balls: ``u⁺ = sort(u⁻)`` ascending (§6).
+    """Post-impact velocities of equal balls: ``u⁺ = sort(u⁻)`` ascending (docs/theory.md §6).
 
     A wave of neighbour swaps (elastic collisions of equal masses) sorts the
     velocities.  Works on the last axis, so a batch (k × n) is mapped row-wise.
@@ -246,7 +246,8 @@ def sector_velocity_map(u_minus: ArrayLike) -> FloatArray:
 
 
 def sector_gamma_map(gamma_minus: ArrayLike) -> FloatArray:
-    """The sector law in gap velocities, for any number of balls, without a table (§6).
+    """The sector law in gap velocities, for any number of balls, without a table (docs/theory.md
+    §6).
 
     Lift γ to velocities by cumulative sum (``u_1 = 0``), sort, take differences:
     O(n log n).  Accepts ``(n−1,)`` or a batch ``(k, n−1)``.
@@ -278,7 +279,7 @@ def format_sector_table(table: SectorTable, include_certificate: bool = True) ->
     """Plain-text table of the sector law: one row per cone (label, rays, Q).
 
     Rays are shown scaled to unit max-norm, matrices with exact fractions.
-    With ``include_certificate`` the §7 certificate summary is appended.
+    With ``include_certificate`` the docs/theory.md §7 certificate summary is appended.
     """
     rows = [(c.label, " ".join(_fmt_ray(r) for r in c.rays), _fmt_matrix(c.Q))
             for c in table.cones]

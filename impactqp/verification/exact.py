@@ -1,6 +1,6 @@
-"""Exact verification of a piecewise-linear impact law on a chain (§7).
+"""Exact verification of a piecewise-linear impact law on a chain (docs/theory.md §7).
 
-The §7 certificate decides every condition on every cone; this module turns it into a
+The docs/theory.md §7 certificate decides every condition on every cone; this module turns it into a
 :class:`~impactqp.verify.LawReport` and, for each failed condition, looks for a concrete
 counterexample on the worst cone (its rays, its centroid and seeded interior directions),
 measured by the same residuals as the sampling verifier so that it can be rechecked.
@@ -28,7 +28,7 @@ def _candidates(cone: Any, rng: np.random.Generator) -> np.ndarray:
 
 
 def _velocities(table: Any, cone: Any, gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A u⁻ with Wᵀu⁻ = γ⁻ (least squares) and u⁺ = u⁻ + M⁻¹WG⁻¹(Q − I)γ⁻ (§1)."""
+    """A u⁻ with Wᵀu⁻ = γ⁻ (least squares) and u⁺ = u⁻ + M⁻¹WG⁻¹(Q − I)γ⁻ (docs/theory.md §1)."""
     W = np.asarray(table.W, dtype=float)
     u_minus = np.linalg.lstsq(W.T, gamma, rcond=None)[0]
     impulses = np.linalg.solve(table.G, cone.Q @ gamma - gamma)
@@ -55,7 +55,7 @@ def _counterexample(table: Any, base: ImpactProblem, cone: Any, condition: str,
 
 
 def certify_table_report(table: Any, *, tol: float, seed: int = 0) -> LawReport:
-    """Exact :class:`LawReport` of a piecewise-linear law (§7).
+    """Exact :class:`LawReport` of a piecewise-linear law (docs/theory.md §7).
 
     ``violations`` counts failing cones per condition (``"non_expansive"``: pieces that
     expand the G⁻¹ or the M norm; ``"continuity"``: 1 when some neighbours disagree).

@@ -1,6 +1,7 @@
-"""Which Frémond matrices keep u⁺ in S? A sampled map over a 2-parameter family (§3).
+"""Which Frémond matrices keep u⁺ in S? A sampled map over a 2-parameter family (docs/theory.md §3).
 
-Frémond's law ``0 ≤ Λ ⟂ γ⁺ + Eγ⁻ ≥ 0`` is not guaranteed to land in S (§3); this module
+Frémond's law ``0 ≤ Λ ⟂ γ⁺ + Eγ⁻ ≥ 0`` is not guaranteed to land in S (docs/theory.md §3); this
+module
 scans a grid of matrices E(a, b) and reports, for each, whether every sampled u⁻ gives an
 admissible u⁺ (kinematic, kinetic and energetic residuals within the tolerance).
 """

@@ -50,7 +50,7 @@ class LawReport:
     method : str
         ``"sampled"`` or ``"exact"``.
     certificate : SectorCertificate or None
-        The §7 certificate when ``method == "exact"``.
+        The docs/theory.md §7 certificate when ``method == "exact"``.
     """
 
     ok: bool

@@ -1,12 +1,14 @@
-"""A verifier for any impact law: is u⁺ in S (§2), is the law non-expansive (§6)?
+"""A verifier for any impact law: is u⁺ in S (docs/theory.md §2), is the law non-expansive
+(docs/theory.md §6)?
 
 A law is sampled: pre-impact velocities u⁻ are drawn (seeded) for the M and W of a problem,
 the law is run on each, and every answer is checked for the three conditions of S
 (kinematic γ⁺ ≥ 0, kinetic u⁺ − u⁻ ∈ N, energetic T⁺ ≤ T⁻) by the exact membership test of
 :class:`~impactqp.admissible.AdmissibleSet`. Maximal monotonicity is equivalent to
-non-expansiveness of u⁻ ↦ u⁺ in the metric M (§6); its evidence is checked on every pair of
+non-expansiveness of u⁻ ↦ u⁺ in the metric M (docs/theory.md §6); its evidence is checked on every
+pair of
 samples. A piecewise-linear law (a :class:`~impactqp.sector.SectorTable`, or any object with
-``cones``, ``G`` and ``W``) is certified exactly instead (§7).
+``cones``, ``G`` and ``W``) is certified exactly instead (docs/theory.md §7).
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ def sample_u_minus(problem: ImpactProblem, samples: int, rng: np.random.Generato
 
     Consistent samples: with independent W (G invertible) γ⁻ = −|Wᵀv'| is drawn from the
     folded normal of covariance G and u⁻ = v + M⁻¹WG⁻¹(γ⁻ − Wᵀv) keeps an isotropic part in
-    ker Wᵀ; with redundant contacts u⁻ = −prox_{T_C}(v) (§1), which lies in −T_C.
+    ker Wᵀ; with redundant contacts u⁻ = −prox_{T_C}(v) (docs/theory.md §1), which lies in −T_C.
     """
     st = problem.structure
     W = as_dense(st.W)
@@ -109,7 +111,8 @@ def _pair_expansion(M: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
 def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 1000,
                seed: int = 0, consistent_only: bool = False, *,
                tol: float = DEFAULT_TOL) -> LawReport:
-    """Check an impact law against S (§2) and for non-expansiveness (§6).
+    """Check an impact law against S (docs/theory.md §2) and for non-expansiveness (docs/theory.md
+    §6).
 
     Parameters
     ----------

@@ -1,4 +1,5 @@
-"""``impactqp plot cradle|sectors|S FILE``: the figures of §5 and §6 as PNG or SVG.
+"""``impactqp plot cradle|sectors|S FILE``: the figures of docs/theory.md §5 and docs/theory.md §6
+as PNG or SVG.
 
 Needs the optional extra ``plot`` (matplotlib).
 """
@@ -43,11 +44,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("plot", help="figures of S and of the sector law (PNG or SVG)")
     which = p.add_subparsers(dest="figure", required=True)
     cradle = which.add_parser("cradle", help="S of the 3-ball cradle with Moreau's half-line "
-                                             "and the sector-law point (§5)")
+                                             "and the sector-law point")
     cradle.add_argument("--v", type=float, default=1.0, help="speed of the released ball")
     cradle.add_argument("--out", default="cradle.png", help="output .png or .svg")
     cradle.set_defaults(func=run_cradle)
-    sectors = which.add_parser("sectors", help="the six cones of the 3-ball sector law (§6)")
+    sectors = which.add_parser("sectors", help="the six cones of the 3-ball sector law")
     sectors.add_argument("--out", default="sectors.png", help="output .png or .svg")
     sectors.set_defaults(func=run_sectors)
     s = which.add_parser("S", help="S of a problem file with two independent contacts")

@@ -1,4 +1,5 @@
-"""``impactqp sector-law``: the sector law's cone table and its exact certificate (§6, §7)."""
+"""``impactqp sector-law``: the sector law's cone table and its exact certificate (docs/theory.md
+§6, §7)."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """``impactqp solve FILE``: apply an impact law to a problem file and report the result.
 
 The law and its coefficients come from the file unless ``--law`` / ``--eps`` / ``--e`` /
-``--E`` say otherwise. Without any, Moreau's law with ε = 0 is used (§3).
+``--E`` say otherwise. Without any, Moreau's law with ε = 0 is used (docs/theory.md §3).
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ def choose_law(args: argparse.Namespace, content: ProblemFile) -> tuple[str, Any
 
 def solve_law(problem: ImpactProblem, law: str, coefficients: Any,
               backend: str = "auto") -> ImpactResult:
-    """Apply one of the laws of §3 and §6 by name."""
+    """Apply one of the laws of docs/theory.md §3 and docs/theory.md §6 by name."""
     if law == "moreau":
         return moreau(problem, eps=0.0 if coefficients is None else coefficients,
                       backend=backend)

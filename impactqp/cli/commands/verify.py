@@ -1,4 +1,5 @@
-"""``impactqp verify FILE``: is a candidate post-impact velocity admissible (u⁺ ∈ S, §2)?
+"""``impactqp verify FILE``: is a candidate post-impact velocity admissible (u⁺ ∈ S,
+docs/theory.md §2)?
 
 Exit status: 0 admissible, 1 not admissible, 2 bad input.
 """

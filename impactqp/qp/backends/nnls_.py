@@ -1,7 +1,8 @@
 """Exact impulse-form solve by non-negative least squares (scipy.optimize.nnls).
 
 With P = BᵀB and c = Bᵀd,  ½xᵀPx + cᵀx = ½‖Bx + d‖² − ½‖d‖², so the QP over x ≥ 0 is the
-NNLS problem min ‖Bx − (−d)‖, solved exactly by an active-set method (§3, impulse form).
+NNLS problem min ‖Bx − (−d)‖, solved exactly by an active-set method (docs/theory.md §3, impulse
+form).
 """
 
 from __future__ import annotations
