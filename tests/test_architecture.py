@@ -24,7 +24,7 @@ LAYERS = {
     "model": 2,
     "tables": 3,
     "laws": 4,
-    "verification": 5,
+    "verification": 5, "simulation": 5,
     "io": 6, "figures": 6,
     "cli": 7,
     "__init__": 8, "__main__": 8,

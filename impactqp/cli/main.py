@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from importlib.metadata import PackageNotFoundError, version
+
 from ..errors import ImpactError
 from .commands import demo, plot, sector, solve, verify
 
@@ -14,6 +16,11 @@ COMMANDS = [demo, solve, verify, plot, sector]
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="impactqp",
                                      description="Rigid-body impacts as convex programs.")
+    try:
+        installed = version("impactqp")
+    except PackageNotFoundError:
+        installed = "0+unknown"
+    parser.add_argument("--version", action="version", version=f"impactqp {installed}")
     sub = parser.add_subparsers(dest="command", required=True)
     for command in COMMANDS:
         command.register(sub)
