@@ -54,6 +54,19 @@ def finite(name: str, values: np.ndarray) -> None:
                              f"at index {tuple(int(i) for i in bad)}")
 
 
+def _has_flag(value: list | tuple) -> bool:
+    """Whether a nested list holds a boolean (numpy would read True as 1.0)."""
+    stack = [value]
+    while stack:
+        item = stack.pop()
+        for x in item:
+            if isinstance(x, (list, tuple)):
+                stack.append(x)
+            elif isinstance(x, (bool, np.bool_)):
+                return True
+    return False
+
+
 def as_array(name: str, value: Any, *, ndim: int | None = None,
              allow_nonfinite: bool = False) -> np.ndarray:
     """A float ndarray from ``value`` (list, tuple, ndarray), checked for kind and finiteness.
@@ -87,6 +100,8 @@ def as_array(name: str, value: Any, *, ndim: int | None = None,
                for v in np.asarray(value, dtype=object).ravel()):
             raise _kind_error(name, "a mixture of numbers and other values", value)
     _numeric_dtype(name, arr, value)
+    if isinstance(value, (list, tuple)) and _has_flag(value):
+        raise _kind_error(name, "booleans", value)
     arr = np.array(arr, dtype=float)  # a private copy: callers may keep it
     if ndim is not None and arr.ndim != ndim:
         raise ShapeError(f"{name} must have {ndim} dimension{'s' if ndim != 1 else ''}, "

@@ -22,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import nnls
 
-from ..base.arrays import as_vector
+from ..base.arrays import as_vector, check_tol
 from ..base.checks import DEFAULT_TOL, NamedChecks
 from ..errors import InputError
 from ..qp.backends.clarabel_ import run as run_clarabel
@@ -180,9 +180,7 @@ class AdmissibleSet:
         if method not in METHODS:
             raise InputError(f"method must be one of {METHODS}, got {method!r}")
         if tol is not None:
-            tol = float(tol)
-            if not 0.0 < tol < 1.0:
-                raise InputError(f"tol must be a tolerance in (0, 1), got {tol!r}")
+            tol = check_tol(tol)
         st = p.structure
         c = float(np.abs(p.u_minus).max(initial=0.0))
         if c == 0.0:  # S = {0}: decided exactly

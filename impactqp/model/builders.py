@@ -125,9 +125,29 @@ def random_impact(n_dof: int, n_contacts: int, *, seed: int | np.random.Generato
     consistent : bool
         When True, u⁻ approaches every contact (γ⁻ ≤ 0); otherwise γ⁻ has both signs.
     condition : float
-        Condition number of the random SPD mass matrix.
+        Condition number of the random SPD mass matrix, ≥ 1.
+
+    Returns
+    -------
+    ImpactProblem
+
+    Raises
+    ------
+    InputError
+        Sizes that are not whole numbers, ``redundant`` not below ``n_contacts``, a
+        condition number below 1, a seed numpy cannot use.
     """
-    rng = np.random.default_rng(seed)
+    n_dof = as_count("n_dof", n_dof, minimum=1)
+    n_contacts = as_count("n_contacts", n_contacts)
+    redundant = as_count("redundant", redundant)
+    if n_contacts and redundant >= n_contacts:
+        raise InputError(f"redundant must be below n_contacts = {n_contacts}, got {redundant}")
+    condition = as_real("condition", condition, low=1.0)
+    consistent = as_flag("consistent", consistent)
+    try:
+        rng = np.random.default_rng(seed)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"seed must be an integer or a numpy Generator: {exc}") from None
     Q, _ = np.linalg.qr(rng.standard_normal((n_dof, n_dof)))
     M = Q @ np.diag(np.geomspace(1.0, condition, n_dof)) @ Q.T
     M = 0.5 * (M + M.T)

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..base.arrays import as_vector
+from ..errors import InputError
 from .admissible import best_impulses
 from .problem import ImpactProblem
 
@@ -62,6 +63,8 @@ def classify(problem: ImpactProblem, u_plus: Any) -> Classification:
     u_plus : (n,) array_like
         A post-impact velocity, normally in u⁻ + N.
     """
+    if not isinstance(problem, ImpactProblem):
+        raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
     u = as_vector("u_plus", u_plus, problem.n_dof)
     z, zp = problem.moreau_split
     du = u - problem.u_minus

@@ -4,8 +4,9 @@ The caller hands a list of :class:`Candidate` (backend, form, program, and ``fin
 caller's recovery of its answer from a :class:`~impactqp.qp.program.QPSolution` together
 with its certificate). ``"auto"`` builds that list from the registry; a named backend is
 one candidate. Iterative answers are polished (docs/theory.md §9) and retried once with a
-tighter tolerance; a failed certificate never becomes a success. This layer knows nothing
-of impacts: the certificate is whatever ``finish`` returns.
+tighter tolerance; a failed certificate never becomes a success. Every backend sees the
+program normalized to order one (:mod:`.scaling`), so answers do not depend on units. This
+layer knows nothing of impacts: the certificate is whatever ``finish`` returns.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from . import backends
 from .backends.exact import MAX_CONSTRAINTS
 from .polish import polish
 from .program import QPSolution, QuadraticProgram
+from .scaling import normalize
 
 Finish = Callable[[QPSolution], tuple[Any, ResidualChecks]]
 
@@ -84,7 +86,9 @@ def plan(programs: dict[str, QuadraticProgram], finishers: dict[str, Finish],
     """Candidates for the programs of each form (in order of preference).
 
     ``backend="auto"`` interleaves the auto order of each form (one candidate per backend,
-    on the first form it suits); a named backend takes the first form it suits.
+    on the first form it suits); a named backend is tried on every form it suits, the
+    preferred one first (quadprog, say, refuses the singular impulse form of redundant
+    contacts and solves their velocity form).
 
     Raises
     ------
@@ -105,13 +109,16 @@ def plan(programs: dict[str, QuadraticProgram], finishers: dict[str, Finish],
                 out.append(Candidate(name, form, programs[form], finishers[form]))
         return out
     entry, _ = backends.parse_backend(backend)
-    reasons = []
-    for form, qp in programs.items():
+    reasons, out = [], []
+    for form, qp in programs.items():  # every form it suits, preferred first
         reason = backends.unsuitable(entry, qp, form)
         if reason is None:
-            return [Candidate(backend, form, qp, finishers[form])]
-        reasons.append(reason)
-    raise BackendUnsuitableError("; ".join(dict.fromkeys(reasons)))
+            out.append(Candidate(backend, form, qp, finishers[form]))
+        else:
+            reasons.append(reason)
+    if not out:
+        raise BackendUnsuitableError("; ".join(dict.fromkeys(reasons)))
+    return out
 
 
 def lcp_feasible(qp: QuadraticProgram) -> bool:
@@ -148,9 +155,10 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
                 raise
             log.append(f"{cand.backend}: not installed")
             continue
+        unit, scaling = normalize(cand.program)
         for attempt_tol in ((tol,) if entry.exact else (tol, tol * 1e-2)):
             try:
-                sol = module.solve(cand.program, tol=attempt_tol, solver=sub)
+                sol_unit = module.solve(unit, tol=attempt_tol, solver=sub)
             except (BackendUnsuitableError, UnknownBackendError) as exc:
                 if named:
                     raise
@@ -162,15 +170,16 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
                 if entry.exact:
                     break
                 continue
+            sol = scaling.solution(sol_unit)
             answer, cert = cand.finish(sol)
             if not entry.exact:
                 # iterative answers stop at a tolerance: solve their active set exactly and
                 # keep that when its certificate is at least as good. Small residuals do not
                 # mean accurate velocities on ill-conditioned impacts (a 10⁵-ball chain
                 # passes at 1e-9 with velocities off by 1e-6), so this is always tried.
-                polished = polish(cand.program, sol)
+                polished = polish(unit, sol_unit)
                 if polished is not None:
-                    answer_p, cert_p = cand.finish(polished)
+                    answer_p, cert_p = cand.finish(scaling.solution(polished))
                     if _better(cert_p, cert):
                         log.append(f"{sol.backend}+polish ({cand.form}): certified")
                         return Outcome(answer_p, cert_p, f"{sol.backend}+polish", cand.form,
@@ -182,7 +191,7 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
             log.append(f"{cand.backend} ({cand.form}, tol {attempt_tol:.0e}): certificate "
                        f"failed, {name} = {value:.1e}")
     impulse = [c.program for c in candidates if c.program.nonnegative]
-    if impulse and not lcp_feasible(impulse[0]):
+    if impulse and not lcp_feasible(normalize(impulse[0])[0]):
         raise NoSolutionError("the LCP 0 ≤ Λ ⟂ GΛ + q ≥ 0 has no feasible point, so the law "
                               "has no solution for this pre-impact velocity")
     raise CertificateError("no backend met the certificate: " + "; ".join(log))
