@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
-
 from importlib.metadata import PackageNotFoundError, version
 
 from ..errors import ImpactError
@@ -27,14 +27,63 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+NUMBER_OPTIONS = ("--u-plus", "--eps", "--e", "--E", "--v", "--mass")
+"""Options whose value may start with a minus sign (``--u-plus -1,0,0``)."""
+
+
+def join_negative_values(argv: list[str]) -> list[str]:
+    """``--u-plus -1,0,0`` as ``--u-plus=-1,0,0``: argparse would read the value as an option."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        token = argv[i]
+        if token in NUMBER_OPTIONS and i + 1 < len(argv) and argv[i + 1].startswith("-") \
+                and len(argv[i + 1]) > 1 and (argv[i + 1][1].isdigit() or argv[i + 1][1] == "."):
+            out.append(f"{token}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(token)
+        i += 1
+    return out
+
+
+def _fail(message: str) -> int:
+    text = " ".join(str(message).split()) or "unknown failure"
+    print(f"impactqp: error: {text}", file=sys.stderr)
+    return 2
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the ``impactqp`` command; return its exit status (2 for bad input)."""
+    """Run the ``impactqp`` command; return its exit status.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The command's own status (``verify``: 0 admissible, 1 not), 2 for any failure:
+        bad input, unreadable or hostile files, unwritable outputs, solver failures. A
+        failure is one line on stderr, never a traceback (set IMPACTQP_DEBUG=1 to see one).
+    """
+    argv = join_negative_values(list(sys.argv[1:] if argv is None else argv))
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args))
     except ImpactError as exc:
-        print(f"impactqp: error: {exc}", file=sys.stderr)
-        return 2
+        return _fail(str(exc))
+    except OSError as exc:  # unwritable --out, vanished files
+        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        return _fail(f"cannot access{where}: {exc.strerror or exc}")
+    except (MemoryError, RecursionError, OverflowError, ValueError) as exc:
+        if os.environ.get("IMPACTQP_DEBUG"):
+            raise
+        return _fail(f"{type(exc).__name__}: {exc}")
+    except KeyboardInterrupt:
+        print("impactqp: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

@@ -15,21 +15,24 @@ One flat schema, stored as JSON or TOML (chosen by the file suffix)::
     u_minus  = [1.0, 0.0, 0.0]
     # optional
     law      = "moreau"                   # "moreau" | "newton" | "fremond" | "sector"
-    eps      = 0.5                        # moreau (docs/theory.md §3); "e" for newton, "E" for
-    fremond
+    eps      = 0.5                        # moreau; "e" for newton, "E" for fremond
     u_plus   = [0.0, 0.0, 1.0]            # a candidate post-impact velocity
 
 Reading is strict: unknown or duplicate keys, wrong types, ragged or mis-shaped arrays and
 non-finite numbers are refused with a :class:`~impactqp.errors.ProblemFileError` that names
-the field. Nothing is evaluated or unpickled; files above :data:`MAX_FILE_BYTES` and
-problems above :data:`MAX_DOF` degrees of freedom are refused before any work is done.
-Writing is in :mod:`impactqp.save`.
+the field. Nothing is evaluated or unpickled. Only regular files are read, at most
+:data:`MAX_FILE_BYTES` of them (a FIFO or a device cannot hang or exhaust memory); numbers
+too large for a float and nesting too deep for the parser are refused; problems above
+:data:`MAX_DOF` degrees of freedom, and general (dense) problems above
+:data:`MAX_DENSE_CONTACTS` contacts, are refused before any work is done. Writing is in
+:mod:`impactqp.io.save`. (Problem structure: docs/theory.md §1, §3, §5.)
 """
 
 from __future__ import annotations
 
 import json
 import math
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -48,6 +51,11 @@ MAX_FILE_BYTES = 10 * 1024 * 1024
 
 MAX_DOF = 10_000
 """Largest number of degrees of freedom (and of contacts) a problem file may declare."""
+
+MAX_DENSE_CONTACTS = 1_000
+"""Largest number of contacts of a general problem in a file: its Delassus matrix is dense
+(m² entries) and every solve costs at least m³, so larger impacts belong in Python with
+scipy.sparse matrices, where the caller decides what is affordable."""
 
 VERSION = 1
 LAWS = ("moreau", "newton", "fremond", "sector")
@@ -127,10 +135,16 @@ def _parse(text: str, fmt: str) -> Any:
 
 def _number(name: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ProblemFileError(f"{name} must be a number, got {type(value).__name__} {value!r}")
-    if not math.isfinite(value):
+        raise ProblemFileError(f"{name} must be a number, got {type(value).__name__} "
+                               f"{str(value)[:40]!r}")
+    try:
+        x = float(value)
+    except OverflowError:
+        raise ProblemFileError(f"{name} is too large for a floating-point number "
+                               f"({len(str(value))} digits)") from None
+    if not math.isfinite(x):
         raise ProblemFileError(f"{name} must be finite, got {value!r}")
-    return float(value)
+    return x
 
 
 def _vector(name: str, value: Any) -> np.ndarray:
@@ -182,7 +196,13 @@ def _problem(data: dict[str, Any]) -> ImpactProblem:
     missing = [k for k in GENERAL_KEYS if k not in data]
     if missing:
         raise ProblemFileError(f"a general problem needs 'M' and 'W'; missing {missing}")
-    return ImpactProblem(_matrix("M", data["M"]), _matrix("W", data["W"]), u_minus)
+    M, W = _matrix("M", data["M"]), _matrix("W", data["W"])
+    if W.ndim == 2 and W.shape[1] > MAX_DENSE_CONTACTS:
+        raise ProblemFileError(f"W has {W.shape[1]} contacts; problem files hold general "
+                               f"problems of at most {MAX_DENSE_CONTACTS} contacts "
+                               "(MAX_DENSE_CONTACTS: the Delassus matrix is dense); build "
+                               "larger impacts in Python with scipy.sparse matrices")
+    return ImpactProblem(M, W, u_minus)
 
 
 def _coefficients(law: str | None, data: dict[str, Any], m: int) -> float | np.ndarray | None:
@@ -235,6 +255,27 @@ def problem_from_dict(data: Any) -> ProblemFile:
     return ProblemFile(problem, law, coefficients, u_plus)
 
 
+def _read_capped(path: Path) -> str:
+    """The text of a regular file of at most MAX_FILE_BYTES, read without following it into
+    a FIFO, a device or a directory."""
+    try:
+        info = path.stat()
+        if not stat.S_ISREG(info.st_mode):
+            raise ProblemFileError(f"{path}: not a regular file")
+        with path.open("rb") as handle:
+            data = handle.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise ProblemFileError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    if len(data) > MAX_FILE_BYTES:
+        raise ProblemFileError(f"{path}: more than the {MAX_FILE_BYTES // 2**20} MB limit of "
+                               "problem files")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ProblemFileError(f"{path}: not UTF-8 text ({exc.reason} at byte "
+                               f"{exc.start})") from None
+
+
 def load_problem(path: str | Path) -> ProblemFile:
     """Read a problem file (``.json`` or ``.toml``).
 
@@ -252,21 +293,18 @@ def load_problem(path: str | Path) -> ProblemFile:
     ProblemFileError
         Unreadable, too large, malformed or invalid; the message names the file and the field.
     """
+    if not isinstance(path, (str, Path)):
+        raise ProblemFileError(f"path must be a str or Path, got {type(path).__name__}")
     path = Path(path)
     fmt = file_format(path)
-    try:
-        size = path.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise ProblemFileError(f"{path}: {size} bytes is more than the "
-                                   f"{MAX_FILE_BYTES // 2**20} MB limit of problem files")
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ProblemFileError(f"{path}: cannot read: {exc}") from exc
+    text = _read_capped(path)
     try:
         parsed = _parse(text, fmt)
     except ProblemFileError:
         raise
-    except ValueError as exc:  # json.JSONDecodeError and tomllib.TOMLDecodeError
+    except RecursionError:
+        raise ProblemFileError(f"{path}: nested too deeply to be a problem file") from None
+    except (ValueError, OverflowError) as exc:  # JSONDecodeError, TOMLDecodeError, big ints
         raise ProblemFileError(f"{path}: not valid {fmt.upper()}: {exc}") from exc
     try:
         content = problem_from_dict(parsed)
