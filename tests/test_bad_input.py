@@ -144,3 +144,11 @@ def test_complex_is_never_truncated() -> None:
     # numpy would keep the real part with a warning; impactqp refuses
     with pytest.raises(iq.InputError, match="complex"):
         iq.ImpactProblem(M3, W3, np.array([1 + 0j, 0, 0]))
+
+
+@pytest.mark.parametrize("backend", ["exact", "qpsolvers:daqp", "qpsolvers:quadprog"])
+def test_dense_backends_refuse_large_sparse_problems(backend: str) -> None:
+    u = np.zeros(5000)
+    u[0] = 1.0
+    with pytest.raises(iq.BackendUnsuitableError, match="dense"):
+        iq.moreau(iq.chain(np.ones(5000), u), 1.0, backend)

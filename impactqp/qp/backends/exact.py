@@ -18,6 +18,9 @@ from ..program import QPSolution, QuadraticProgram
 
 MAX_CONSTRAINTS = 14
 
+MAX_DENSE_VARIABLES = 2_000
+"""Largest sparse program this dense backend converts (a dense P of 32 MB)."""
+
 
 def _nonneg_candidate(P, c, free):
     """x ≥ 0 shape: x_J = 0 on the active set, P_FF x_F = −c_F on the free set F."""
@@ -43,6 +46,9 @@ def _general_candidate(P, c, A, b, active):
 
 
 def unsuitable(qp: QuadraticProgram) -> str | None:
+    if qp.sparse and qp.n_vars > MAX_DENSE_VARIABLES:
+        return (f"'exact' works on dense matrices; {qp.n_vars} variables of a sparse program "
+                f"are more than {MAX_DENSE_VARIABLES}")
     if qp.n_constraints > MAX_CONSTRAINTS:
         return (f"'exact' enumerates 2^r active sets; r = {qp.n_constraints} > "
                 f"{MAX_CONSTRAINTS} constraints is too many")

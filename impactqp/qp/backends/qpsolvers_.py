@@ -6,9 +6,10 @@ import numpy as np
 import qpsolvers
 
 from ...base.arrays import as_dense
-from ...errors import SolverError, UnknownBackendError
+from ...errors import BackendUnsuitableError, SolverError, UnknownBackendError
 from ..program import QPSolution, QuadraticProgram
 from . import tolerance_options
+from .exact import MAX_DENSE_VARIABLES
 
 
 def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
@@ -17,6 +18,10 @@ def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None
                                   f"{', '.join(qpsolvers.available_solvers)} "
                                   "(pip install 'impactqp[solvers]' adds more)")
     sparse_ok = solver in qpsolvers.sparse_solvers
+    if not sparse_ok and qp.sparse and qp.n_vars > MAX_DENSE_VARIABLES:
+        raise BackendUnsuitableError(f"qpsolvers:{solver} works on dense matrices; {qp.n_vars} "
+                                     f"variables of a sparse program are more than "
+                                     f"{MAX_DENSE_VARIABLES} (use a sparse solver such as piqp)")
     P, G = qp.P, -qp.constraint_matrix()
     if not sparse_ok:
         P, G = as_dense(P), as_dense(G)
