@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..base.arrays import as_array
 from ..errors import SectorInputError, SectorTableTooLarge
 from ..model.builders import chain
 from .piecewise_table import PiecewiseLinearTable
@@ -150,7 +151,7 @@ def reflection_law_table(masses: Any, *, left_wall: bool = False,
     SectorTableTooLarge
         When the group has more than ``MAX_TABLE_ORDER`` elements (use reflection_law).
     """
-    masses = np.asarray(masses, dtype=float)
+    masses = as_array("masses", masses, ndim=1)
     p = chain(masses, np.zeros(masses.size), left_wall=left_wall, right_wall=right_wall,
               sparse=False)
     group = check_reflection_problem(p)

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from ..base.arrays import as_array, as_count, check_tol
 from ..errors import InputError
 from ..laws.functions import fremond
 from ..model.problem import ImpactProblem
@@ -50,10 +51,15 @@ def fremond_admissibility_map(problem: ImpactProblem, a_values: Any, b_values: A
     tol : float
         Tolerance on the dimensionless residuals of the membership test.
     """
-    a_values = np.atleast_1d(np.asarray(a_values, dtype=float))
-    b_values = np.atleast_1d(np.asarray(b_values, dtype=float))
+    a_values = np.atleast_1d(as_array("a_values", a_values))
+    b_values = np.atleast_1d(as_array("b_values", b_values))
     if a_values.ndim != 1 or b_values.ndim != 1:
         raise InputError("a_values and b_values must be 1-D")
+    if not isinstance(problem, ImpactProblem):
+        raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
+    samples = as_count("samples", samples, minimum=2)
+    seed = as_count("seed", seed)
+    tol = check_tol(tol)
     m = problem.n_contacts
     if family not in FAMILIES:
         raise InputError(f"family must be one of {FAMILIES}, got {family!r}")
