@@ -12,6 +12,7 @@ layer knows nothing of impacts: the certificate is whatever ``finish`` returns.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -31,7 +32,7 @@ from . import backends
 from .backends.exact import MAX_CONSTRAINTS
 from .polish import polish
 from .program import QPSolution, QuadraticProgram
-from .scaling import normalize
+from .scaling import Scaling, normalize
 
 Finish = Callable[[QPSolution], tuple[Any, ResidualChecks]]
 
@@ -64,7 +65,22 @@ def auto_order(qp: QuadraticProgram, form: str) -> list[str]:
     """The backends ``"auto"`` tries on ``qp``, least overhead and exact first (measured in
     benchmarks/: the kernel and isotonic regression beat every QP solver where they apply;
     NNLS is exact and fastest on dense impulse forms; PIQP is 3–5× faster than Clarabel on
-    sparse impacts of 10⁴ contacts and as accurate after polishing)."""
+    sparse impacts of 10⁴ contacts and as accurate after polishing).
+
+    The order depends on the program's shape only, so it is kept per owner and tag."""
+    if qp.cache_owner is None:
+        return _auto_order(qp, form)
+    per_owner = _ORDERS.setdefault(qp.cache_owner, {})
+    key = (qp.cache_tag, form)
+    if key not in per_owner:
+        per_owner[key] = _auto_order(qp, form)
+    return per_owner[key]
+
+
+_ORDERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _auto_order(qp: QuadraticProgram, form: str) -> list[str]:
     names: list[str] = []
     for name in ("kernel", "isotonic", "nnls"):
         entry = backends.REGISTRY[name]
@@ -155,7 +171,8 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
                 raise
             log.append(f"{cand.backend}: not installed")
             continue
-        unit, scaling = normalize(cand.program)
+        unit, scaling = (cand.program, Scaling(1.0, 1.0)) if entry.scale_free \
+            else normalize(cand.program)
         for attempt_tol in ((tol,) if entry.exact else (tol, tol * 1e-2)):
             try:
                 sol_unit = module.solve(unit, tol=attempt_tol, solver=sub)

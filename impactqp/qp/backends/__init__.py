@@ -46,6 +46,9 @@ class Backend:
         One line on what it takes (sizes, structure).
     sub_solver : {"none", "optional", "required"}
         Whether ``"name:SOLVER"`` is accepted.
+    scale_free : bool
+        Its answer does not depend on the units of the program (relative tolerances only),
+        so it needs no normalization (docs/theory.md §9).
     """
 
     name: str
@@ -56,6 +59,7 @@ class Backend:
     exact: bool
     serves: str
     sub_solver: str = "none"
+    scale_free: bool = False
 
     @property
     def installed(self) -> bool:
@@ -64,9 +68,10 @@ class Backend:
 
 REGISTRY: dict[str, Backend] = {b.name: b for b in (
     Backend("kernel", "kernel", "numpy", "numpy", ("impulse",), True,
-            "prepared active-set kernel: dense impulse form, at most 10 contacts"),
+            "prepared active-set kernel: dense impulse form, at most 10 contacts",
+            scale_free=True),
     Backend("isotonic", "isotonic", "scipy", "scipy", ("velocity",), True,
-            "weighted isotonic regression: velocity form of 1-D chains, O(N)"),
+            "weighted isotonic regression: velocity form of 1-D chains, O(N)", scale_free=True),
     Backend("exact", "exact", "numpy", "numpy", FORMS, True,
             "active-set enumeration, at most 14 constraints: the reference"),
     Backend("nnls", "nnls_", "scipy", "scipy", ("impulse",), True,
@@ -133,6 +138,7 @@ def parse_backend(name: object) -> tuple[Backend, str | None]:
     return entry, sub
 
 
+@cache
 def load(entry: Backend) -> ModuleType:
     """Import a backend's module.
 
