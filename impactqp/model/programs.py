@@ -14,7 +14,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..qp.program import ChainShape, QuadraticProgram
 
@@ -38,7 +37,7 @@ def velocity_program(problem: Any) -> QuadraticProgram:
     """Velocity form min ½‖v − u⁻‖²_M s.t. Wᵀv ≥ 0: its solution is z = prox_{T_C}(u⁻)
     and its multipliers are the impulses Λ_z of M(z − u⁻) = WΛ_z."""
     st = problem.structure
-    A = sp.csc_matrix(st.W.T) if st.sparse else st.W.T
+    A = st.contact_rows
     c = problem.chain
     shape = None if c is None else ChainShape(c.masses, c.left_wall, c.right_wall)
     return QuadraticProgram(P=st.M, c=-st.mass_rows(problem.u_minus), A=A, b=np.zeros(st.m),

@@ -133,12 +133,31 @@ class ImpactStructure:
         return s * np.sqrt(np.maximum(row_sum(self.mass_rows(Y) * Y), 0.0))
 
     def Wt_times(self, U: np.ndarray) -> np.ndarray:
-        """Contact velocities γ = Wᵀu of a vector or of every row of U."""
-        return np.asarray(self.W.T @ U.T).T
+        """Contact velocities γ = Wᵀu of a vector or of every row of U (for a chain, the
+        differences of neighbouring velocities, in O(N) without a matrix)."""
+        c = self.chain
+        if c is None:
+            return np.asarray(self.W.T @ U.T).T
+        parts = [U[..., :1]] if c.left_wall else []
+        parts.append(np.diff(U, axis=-1))
+        if c.right_wall:
+            parts.append(-U[..., -1:])
+        return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=-1)
 
     def impulse_velocity(self, Lam: np.ndarray) -> np.ndarray:
-        """Velocity jump M⁻¹WΛ of an impulse vector or of every row of Lam (docs/theory.md §1)."""
-        return np.asarray(self.Minv_W @ Lam.T).T
+        """Velocity jump M⁻¹WΛ of an impulse vector or of every row of Lam (docs/theory.md §1;
+        for a chain, ball j gets (L_{j−1} − L_j)/m_j from the impulses L on its two sides)."""
+        c = self.chain
+        if c is None:
+            return np.asarray(self.Minv_W @ Lam.T).T
+        pad = [(0, 0)] * (Lam.ndim - 1) + [(0 if c.left_wall else 1, 0 if c.right_wall else 1)]
+        L = np.pad(Lam, pad)
+        return (L[..., :-1] - L[..., 1:]) / c.masses
+
+    @cached_property
+    def contact_rows(self) -> Matrix:
+        """Wᵀ as the constraint rows of the velocity program (CSC when sparse), kept once."""
+        return sp.csc_matrix(self.W.T) if self.sparse else self.W.T
 
     @cached_property
     def cholesky_factor(self) -> np.ndarray:
