@@ -23,9 +23,12 @@ def kinetic_norms(structure: ImpactStructure, X: np.ndarray) -> np.ndarray:
 def normalized_rows(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
     """Divide (u⁻, u⁺, Λ, …), one impact or rows, by the largest entry of each row of u⁻ (the
     first array); where u⁻ = 0, by the largest entry of the others (1 when all are 0).
-    The residuals of docs/theory.md §8 are invariant under this scaling."""
+    The residuals of docs/theory.md §8 are invariant under this scaling, so rows whose
+    scale is between 1e-60 and 1e60 are left as they are."""
     first = arrays[0]
     c = row_max(np.abs(first))
+    if np.all((c > 1e-60) & (c < 1e60)):  # squares in range: the units need no change
+        return arrays
     if np.any(c == 0):
         rest = np.max([row_max(np.abs(a)) if a.shape[-1] else np.zeros(first.shape[:-1])
                        for a in arrays[1:]], axis=0)

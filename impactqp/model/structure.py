@@ -126,7 +126,12 @@ class ImpactStructure:
 
     def kinetic_norms(self, X: np.ndarray) -> np.ndarray:
         """‖x‖ = sqrt(xᵀMx) of a vector or of every row of X, without overflow or underflow
-        (each row is divided by its largest entry before it is squared)."""
+        (each row is divided by its largest entry before it is squared whenever the plain
+        sum of squares would lose range)."""
+        with np.errstate(over="ignore", under="ignore"):
+            q = row_sum(self.mass_rows(X) * X)
+        if np.all(np.isfinite(q)) and np.min(q, initial=np.inf) > 1e-250:
+            return np.sqrt(q)
         s = row_max(np.abs(X))
         safe = np.where(s > 0, s, 1.0)
         Y = X / (safe[..., None] if X.ndim == 2 else safe)
