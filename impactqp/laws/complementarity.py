@@ -107,6 +107,10 @@ class Newton(_ComplementarityLaw):
     def coefficients_for(self, problem: ImpactProblem) -> np.ndarray:
         return self._E(problem.n_contacts)
 
+    def coefficients_for_size(self, m: int) -> list[float]:
+        """The m coefficients eᵢ as Python floats."""
+        return self._E(m).tolist()
+
     def check(self, problem: ImpactProblem) -> None:
         if not self._scalar:
             check_restitution("e", self.e, problem.n_contacts)

@@ -26,6 +26,7 @@ from ..qp import backends
 from ..qp.backends import FORMS
 from ..qp.certified import plan, solve_certified
 from ..qp.program import QPSolution
+from . import small
 from .base import Answer, ImpactLaw
 from .result import ImpactResult
 
@@ -134,6 +135,10 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
                        start, attempts=["no contact or u⁻ = 0: u⁺ = u⁻, Λ = 0"])
     if not law.forms:
         return _closed_form(problem, law, backend, tol, start)
+    if small.applies(problem, law, backend, form):
+        result = small.solve_small(problem, law, tol, start)
+        if result is not None:
+            return result
 
     forms = (form,) if form != "auto" else law.preferred_forms(problem)
     programs = {f: law.program(problem, f) for f in forms}

@@ -11,6 +11,7 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg as sla
@@ -30,6 +31,15 @@ class ChainInfo:
     masses: np.ndarray
     left_wall: bool = False
     right_wall: bool = False
+
+
+class FloatRows(NamedTuple):
+    """Small dense operators as nested tuples of floats (see ImpactStructure.float_rows)."""
+
+    M: tuple[tuple[float, ...], ...]
+    Wt: tuple[tuple[float, ...], ...]
+    Minv_W: tuple[tuple[float, ...], ...]
+    contact_scale: tuple[float, ...]
 
 
 class ImpactStructure:
@@ -158,6 +168,15 @@ class ImpactStructure:
         pad = [(0, 0)] * (Lam.ndim - 1) + [(0 if c.left_wall else 1, 0 if c.right_wall else 1)]
         L = np.pad(Lam, pad)
         return (L[..., :-1] - L[..., 1:]) / c.masses
+
+    @cached_property
+    def float_rows(self) -> FloatRows:
+        """M, Wᵀ, M⁻¹W and the contact scales as tuples of Python floats (dense problems):
+        the operators of single small impacts without array overhead."""
+        def rows(A) -> tuple[tuple[float, ...], ...]:
+            return tuple(map(tuple, as_dense(A).tolist()))
+        return FloatRows(rows(self.M), rows(self.W.T), rows(self.Minv_W),
+                         tuple(self.contact_scale.tolist()))
 
     @cached_property
     def contact_rows(self) -> Matrix:

@@ -53,6 +53,34 @@ class ActiveSetKernel:
         self.supports = supports
         self._last = 0
         self._scale = scale
+        # the same supports on Python floats, for single small impacts (no array overhead)
+        self._float_supports = [(tuple(J.tolist()), tuple(F.tolist()),
+                                 tuple(map(tuple, inv.tolist())), tuple(map(tuple, GFJ.tolist())))
+                                for J, F, inv, GFJ in supports]
+
+    def solve_floats(self, q: list[float], tol: float = _TOL) -> list[float] | None:
+        """:meth:`solve` on Python floats: Λ as a list, or None when no support fits."""
+        qs = max(max(q), -min(q))
+        if min(q) >= 0.0:
+            return [0.0] * self.m
+        lam_tol, w_tol = -tol * qs / self._scale, -tol * qs
+        n_sup = len(self._float_supports)
+        for k in range(n_sup):
+            idx = (self._last + k) % n_sup
+            J, F, inv, GFJ = self._float_supports[idx]
+            qJ = [q[j] for j in J]
+            lam_J = [-sum(a * b for a, b in zip(row, qJ)) for row in inv]
+            if min(lam_J) < lam_tol:
+                continue
+            if F and min(sum(a * b for a, b in zip(row, lam_J)) + q[f]
+                         for row, f in zip(GFJ, F)) < w_tol:
+                continue
+            self._last = idx
+            lam = [0.0] * self.m
+            for j, value in zip(J, lam_J):
+                lam[j] = value if value > 0.0 else 0.0
+            return lam
+        return None
 
     def solve(self, q: np.ndarray, tol: float = _TOL) -> np.ndarray | None:
         """Return Λ solving the LCP, or None when no invertible support fits."""

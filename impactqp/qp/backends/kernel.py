@@ -32,10 +32,15 @@ def prepared(qp: QuadraticProgram) -> ActiveSetKernel:
     """The kernel of ``qp.P``, shared by every program with the same owner and tag."""
     if qp.cache_owner is None:
         return ActiveSetKernel(np.asarray(qp.P, dtype=float))
-    per_owner = _CACHE.setdefault(qp.cache_owner, {})
-    kernel = per_owner.get(qp.cache_tag)
+    return prepared_for(qp.cache_owner, qp.cache_tag, qp.P)
+
+
+def prepared_for(owner: object, tag: str, P: np.ndarray) -> ActiveSetKernel:
+    """The kernel of P kept for (owner, tag): P must be the same matrix at every call."""
+    per_owner = _CACHE.setdefault(owner, {})
+    kernel = per_owner.get(tag)
     if kernel is None:
-        kernel = per_owner[qp.cache_tag] = ActiveSetKernel(np.asarray(qp.P, dtype=float))
+        kernel = per_owner[tag] = ActiveSetKernel(np.asarray(P, dtype=float))
     return kernel
 
 
