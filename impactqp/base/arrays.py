@@ -48,7 +48,7 @@ def _numeric_dtype(name: str, arr: np.ndarray, value: Any) -> None:
 
 def finite(name: str, values: np.ndarray) -> None:
     """Raise NonFiniteError naming the first NaN or infinite entry of ``values``."""
-    if values.size and not np.all(np.isfinite(values)):
+    if values.size and not np.isfinite(values).all():
         bad = np.argwhere(~np.isfinite(values))[0]
         raise NonFiniteError(f"{name} must be finite; found {values[tuple(bad)]} "
                              f"at index {tuple(int(i) for i in bad)}")

@@ -34,9 +34,12 @@ def chain_directions(n_balls: int, *, left_wall: bool = False, right_wall: bool 
             rows.append(np.array([row]))
             cols.append(np.array([col]))
             vals.append(np.array([val]))
-    W = sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                      shape=(n, m))
-    return W if sparse else W.toarray()
+    rows, cols, vals = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+    if sparse:
+        return sp.csc_matrix((vals, (rows, cols)), shape=(n, m))
+    W = np.zeros((n, m))
+    W[rows, cols] = vals
+    return W
 
 
 def chain(masses: Any, u_minus: Any, *, left_wall: bool = False, right_wall: bool = False,
