@@ -31,6 +31,8 @@ class Scaling:
 
     def solution(self, sol: QPSolution) -> QPSolution:
         """A solution of the normalized program as one of the original program."""
+        if self.x_scale == 1.0 and self.y_scale == 1.0:
+            return sol
         return replace(sol, x=sol.x * self.x_scale, y=sol.y * self.y_scale)
 
 
