@@ -174,44 +174,96 @@ def summary_markdown(rows: list[dict], meta: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: the columns of the figure: which method groups share a panel
+PANELS = (("impactqp", ("impactqp", "batch")), ("raw solvers and peers", ("raw", "peer")))
+PALETTE = [*(f"C{i}" for i in range(10)), "black", "darkgoldenrod"]
+MARKERS = "os^vDPX*h<>p"
+LINESTYLES = {"impactqp": "-", "batch": "-", "raw": "--", "peer": ":"}
+REFERENCE = "iq:auto"  # also drawn in the raw-solver panels, for comparison
+
+
+def _size_label(size: float) -> str:
+    """Compact tick label: 3, 50, 1000, 10⁴, 10⁵, 2·10⁵."""
+    if size < 10_000:
+        return f"{size:g}"
+    exponent = int(np.floor(np.log10(size)))
+    mantissa = size / 10**exponent
+    power = f"10$^{{{exponent}}}$"
+    return power if abs(mantissa - 1) < 1e-9 else f"{mantissa:g}·{power}"
+
+
+def _styles(rows: list[dict]) -> dict[str, dict[str, Any]]:
+    """Colour, marker and line style per method, distinct within each panel column."""
+    group_of = {r["method"]: r["group"] for r in rows}
+    styles: dict[str, dict[str, Any]] = {}
+    for _, groups in PANELS:
+        members = [m for m in group_of if group_of[m] in groups]
+        for i, method in enumerate(members):
+            styles[method] = {"color": PALETTE[i % len(PALETTE)],
+                              "marker": MARKERS[i % len(MARKERS)],
+                              "ls": LINESTYLES.get(group_of[method], "-")}
+    return styles
+
+
 def plot(rows: list[dict], path: Path) -> None:
-    """Log-log median time vs size, one panel per family, one line per method."""
+    """Log-log median time vs size: one row per family, impactqp's paths on the left, raw
+    solvers and the Siconos peer on the right (with iq:auto repeated there for comparison);
+    every method has its own colour and marker, ticks only at the measured sizes."""
+    from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
+
     fams = [f for f in SIZE_LABEL if any(r["family"] == f for r in rows)]
-    ncol = min(3, len(fams))
-    nrow = -(-len(fams) // ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(6 * ncol, 4.5 * nrow), squeeze=False)
-    methods = list(dict.fromkeys(r["method"] for r in rows))
-    colors = {m: plt.cm.tab20(i % 20) for i, m in enumerate(methods)}
-    styles = {"impactqp": "-", "raw": "--", "peer": ":", "batch": "-"}
-    for ax, family in zip(axes.flat, fams):
-        for method in methods:
-            pts = sorted((r["size"], r["median_s"], r["success_rate"]) for r in rows
-                         if r["family"] == family and r["method"] == method
-                         and r["median_s"] is not None)
-            if not pts:
+    if not fams:
+        fig = plt.figure(figsize=(6, 1.5))
+        fig.text(0.5, 0.5, "no measurements", ha="center", va="center")
+        fig.savefig(path, dpi=90)
+        plt.close(fig)
+        return
+    styles = _styles(rows)
+    fig, axes = plt.subplots(len(fams), len(PANELS), figsize=(12, 2.9 * len(fams) + 1.6),
+                             squeeze=False, layout="constrained")
+    handles: list[dict[str, Any]] = [{} for _ in PANELS]
+    for row, family in enumerate(fams):
+        fam = [r for r in rows if r["family"] == family and r["median_s"] is not None]
+        sizes = sorted({r["size"] for r in fam})
+        for col, (title, groups) in enumerate(PANELS):
+            ax = axes[row, col]
+            methods = [m for m in dict.fromkeys(r["method"] for r in fam)
+                       if next(r["group"] for r in fam if r["method"] == m) in groups]
+            if not methods:
+                ax.axis("off")
                 continue
-            x, y, ok = zip(*pts)
-            group = next(r["group"] for r in rows if r["method"] == method)
-            ax.plot(x, y, styles.get(group, "-"), color=colors[method], label=method, marker="o",
-                    markersize=3)
-            bad = [(a, b) for a, b, s in pts if s != 1]
-            if bad:
-                ax.plot(*zip(*bad), "x", color=colors[method], markersize=8)
-        ax.set(xscale="log", yscale="log", title=family, xlabel=SIZE_LABEL[family],
-               ylabel="median time [s]")
-        ax.grid(True, which="major", alpha=0.3)
-    for ax in list(axes.flat)[len(fams):]:
-        ax.axis("off")
-    handles, labels = {}, {}
-    for ax in axes.flat:
-        for h, lab in zip(*ax.get_legend_handles_labels()):
-            handles.setdefault(lab, h)
-    labels = list(handles)
-    fig.legend([handles[k] for k in labels], labels, loc="lower center", ncol=6, fontsize=8,
-               frameon=False)
+            if col > 0 and any(r["method"] == REFERENCE for r in fam):
+                methods.append(REFERENCE)
+            for method in methods:
+                pts = sorted((r["size"], r["median_s"], r["success_rate"]) for r in fam
+                             if r["method"] == method)
+                x, y, _ = zip(*pts)
+                style = dict(styles[method])
+                if method == REFERENCE and col > 0:
+                    style.update(lw=2.5, alpha=0.35, ls="-")
+                (line,) = ax.plot(x, y, markersize=4, **style)
+                label = f"{method} (for comparison)" if col > 0 and method == REFERENCE \
+                    else method
+                handles[col].setdefault(label, line)
+                bad = [(a, b) for a, b, s in pts if s != 1]
+                if bad:
+                    ax.plot(*zip(*bad), "x", color=style["color"], markersize=9, mew=1.5)
+            ax.set(xscale="log", yscale="log", ylabel="median time [s]",
+                   title=f"{family}: {title}")
+            ax.xaxis.set_major_locator(FixedLocator(sizes))
+            ax.xaxis.set_minor_locator(NullLocator())
+            ax.xaxis.set_major_formatter(NullFormatter())
+            ax.set_xticks(sizes, [_size_label(s) for s in sizes],
+                          rotation=30 if len(sizes) > 5 else 0)
+            ax.yaxis.set_minor_formatter(NullFormatter())
+            ax.grid(True, which="major", alpha=0.3)
+            ax.set_xlabel(SIZE_LABEL[family])
+    for (title, _), col_handles, loc in zip(PANELS, handles, ("left", "right")):
+        if col_handles:
+            fig.legend(list(col_handles.values()), list(col_handles), loc=f"outside lower {loc}",
+                       ncol=3, fontsize=8, title=title, title_fontsize=9, frameon=False)
     fig.suptitle("Moreau impact: median solve time (× = some runs failed or inaccurate)")
-    fig.tight_layout(rect=(0, 0.03 + 0.012 * (len(labels) // 6 + 1), 1, 0.97))
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=90)
     plt.close(fig)
 
 

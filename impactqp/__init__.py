@@ -13,7 +13,7 @@ conventions are in docs/theory.md of the repository.
 
 from importlib.metadata import PackageNotFoundError, version
 
-from .base.checks import DEFAULT_TOL
+from .base.checks import DEFAULT_TOL, ResidualChecks
 from .errors import (
     BackendUnsuitableError,
     CertificateError,
@@ -73,11 +73,12 @@ __all__ = [
     "InputError", "LCPResult", "LawReport", "MassMatrixError", "Membership", "Moreau",
     "Newton", "NoSolutionError", "NonConvexLCPError", "NonFiniteError", "NonSymmetricLCPError",
     "OptionalDependencyError", "ProblemFile", "ProblemFileError", "ReflectionLaw",
-    "RestitutionError", "SectorCertificate", "SectorCone", "SectorInputError", "SectorLaw",
-    "SectorLawCertificate", "SectorLawError", "SectorTable", "SectorTableTooLarge",
-    "ShapeError", "SolverError", "UnknownBackendError", "available_backends", "chain",
-    "classify", "continuous_mass_ratios", "fremond", "fremond_admissibility_map",
-    "load_problem", "moreau", "moreau_batch", "newton", "newtons_cradle", "random_impact",
-    "reflection_law", "reflection_law_table", "save_problem", "sector_law", "sector_law_batch",
-    "sector_law_table", "solve", "solve_batch", "solve_lcp", "verify_law",
+    "ResidualChecks", "RestitutionError", "SectorCertificate", "SectorCone",
+    "SectorInputError", "SectorLaw", "SectorLawCertificate", "SectorLawError", "SectorTable",
+    "SectorTableTooLarge", "ShapeError", "SolverError", "UnknownBackendError",
+    "available_backends", "chain", "classify", "continuous_mass_ratios", "fremond",
+    "fremond_admissibility_map", "load_problem", "moreau", "moreau_batch", "newton",
+    "newtons_cradle", "random_impact", "reflection_law", "reflection_law_table",
+    "save_problem", "sector_law", "sector_law_batch", "sector_law_table", "solve",
+    "solve_batch", "solve_lcp", "verify_law",
 ]

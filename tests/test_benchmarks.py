@@ -83,3 +83,22 @@ def test_disc_packing_geometry():
     assert abs(W[0::2].sum(axis=0)).max() < 1e-12 and abs(W[1::2].sum(axis=0)).max() < 1e-12
     assert abs((W ** 2).sum(axis=0) - 2.0).max() < 1e-12
     assert (abs(W) > 0).sum(axis=0).max() <= 4
+
+
+def test_progress_bar_stays_out_of_logs(tmp_path, capsys):
+    run_suite("smoke", tmp_path, methods=[], siconos_python="", progress=True)
+    err = capsys.readouterr().err
+    assert "\r" not in err  # stderr is not a terminal here: no bar, no carriage returns
+
+
+def test_plot_keeps_methods_apart(smoke):
+    from benchmarks import report
+
+    rows = report.aggregate(smoke[1])
+    styles = report._styles(rows)
+    for _, groups in report.PANELS:
+        members = [m for m in styles if any(r["method"] == m and r["group"] in groups
+                                            for r in rows)]
+        looks = {(styles[m]["color"], styles[m]["marker"]) for m in members}
+        assert len(looks) == len(members)  # no two methods of a panel look alike
+    assert report._size_label(100_000) == "10$^{5}$" and report._size_label(50) == "50"

@@ -139,10 +139,35 @@ def test_parse_numbers():
 def test_plot_commands(capsys, tmp_path, cradle_file):
     for argv in (["plot", "cradle", "--out", tmp_path / "c.png"],
                  ["plot", "sectors", "--out", tmp_path / "s.svg"],
-                 ["plot", "S", cradle_file, "--out", tmp_path / "S.png"]):
+                 ["plot", "S", cradle_file, "--out", tmp_path / "S.png"],
+                 ["plot", "cradle", "--out", tmp_path / "c.pdf"]):
         code, out, _ = run(capsys, *argv)
         assert code == 0 and out == f"wrote {argv[-1]}\n"
         assert argv[-1].stat().st_size > 5000
+    assert (tmp_path / "c.pdf").read_bytes().startswith(b"%PDF")
+
+
+def test_plot_refuses_to_overwrite_without_force(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, out, _ = run(capsys, "plot", "sectors")  # default output: ./sectors.png
+    assert code == 0 and out == "wrote sectors.png\n"
+    (tmp_path / "sectors.png").write_bytes(b"keep me")
+    code, out, err = run(capsys, "plot", "sectors")
+    assert code == 2 and out == "" and "sectors.png exists" in err and "--force" in err
+    assert (tmp_path / "sectors.png").read_bytes() == b"keep me"
+    code, out, _ = run(capsys, "plot", "sectors", "--force")
+    assert code == 0 and (tmp_path / "sectors.png").read_bytes().startswith(b"\x89PNG")
+    mine = tmp_path / "mine.svg"
+    mine.write_text("mine")
+    code, _, err = run(capsys, "plot", "cradle", "--out", mine)
+    assert code == 2 and "exists" in err and mine.read_text() == "mine"
+
+
+def test_plot_help_documents_the_default(capsys):
+    with pytest.raises(SystemExit):
+        cli.main(["plot", "cradle", "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "default: ./cradle.png" in out and "--force" in out and ".pdf" in out
 
 
 def test_plot_errors_exit_2(capsys, tmp_path, monkeypatch):

@@ -6,7 +6,7 @@ import pytest
 
 import impactqp as iq
 from impactqp.figures.geometry2d import clip, plane_picture, sector_picture
-from impactqp.figures.plots import plot_cradle, plot_S, plot_sectors
+from impactqp.figures.plots import _edges, draw_plane, plot_cradle, plot_S, plot_sectors
 from impactqp.tables.sector_table import sector_law_table
 
 
@@ -95,25 +95,67 @@ def test_clip_half_plane():
 def test_sector_picture_data():
     wedges = sector_picture()
     assert len(wedges) == 6 and len({w.label for w in wedges}) == 6
-    cones = {c.label: c for c in sector_law_table(3).cones}
+    table = sector_law_table(3)
+    cones = {c.label: c for c in table.cones}
     for w in wedges:
         cone = cones[w.label]
-        assert cone.contains(w.sample) and cone.contains(w.anchor)
-        assert all(cone.contains(x) for x in w.polygon)
-        np.testing.assert_allclose(w.image, cone.Q @ w.sample, atol=1e-12)
-        assert np.all(w.image >= -1e-12)
+        np.testing.assert_allclose(w.frame @ w.frame.T, table.G, atol=1e-12)  # G = LLᵀ
+
+        def gamma(y, w=w):
+            return w.frame @ np.asarray(y).T
+
+        assert cone.contains(gamma(w.sample)) and cone.contains(gamma(w.anchor))
+        assert all(cone.contains(gamma(y)) for y in w.polygon)
+        np.testing.assert_allclose(gamma(w.image), cone.Q @ gamma(w.sample), atol=1e-12)
+        assert np.all(gamma(w.image) >= -1e-12)
         assert w.label in w.text and "Q = [" in w.text
+        # G⁻¹-orthonormal coordinates: every cone is 60°, every Q an isometry
+        a, b = w.polygon[1], w.polygon[-1]
+        assert np.degrees(np.arccos(a @ b)) == pytest.approx(60.0)
+        assert np.linalg.norm(w.image) == pytest.approx(np.linalg.norm(w.sample))
+    images = np.array([w.image for w in wedges])
+    assert min(np.linalg.norm(images[i] - images[j]) for i in range(6)
+               for j in range(i)) > 0.02  # no two images drawn on top of each other
+
+
+def test_edges_leave_out_the_view_border():
+    square = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+    assert len(_edges(square, 1.0)) == 0
+    wedge = np.array([[0.0, 0.0], [1.0, -1.0], [1.0, 1.0]])  # one side on the border x = 1
+    path = _edges(wedge, 1.0)
+    segments = [s for s in np.split(path, np.flatnonzero(np.isnan(path[:, 0])))
+                if len(s[~np.isnan(s[:, 0])]) == 2]
+    assert len(segments) == 2
+
+
+def test_legend_shows_the_colours_of_the_regions():
+    from matplotlib.colors import to_rgba
+    from matplotlib.figure import Figure
+
+    ax = Figure().add_subplot()
+    draw_plane(plane_picture(iq.newtons_cradle(3)), ax)
+    fills = {to_rgba(p.get_facecolor()) for p in ax.patches if p.get_fill()}
+    legend = {h.get_label(): h for h in ax.get_legend().legend_handles}
+    for label in ("u⁻ + N", "S"):
+        face = to_rgba(legend[label].get_facecolor())
+        assert face[3] == 1.0 and face in fills  # opaque and the colour drawn
+    tangent = legend["T_C (its trace in the plane)"]
+    assert tangent.get_hatch() and any(p.get_hatch() == tangent.get_hatch() for p in ax.patches)
+    assert all(to_rgba(p.get_facecolor())[3] in (0.0, 1.0) for p in ax.patches)  # no blending
+    assert "M-orthonormal" in ax.get_xlabel() and "M-orthonormal" in ax.get_ylabel()
 
 
 def _check_file(path, fmt):
     data = path.read_bytes()
     if fmt == "png":
         assert data.startswith(b"\x89PNG\r\n\x1a\n") and len(data) > 10_000
+    elif fmt == "pdf":
+        assert data.startswith(b"%PDF") and b"%%EOF" in data[-32:]
     else:
         assert b"<svg" in data[:2000] and data.rstrip().endswith(b"</svg>")
 
 
-@pytest.mark.parametrize("fmt", ["png", "svg"])
+@pytest.mark.parametrize("fmt", ["png", "svg", "pdf"])
 def test_figures_render(tmp_path, fmt):
     _check_file(plot_cradle(tmp_path / f"c.{fmt}"), fmt)
     _check_file(plot_sectors(tmp_path / f"s.{fmt}"), fmt)
@@ -121,7 +163,7 @@ def test_figures_render(tmp_path, fmt):
 
 def test_figure_errors(tmp_path, monkeypatch):
     with pytest.raises(iq.InputError, match="must end in one of"):
-        plot_sectors(tmp_path / "x.pdf")
+        plot_sectors(tmp_path / "x.jpg")
     with pytest.raises(iq.InputError, match="exactly 2 independent"):
         plot_S(iq.newtons_cradle(4), tmp_path / "x.png")
     monkeypatch.setitem(sys.modules, "matplotlib.figure", None)
@@ -135,3 +177,14 @@ def test_committed_figures_are_small():
     for name in ("cradle.png", "sectors.png"):
         data = (root / name).read_bytes()
         assert data.startswith(b"\x89PNG") and len(data) < 200_000
+
+
+def test_sector_axes_name_their_metric():
+    from matplotlib.figure import Figure
+
+    from impactqp.figures.plots import draw_sectors
+
+    ax = Figure().add_subplot()
+    draw_sectors(sector_picture(), ax)
+    assert "G⁻¹-orthonormal" in ax.get_xlabel() and "G⁻¹-orthonormal" in ax.get_ylabel()
+    assert "60°" in ax.get_title()

@@ -135,7 +135,11 @@ def test_save_refuses_what_it_could_not_read(tmp_path):
     assert not (tmp_path / "x.json").exists()
 
 
-def test_toml_writer_formats():
-    text = save.to_toml({"version": 1, "law": "sector", "left_wall": True,
-                          "M": [[1e-300, -2.5e17]]})
-    assert text == 'version = 1\nlaw = "sector"\nleft_wall = true\nM = [[1e-300, -2.5e+17]]\n'
+def test_toml_writer_round_trips_exactly():
+    tomllib = files._toml_module()
+    data = {"version": 1, "law": "sector", "left_wall": True,
+            "M": [[1e-300, -2.5e17], [0.1, 1 / 3]]}
+    text = save.to_toml(data)
+    assert text.startswith('version = 1\nlaw = "sector"\nleft_wall = true\nM = [')
+    back = tomllib.loads(text)
+    assert back == data and all(isinstance(v, float) for row in back["M"] for v in row)

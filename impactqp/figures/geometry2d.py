@@ -1,13 +1,14 @@
-"""The data of the figures, without drawing: S in its plane (docs/theory.md §2–§5) and the sector
-cones (docs/theory.md §6).
+"""The data of the figures, without drawing: S in its plane (docs/theory.md §2–§5) and the
+sector cones (docs/theory.md §6).
 
 With two independent contacts, ``u⁻ + N`` and hence S lie in the 2-D affine plane
 ``u⁻ + range(M⁻¹W)`` (for the 3-ball cradle: the momentum-conserving velocities
 u₁ + u₂ + u₃ = v). Coordinates in that plane are taken in an M-orthonormal basis, so
-Euclidean lengths and angles of the picture are the kinetic ones of docs/theory.md §1: the energy
-ball
-becomes a true circle and the angle α of docs/theory.md §4 is the angle seen on paper.
-Everything here is arrays; :mod:`impactqp.plots` draws them.
+Euclidean lengths and angles of the picture are the kinetic ones of docs/theory.md §1: the
+energy ball becomes a true circle and the angle α of docs/theory.md §4 is the angle seen on
+paper. The sector law's plane of contact velocities γ is drawn likewise in coordinates
+orthonormal for its kinetic metric G⁻¹ (:func:`sector_frame`), where its cones are 60°.
+Everything here is arrays; :mod:`impactqp.figures.plots` draws them.
 """
 
 from __future__ import annotations
@@ -190,7 +191,9 @@ def plane_picture(problem: ImpactProblem, candidates: Mapping[str, ArrayLike] | 
 class Wedge:
     """One cone of the 3-ball sector law, drawn as a circular sector of the γ plane.
 
-    ``sample`` is a γ⁻ inside the cone and ``image`` its γ⁺ = Q γ⁻.
+    All points are in the G⁻¹-orthonormal coordinates y of :func:`sector_picture`
+    (γ = ``frame @ y``); ``sample`` is a γ⁻ inside the cone and ``image`` its
+    γ⁺ = Q γ⁻, both in those coordinates.
     """
 
     label: str
@@ -200,23 +203,72 @@ class Wedge:
     anchor: np.ndarray
     sample: np.ndarray
     image: np.ndarray
+    frame: np.ndarray
 
 
 def _matrix_text(Q: np.ndarray) -> str:
     return "Q = [" + "; ".join(" ".join(f"{v + 0.0:g}" for v in row) for row in Q) + "]"
 
 
+def sector_frame(G: ArrayLike) -> np.ndarray:
+    """The lower Cholesky factor L of the Delassus matrix G = LLᵀ.
+
+    Coordinates y with γ = L y are orthonormal in the metric G⁻¹ of the γ plane
+    (γᵀG⁻¹γ = yᵀy), which is the kinetic metric of the velocities u = M⁻¹WG⁻¹γ: in them
+    the angles of the sector law's cones are the true ones (60° for three equal balls) and
+    every map γ⁻ ↦ Qγ⁻ is an isometry.
+
+    Parameters
+    ----------
+    G : (m, m) array_like
+        Symmetric positive definite.
+
+    Returns
+    -------
+    ndarray
+        L, shape (m, m).
+    """
+    return np.linalg.cholesky(np.asarray(G, dtype=float))
+
+
 def sector_picture(radius: float = 1.0, sample_radius: float = 0.45) -> list[Wedge]:
     """The six cones of the (γ₁⁻, γ₂⁻) plane for three equal balls, each with its Q and
-    one sample point mapped by the law (docs/theory.md §6)."""
+    one sample point mapped by the law (docs/theory.md §6).
+
+    The plane is drawn in G⁻¹-orthonormal coordinates (:func:`sector_frame`), so each cone is
+    a 60° circular sector of radius ``radius`` and every image lies as far from the origin as
+    its sample.
+
+    Parameters
+    ----------
+    radius : float
+        Radius of the drawn sectors.
+    sample_radius : float
+        Typical distance of the sample points from the origin, as a fraction of ``radius``
+        (each cone's sample lies at an angle and a distance of its own, so that no two images
+        coincide).
+
+    Returns
+    -------
+    list of Wedge
+        One per cone, in the order of :func:`~impactqp.sector_law_table`.
+    """
+    table = sector_law_table(3)
+    L = sector_frame(table.G)
+    to_y = np.linalg.inv(L)
     wedges = []
-    for cone in sector_law_table(3).cones:
-        r1, r2 = cone.rays
+    for k, cone in enumerate(table.cones):
+        r1, r2 = (to_y @ r for r in cone.rays)
+        r1, r2 = r1 / np.linalg.norm(r1), r2 / np.linalg.norm(r2)
         mid = (r1 + r2) / np.linalg.norm(r1 + r2)
         polygon = np.vstack([[0.0, 0.0], _arc(np.zeros(2), radius, r1, r2)])
-        sample = sample_radius * radius * mid
+        # each sample at an angle and a radius of its own, so that no two images coincide
+        turn = np.arctan2(r1[0] * r2[1] - r1[1] * r2[0], r1 @ r2)
+        angle = np.arctan2(r1[1], r1[0]) + (k + 0.5) / len(table.cones) * turn
+        sample = sample_radius * radius * (0.75 + 0.1 * k) * np.array([np.cos(angle),
+                                                                      np.sin(angle)])
         wedges.append(Wedge(label=cone.label, Q=cone.Q,
                             text=f"{cone.label}\n{_matrix_text(cone.Q)}", polygon=polygon,
-                            anchor=0.78 * radius * mid, sample=sample,
-                            image=sector_gamma_map(sample)))
+                            anchor=0.72 * radius * mid, sample=sample,
+                            image=to_y @ sector_gamma_map(L @ sample), frame=L))
     return wedges

@@ -1,8 +1,8 @@
-"""Writing problem files in the flat schema of :mod:`impactqp.files` (JSON or TOML).
+"""Writing problem files in the flat schema of :mod:`impactqp.io.files` (JSON or TOML).
 
-TOML is written by the small writer :func:`to_toml` (the schema has only top-level keys with
-numbers, booleans, one string and nested arrays), so writing needs no extra package. Every
-file is validated by :func:`impactqp.files.problem_from_dict` before it is written.
+TOML is written by ``tomli_w`` (floats as their shortest ``repr``, which round-trips
+exactly); JSON by the standard library. Every file is validated by
+:func:`impactqp.io.files.problem_from_dict` before it is written.
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import tomli_w
 
 from ..base.arrays import as_dense
 from ..errors import InputError
@@ -44,20 +45,21 @@ def problem_to_dict(problem: ImpactProblem, *, law: str | None = None, coefficie
     return data
 
 
-def _toml_value(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return repr(float(value)) if isinstance(value, float) else str(value)
-    if isinstance(value, str):
-        return json.dumps(value)  # a TOML basic string
-    return "[" + ", ".join(_toml_value(v) for v in value) + "]"
-
-
 def to_toml(data: dict[str, Any]) -> str:
-    """TOML text of the flat schema: top-level keys with numbers, booleans, strings and
-    (nested) arrays of numbers. Floats are written with ``repr``, which round-trips exactly."""
-    return "".join(f"{key} = {_toml_value(value)}\n" for key, value in data.items())
+    """TOML text of the flat schema (top-level keys with numbers, booleans, strings and
+    nested arrays of numbers), written by ``tomli_w``.
+
+    Parameters
+    ----------
+    data : dict
+        The file content, as returned by :func:`problem_to_dict`.
+
+    Returns
+    -------
+    str
+        TOML text that :func:`impactqp.load_problem` reads back bit-exactly.
+    """
+    return tomli_w.dumps(data)
 
 
 def to_json(data: dict[str, Any]) -> str:

@@ -22,7 +22,17 @@ from ..qp.program import QPSolution, QuadraticProgram
 
 
 class Answer(NamedTuple):
-    """A law's answer: post-impact velocity, impulses and (Moreau's family) the projection z."""
+    """A law's answer: post-impact velocity, impulses and (Moreau's family) the projection z.
+
+    Attributes
+    ----------
+    u_plus : (n,) ndarray
+        Post-impact velocity u⁺.
+    impulses : (m,) ndarray
+        Contact impulses Λ with M(u⁺ − u⁻) = WΛ.
+    z : (n,) ndarray or None
+        z = prox_{T_C}(u⁻) for laws of Moreau's family (docs/theory.md §3), else None.
+    """
 
     u_plus: np.ndarray
     impulses: np.ndarray
@@ -32,8 +42,12 @@ class Answer(NamedTuple):
 class ImpactLaw(ABC):
     """Base class of impact laws.
 
-    Class attributes
-    ----------------
+    A subclass sets the class attributes below, implements :meth:`residuals` and
+    :meth:`certificate`, and either :meth:`program` with :meth:`recover` (a law solved through
+    quadratic programs) or :meth:`closed_form` (``forms = ()``).
+
+    Attributes
+    ----------
     name : str
         Short name (``"moreau"``), stored in :attr:`ImpactResult.law`.
     title : str
@@ -100,7 +114,8 @@ class ImpactLaw(ABC):
     def closed_form_rows(self, problem: ImpactProblem,
                          U_minus: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(U⁺, Λ) of a closed-form law for every row of U_minus."""
-        raise NotImplementedError(f"{self.title} is solved through programs")
+        raise NotImplementedError(f"{self.title} does not evaluate many impacts at once; "
+                                  "define closed_form_rows to use it in a batch")
 
     @abstractmethod
     def residuals(self, structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,

@@ -283,18 +283,11 @@ def sector_law_batch(problem: ImpactProblem, U_minus: Any, *,
     problem : ImpactProblem
         A free chain of equal masses (its own u⁻ is not used).
     U_minus : (k, n) array_like
-    tol : float
-    n_jobs : int
-        Threads working on chunks of rows at once.
-
-    Parameters
-    ----------
-    problem : ImpactProblem
-        A free chain of equal balls (its own u⁻ is not used).
-    U_minus : (k, n) array_like
         One pre-impact velocity per row.
     tol : float
         Tolerance of the recomputed certificates.
+    n_jobs : int
+        Threads working on chunks of rows at once.
 
     Returns
     -------

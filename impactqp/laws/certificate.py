@@ -42,9 +42,9 @@ class Certificate(ResidualChecks):
     law_feasibility : float
         Largest violation of γ⁺ + Eγ⁻ ≥ 0 (scaled).
     complementarity : float
-        max |Λᵢ (γ⁺ + Eγ⁻)ᵢ| / V².
+        max abs(Λᵢ (γ⁺ + Eγ⁻)ᵢ) / V².
     energy_balance : float or None
-        For Moreau's law: |‖u⁺‖² − ‖z‖² − ε²‖z⊥‖²| / V² (docs/theory.md §3), else None.
+        For Moreau's law: abs(‖u⁺‖² − ‖z‖² − ε²‖z⊥‖²) / V² (docs/theory.md §3), else None.
     duality_gap : float or None
         For Moreau's law: (Σᵢ Λᵢ|wᵢ| + ‖u⁺ − u⁻ − M⁻¹WΛ‖²) / V² with w = γ⁺ + εγ⁻, a bound on
         the squared velocity error ‖u⁺ − u⁺_exact‖² / V² (docs/theory.md §3): with Λ* the

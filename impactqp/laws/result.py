@@ -38,6 +38,9 @@ class ImpactResult:
         Recomputed residuals of the law that was solved.
     form : str or None
         ``"velocity"`` or ``"impulse"`` for laws solved through a program.
+    z : (n,) ndarray
+        z = prox_{T_C}(u⁻), the least-energy point of S (docs/theory.md §3); given by laws of
+        Moreau's family, computed on first access otherwise.
     attempts : list of str
         What the pipeline tried, in order.
     solve_time : float

@@ -41,9 +41,9 @@ class SectorLawCertificate(ResidualChecks):
     kinematic : float
         Largest violation of γ⁺ ≥ 0 (scaled).
     energy_balance : float
-        |‖u⁺‖² − ‖u⁻‖²| / V²: the sector law conserves kinetic energy.
+        abs(‖u⁺‖² − ‖u⁻‖²) / V²: the sector law conserves kinetic energy.
     law_residual : float
-        max |γ⁺ − S(γ⁻)| / V with S the closed-form sector map of docs/theory.md §6.
+        max abs(γ⁺ − S(γ⁻)) / V with S the closed-form sector map of docs/theory.md §6.
     tol : float
         Tolerance every residual must meet.
     """

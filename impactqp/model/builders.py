@@ -98,6 +98,16 @@ def newtons_cradle(n_balls: int = 3, v: float = 1.0, mass: float = 1.0,
         Mass of every ball, positive.
     released : int
         How many balls (from the left) move at ``v``; 1 ≤ released < n_balls.
+
+    Returns
+    -------
+    ImpactProblem
+        A chain of equal masses without walls (``problem.chain`` set).
+
+    Raises
+    ------
+    InputError
+        For counts that are not whole numbers in range, or a non-finite ``v`` or ``mass``.
     """
     n_balls = as_count("n_balls", n_balls, minimum=2)
     released = as_count("released", released, minimum=1)

@@ -34,6 +34,8 @@ class Classification:
         (−sqrt(−ratio)) when u⁺ has less energy than z, NaN when z⊥ = 0.
     moreau_direction : ndarray
         (z − u⁻)/‖z − u⁻‖.
+    impulses : ndarray
+        Λ ≥ 0 that best explains u⁺ − u⁻ (one of several with redundant contacts).
     kinetic_residual : float
         How far u⁺ is from u⁻ + N (relative); the classification assumes it is ~0.
     """
@@ -62,6 +64,15 @@ def classify(problem: ImpactProblem, u_plus: Any) -> Classification:
     problem : ImpactProblem
     u_plus : (n,) array_like
         A post-impact velocity, normally in u⁻ + N.
+
+    Returns
+    -------
+    Classification
+
+    Raises
+    ------
+    InputError
+        ``problem`` is not an ImpactProblem or ``u_plus`` is not a finite (n,) vector.
     """
     if not isinstance(problem, ImpactProblem):
         raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")

@@ -24,6 +24,9 @@ class ImpactProblem:
     u_minus : (n,) array_like
         Pre-impact generalized velocity. Kinematically inconsistent values (a closed contact
         already separating, γ⁻ᵢ > 0) are legal.
+    structure : ImpactStructure, optional
+        An already validated and factorized M and W to reuse (then M and W are ignored);
+        :meth:`from_structure` and :meth:`with_u_minus` pass it.
 
     Raises
     ------

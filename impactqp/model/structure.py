@@ -25,8 +25,15 @@ from ..errors import MassMatrixError, ShapeError
 
 @dataclass(frozen=True)
 class ChainInfo:
-    """Marks a problem as a 1-D chain (docs/theory.md §5): ball masses and the fixed walls, if
-    any."""
+    """Marks a problem as a 1-D chain (docs/theory.md §5): ball masses and the fixed walls.
+
+    Attributes
+    ----------
+    masses : (N,) ndarray
+        Ball masses, left to right.
+    left_wall, right_wall : bool
+        Fixed walls touching the first / last ball.
+    """
 
     masses: np.ndarray
     left_wall: bool = False
@@ -51,6 +58,14 @@ class ImpactStructure:
         Mass matrix, symmetric positive definite.
     W : (n, m) array_like or scipy.sparse matrix
         Generalized force directions, one column per closed contact; ``m = 0`` is allowed.
+    chain : ChainInfo, optional
+        Marks W as the chain's directions (:func:`impactqp.model.builders.chain_directions`),
+        which lets chains use O(N) operators and the isotonic backend; set by the builders.
+
+    Raises
+    ------
+    ShapeError, NonFiniteError, MassMatrixError, InputError
+        On malformed input (all ``ValueError`` subclasses naming the argument).
     """
 
     def __init__(self, M: Matrix, W: Matrix, *, chain: ChainInfo | None = None) -> None:
@@ -226,7 +241,7 @@ class ImpactStructure:
 
     @cached_property
     def contact_scale(self) -> np.ndarray:
-        """sᵢ = sqrt(Gᵢᵢ): |γᵢ| ≤ sᵢ‖u‖ (the unit of contact velocities in certificates)."""
+        """sᵢ = sqrt(Gᵢᵢ): abs(γᵢ) ≤ sᵢ‖u‖ (the unit of contact velocities in certificates)."""
         return np.sqrt(self.delassus_diagonal)
 
     @cached_property

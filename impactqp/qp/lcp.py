@@ -32,7 +32,7 @@ class LCPResult:
     error : float
         ‖z − max(0, z − w)‖ / ‖(G, q)‖ (the natural-map residual, dimensionless).
     residuals : dict
-        Largest violations of z ≥ 0, w ≥ 0 and |zᵢwᵢ|, scaled.
+        Largest violations of z ≥ 0, w ≥ 0 and abs(zᵢwᵢ), scaled.
     backend : str
         What produced z (``"kernel"``, ``"nnls"``, ``"clarabel+polish"``, ...).
     tol : float

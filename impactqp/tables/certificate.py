@@ -76,6 +76,27 @@ class SectorCertificate:
     ``maximal_monotone`` is True iff the law is continuous across every pair of
     neighbouring cones and every piece is non-expansive in ``G⁻¹`` and in ``M``;
     ``reason`` names the failed check and cone, or says why the property holds.
+
+    Attributes
+    ----------
+    n_balls : int
+        Number of balls of the chain.
+    n_cones : int
+        Number of cones of the table.
+    n_neighbour_pairs : int
+        Pairs of cones sharing a facet (n−2 rays), checked for continuity.
+    cones : tuple of ConeCheck
+        The per-cone margins and verdicts.
+    kinematic, kinetic, energetic : CheckResult
+        u⁺ ∈ S on every cone: γ⁺ ≥ 0, Λ ≥ 0, and no energy gain (docs/theory.md §2).
+    continuity : CheckResult
+        Neighbouring cones agree on their shared rays.
+    non_expansive, velocity_non_expansive : CheckResult
+        Every piece is non-expansive in G⁻¹ (contact velocities) and in M (velocities).
+    maximal_monotone : bool
+        Continuity and non-expansiveness together (docs/theory.md §6).
+    reason : str
+        The failed check and cone, or why the property holds.
     """
 
     n_balls: int

@@ -109,6 +109,18 @@ def continuous_mass_ratios(k: int, m1: float = 1.0, m3: float = 1.0) -> np.ndarr
     (equal masses), √2 − 1 for k = 4, √5 − 2 for k = 5, 2/√3 − 1 for k = 6.  k = 2 (90°)
     is not attainable: it needs 1/m2 = 0.
 
+    Parameters
+    ----------
+    k : int
+        The angle of T_C is π/k; k ≥ 3.
+    m1, m3 : float
+        Masses of the outer balls (positive).
+
+    Returns
+    -------
+    (3,) ndarray
+        The masses (m1, m2, m3).
+
     Raises
     ------
     SectorInputError

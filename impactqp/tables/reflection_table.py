@@ -144,6 +144,11 @@ def reflection_law_table(masses: Any, *, left_wall: bool = False,
     left_wall, right_wall : bool
         At most one wall (a contact like any other).
 
+    Returns
+    -------
+    ReflectionTable
+        One cone per element of the reflection group, with its exact certificate.
+
     Raises
     ------
     SectorLawError

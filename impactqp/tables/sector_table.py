@@ -203,6 +203,19 @@ class SectorTable(PiecewiseLinearTable):
 def sector_law_table(n_balls: int = 3, mass: float = 1.0) -> SectorTable:
     """Enumerate the n! cones of the sector law for ``n_balls`` equal balls (docs/theory.md §6).
 
+    Parameters
+    ----------
+    n_balls : int
+        Number of balls, 2 to 8.
+    mass : float
+        The common mass (positive).
+
+    Returns
+    -------
+    SectorTable
+        The cones with their rays, matrices Q and inequalities; ``table.certificate`` checks
+        them exactly (docs/theory.md §7).
+
     Raises
     ------
     SectorTableTooLarge

@@ -16,6 +16,7 @@ from ..base.arrays import as_array, as_count, check_tol
 from ..errors import InputError
 from ..laws.functions import fremond
 from ..model.problem import ImpactProblem
+from .parallel import check_jobs, run_chunks, split
 from .sampled import DEFAULT_TOL, admissibility_residuals, sample_u_minus
 
 FAMILIES = ("symmetric", "triangular")
@@ -33,7 +34,8 @@ def fremond_matrix(a: float, b: float, m: int, family: str = "symmetric") -> np.
 def fremond_admissibility_map(problem: ImpactProblem, a_values: Any, b_values: Any,
                               samples: int = 200, seed: int = 0, *,
                               family: str = "symmetric", consistent_only: bool = True,
-                              tol: float = DEFAULT_TOL) -> np.ndarray:
+                              tol: float = DEFAULT_TOL, n_jobs: int = 1, client: Any = None,
+                              progress: bool | None = None) -> np.ndarray:
     """Boolean grid: ``out[i, j]`` is True when E(a_values[i], b_values[j]) keeps u⁺ ∈ S
     for every sampled u⁻.
 
@@ -50,6 +52,24 @@ def fremond_admissibility_map(problem: ImpactProblem, a_values: Any, b_values: A
         Sample only γ⁻ ≤ 0 (default), where Moreau's E = εI is known to be admissible.
     tol : float
         Tolerance on the dimensionless residuals of the membership test.
+    n_jobs : int
+        Local worker processes sharing the cells (-1: every core); the grid does not
+        depend on it.
+    client : dask.distributed.Client, optional
+        Run the cells on this Dask cluster instead (the ``dask`` extra).
+    progress : bool or None
+        Progress bar on stderr (None: only on a terminal).
+
+    Returns
+    -------
+    (len(a_values), len(b_values)) ndarray of bool
+        True where every sampled u⁻ ends in S.
+
+    Raises
+    ------
+    InputError
+        For grids that are not 1-D, a ``problem`` that is not an ImpactProblem, an unknown
+        ``family``, or bad ``samples``, ``seed`` or ``tol``.
     """
     a_values = np.atleast_1d(as_array("a_values", a_values))
     b_values = np.atleast_1d(as_array("b_values", b_values))
@@ -63,12 +83,21 @@ def fremond_admissibility_map(problem: ImpactProblem, a_values: Any, b_values: A
     m = problem.n_contacts
     if family not in FAMILIES:
         raise InputError(f"family must be one of {FAMILIES}, got {family!r}")
+    n_jobs = check_jobs(n_jobs, client)
     u_minus = sample_u_minus(problem, samples, np.random.default_rng(seed),
                              consistent_only=consistent_only)
-    out = np.zeros((a_values.size, b_values.size), dtype=bool)
-    for i, a in enumerate(a_values):
-        for j, b in enumerate(b_values):
+    cells = [(a, b) for a in a_values for b in b_values]
+
+    def work(span: range) -> list[bool]:
+        verdicts = []
+        for a, b in (cells[k] for k in span):
             E = fremond_matrix(a, b, m, family)
             _, res = admissibility_residuals(lambda q, E=E: fremond(q, E), problem, u_minus)
-            out[i, j] = bool(np.all(res <= tol))  # NaN (the law failed) counts as not in S
-    return out
+            verdicts.append(bool(np.all(res <= tol)))  # NaN (the law failed): not in S
+        return verdicts
+
+    chunks = split(len(cells), n_jobs, client=client, impacts_per_item=samples)
+    found = run_chunks(work, chunks, n_jobs=n_jobs, client=client,
+                       desc="Frémond map", progress=progress)
+    return np.array([v for part in found for v in part], dtype=bool).reshape(
+        a_values.size, b_values.size)

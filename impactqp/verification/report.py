@@ -21,7 +21,19 @@ class Counterexample:
 
     For ``"non_expansive"`` the offending pair is stacked: ``u_minus`` and ``u_plus`` have
     shape (2, n) and ``amount`` is ‖Δu⁺‖/‖Δu⁻‖ − 1; otherwise ``amount`` is the residual of
-    :class:`~impactqp.admissible.Membership` for that condition.
+    :class:`~impactqp.Membership` for that condition.
+
+    Attributes
+    ----------
+    u_minus : (n,) or (2, n) ndarray
+        The pre-impact velocity (the pair, for ``"non_expansive"``).
+    u_plus : (n,) or (2, n) ndarray
+        The law's answer to it (NaN where the law raised).
+    condition : str
+        ``"kinematic"``, ``"kinetic"``, ``"energetic"``, ``"non_expansive"``,
+        ``"law_error"`` (or ``"continuity"`` for an exact certificate).
+    amount : float
+        By how much the condition is violated (dimensionless; ``inf`` for a law error).
     """
 
     u_minus: np.ndarray

@@ -2,29 +2,33 @@
 (docs/theory.md §6)?
 
 A law is sampled: pre-impact velocities u⁻ are drawn (seeded) for the M and W of a problem,
-the law is run on each, and every answer is checked for the three conditions of S
-(kinematic γ⁺ ≥ 0, kinetic u⁺ − u⁻ ∈ N, energetic T⁺ ≤ T⁻) by the exact membership test of
-:class:`~impactqp.admissible.AdmissibleSet`. Maximal monotonicity is equivalent to
-non-expansiveness of u⁻ ↦ u⁺ in the metric M (docs/theory.md §6); its evidence is checked on every
-pair of
-samples. A piecewise-linear law (a :class:`~impactqp.sector.SectorTable`, or any object with
+kinematically consistent ones (γ⁻ ≤ 0) unless asked otherwise; the law is run on each, and
+every answer is checked for the three conditions of S (kinematic γ⁺ ≥ 0, kinetic
+u⁺ − u⁻ ∈ N, energetic T⁺ ≤ T⁻) by the exact membership test of
+:class:`~impactqp.AdmissibleSet`. Maximal monotonicity is equivalent to non-expansiveness of
+u⁻ ↦ u⁺ in the metric M (docs/theory.md §6); its evidence is checked on every pair of
+samples. A piecewise-linear law (a :class:`~impactqp.SectorTable`, or any object with
 ``cones``, ``G`` and ``W``) is certified exactly instead (docs/theory.md §7).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import numpy as np
 
-from ..base.arrays import as_dense
+from ..base.arrays import as_count, as_dense, as_flag, check_tol
 from ..errors import ImpactError, InputError, ShapeError
+from ..laws.base import ImpactLaw
 from ..laws.functions import moreau
+from ..laws.pipeline import solve
 from ..laws.result import ImpactResult
 from ..model.problem import ImpactProblem
 from ..tables.piecewise_table import PiecewiseLinearTable
 from .exact import certify_table_report
+from .parallel import check_jobs, run_chunks, split
 from .report import ADMISSIBILITY, DEFAULT_TOL, Counterexample, LawReport
 
 Law = Callable[[ImpactProblem], Any]
@@ -57,6 +61,10 @@ def sample_u_minus(problem: ImpactProblem, samples: int, rng: np.random.Generato
         lift = as_dense(st.Minv_W) @ np.linalg.inv(as_dense(st.delassus))
         return v + (gamma - v @ W) @ lift.T
     return np.array([-moreau(problem.with_u_minus(x), eps=0.0).u_plus for x in v])
+
+
+def _solve_with(law: ImpactLaw, problem: ImpactProblem) -> ImpactResult:
+    return solve(problem, law)
 
 
 def run_law(law: Law, problem: ImpactProblem) -> np.ndarray:
@@ -109,44 +117,81 @@ def _pair_expansion(M: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
 
 # --------------------------------------------------------------------------- entry point
 def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 1000,
-               seed: int = 0, consistent_only: bool = False, *,
-               tol: float = DEFAULT_TOL) -> LawReport:
-    """Check an impact law against S (docs/theory.md §2) and for non-expansiveness (docs/theory.md
-    §6).
+               seed: int = 0, consistent_only: bool = True, *,
+               tol: float = DEFAULT_TOL, n_jobs: int = 1, client: Any = None,
+               progress: bool | None = None) -> LawReport:
+    """Check an impact law against S (docs/theory.md §2) and for non-expansiveness
+    (docs/theory.md §6).
+
+    By default only kinematically consistent pre-impact velocities are sampled (γ⁻ = Wᵀu⁻ ≤ 0:
+    no closed contact is already separating or penetrating from the wrong side), the impacts a
+    law meets in a simulation. ``consistent_only=False`` samples u⁻ isotropically in the
+    kinetic metric instead, which also tests the law on inconsistent u⁻ (where Moreau's law
+    may end penetrating and local Newton may gain energy).
 
     Parameters
     ----------
-    law : callable or SectorTable
-        ``law(problem)`` returns an :class:`ImpactResult` or u⁺ as an (n,) array. A
-        piecewise-linear law (``cones`` with ``rays``, ``Q``, ``label``; ``G``; ``W``) is
-        certified exactly by :func:`~impactqp.sector_certificate.certify_sector_table`.
+    law : ImpactLaw, callable or SectorTable
+        A law object (solved by :func:`impactqp.solve`), or ``law(problem)`` returning an
+        :class:`~impactqp.ImpactResult` or u⁺ as an (n,) array.
+        A piecewise-linear law (``cones`` with ``rays``, ``Q``, ``label``; ``G``; ``W``) is
+        certified exactly instead of sampled (docs/theory.md §7).
     problem : ImpactProblem
         Supplies M and W (its u⁻ is not used); not needed for an exact certificate.
     samples : int
-        Number of pre-impact velocities.
+        Number of pre-impact velocities (at least 2).
     seed : int
         Seed of the sampling.
     consistent_only : bool
-        Sample only kinematically consistent u⁻ (γ⁻ ≤ 0).
+        Sample only kinematically consistent u⁻ (γ⁻ ≤ 0), the default; False samples any u⁻.
     tol : float
         Tolerance on the dimensionless residuals.
+    n_jobs : int
+        Local worker processes sharing the samples (-1: every core). The samples are drawn
+        before they are shared out, so the report does not depend on it.
+    client : dask.distributed.Client, optional
+        Run on this Dask cluster instead (the ``dask`` extra), at least 10⁴ impacts a task.
+    progress : bool or None
+        Progress bar on stderr (None: only on a terminal).
 
     Returns
     -------
     LawReport
+        Violation counts per condition (kinematic, kinetic, energetic, non_expansive,
+        law_error) and a recheckable counterexample for each violated one.
+
+    Raises
+    ------
+    InputError
+        If ``law`` is neither callable nor a piecewise-linear table, ``problem`` is not an
+        :class:`~impactqp.ImpactProblem`, or ``samples`` is not an integer ≥ 2.
+    ShapeError
+        If the law returns u⁺ of the wrong shape.
     """
     if isinstance(law, PiecewiseLinearTable) or (hasattr(law, "cones") and hasattr(law, "G")):
         return certify_table_report(law, tol=tol)
+    if isinstance(law, ImpactLaw):
+        law = partial(_solve_with, law)
     if not callable(law):
-        raise InputError(f"law must be callable or a piecewise-linear table, got "
+        raise InputError(f"law must be an impact law, a callable or a piecewise-linear table, got "
                          f"{type(law).__name__}")
     if not isinstance(problem, ImpactProblem):
         raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
     if not isinstance(samples, (int, np.integer)) or samples < 2:
         raise InputError(f"samples must be an integer ≥ 2, got {samples!r}")
+    seed = as_count("seed", seed)
+    consistent_only = as_flag("consistent_only", consistent_only)
+    tol = check_tol(tol)
+    n_jobs = check_jobs(n_jobs, client)
     rng = np.random.default_rng(seed)
     u_minus = sample_u_minus(problem, samples, rng, consistent_only=consistent_only)
-    u_plus, res = admissibility_residuals(law, problem, u_minus)
+    chunks = split(samples, n_jobs, client=client, min_chunk=16)
+    parts = run_chunks(lambda span: admissibility_residuals(law, problem, u_minus[span.start:
+                                                                                 span.stop]),
+                       chunks, n_jobs=n_jobs, client=client, desc="verify_law",
+                       progress=progress)
+    u_plus = np.concatenate([part[0] for part in parts])
+    res = np.concatenate([part[1] for part in parts])
     st = problem.structure
     expansion, pairs = _pair_expansion(as_dense(st.M), u_minus, u_plus)
 

@@ -1,5 +1,8 @@
 """``impactqp plot cradle|sectors|S FILE``: the figures of docs/theory.md §5 and docs/theory.md §6
-as PNG or SVG.
+as PNG, SVG or PDF (chosen by the suffix of ``--out``).
+
+Without ``--out`` a figure is written to ``cradle.png``, ``sectors.png`` or ``S.png`` in the
+current directory. An existing file is never overwritten unless ``--force`` is given.
 
 Needs the optional extra ``plot`` (matplotlib).
 """
@@ -7,28 +10,43 @@ Needs the optional extra ``plot`` (matplotlib).
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
+from ...errors import InputError
 from ...io.files import load_problem
 
 
-def run_cradle(args: argparse.Namespace) -> int:
-    from ...figures.plots import plot_cradle
+def _target(args: argparse.Namespace) -> Path:
+    """The output path, refused when it exists and ``--force`` was not given."""
+    out = Path(args.out)
+    if out.exists() and not args.force:
+        raise InputError(f"{out} exists; pass --force to overwrite it or --out to write "
+                         "elsewhere")
+    return out
 
-    print(f"wrote {plot_cradle(args.out, v=args.v)}")
+
+def run_cradle(args: argparse.Namespace) -> int:
+    from ...figures.plots import figure_format, plot_cradle
+
+    figure_format(args.out)
+    print(f"wrote {plot_cradle(_target(args), v=args.v)}")
     return 0
 
 
 def run_sectors(args: argparse.Namespace) -> int:
-    from ...figures.plots import plot_sectors
+    from ...figures.plots import figure_format, plot_sectors
 
-    print(f"wrote {plot_sectors(args.out)}")
+    figure_format(args.out)
+    print(f"wrote {plot_sectors(_target(args))}")
     return 0
 
 
 def run_S(args: argparse.Namespace) -> int:
-    from ...figures.plots import plot_S
+    from ...figures.plots import figure_format, plot_S
     from .solve import solve_law
 
+    figure_format(args.out)
+    out = _target(args)
     content = load_problem(args.file)
     marks = {}
     if content.law is not None:
@@ -36,22 +54,29 @@ def run_S(args: argparse.Namespace) -> int:
         marks[f"{content.law} law u⁺"] = result.u_plus
     if content.u_plus is not None:
         marks["u_plus of the file"] = content.u_plus
-    print(f"wrote {plot_S(content.problem, args.out, marks)}")
+    print(f"wrote {plot_S(content.problem, out, marks)}")
     return 0
 
 
+def _output_options(parser: argparse.ArgumentParser, default: str) -> None:
+    parser.add_argument("--out", default=default,
+                        help=f"output file, .png, .svg or .pdf (default: ./{default})")
+    parser.add_argument("--force", action="store_true",
+                        help="overwrite the output file if it exists (default: refuse)")
+
+
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("plot", help="figures of S and of the sector law (PNG or SVG)")
+    p = sub.add_parser("plot", help="figures of S and of the sector law (PNG, SVG or PDF)")
     which = p.add_subparsers(dest="figure", required=True)
     cradle = which.add_parser("cradle", help="S of the 3-ball cradle with Moreau's half-line "
                                              "and the sector-law point")
     cradle.add_argument("--v", type=float, default=1.0, help="speed of the released ball")
-    cradle.add_argument("--out", default="cradle.png", help="output .png or .svg")
+    _output_options(cradle, "cradle.png")
     cradle.set_defaults(func=run_cradle)
     sectors = which.add_parser("sectors", help="the six cones of the 3-ball sector law")
-    sectors.add_argument("--out", default="sectors.png", help="output .png or .svg")
+    _output_options(sectors, "sectors.png")
     sectors.set_defaults(func=run_sectors)
     s = which.add_parser("S", help="S of a problem file with two independent contacts")
     s.add_argument("file", help="problem file (.json or .toml)")
-    s.add_argument("--out", default="S.png", help="output .png or .svg")
+    _output_options(s, "S.png")
     s.set_defaults(func=run_S)
