@@ -155,18 +155,18 @@ BUILDERS: dict[str, Callable[[int, int], Case]] = {
     "mass-ratio": _mass_ratio, "discs": _discs, "batch": _batch,
 }
 SIZE_LABEL = {"cradle": "N", "random": "m", "redundant": "m", "mass-ratio": "r",
-              "discs": "m", "batch": "k"}
+              "discs": "m", "batch": "k", "sweep": "cells"}
 #: seeded instances per size (only the random families vary with the seed)
 INSTANCES = {"random": 3, "redundant": 3}
 
 SUITES: dict[str, dict[str, list[int]]] = {
     "smoke": {"cradle": [3, 100], "random": [5], "discs": [30], "batch": [1000]},
-    "quick": {"cradle": [3, 100, 10_000], "random": [2, 50], "redundant": [6],
+    "quick": {"cradle": [3, 100, 10_000], "random": [2, 4, 10, 50], "redundant": [6],
               "mass-ratio": [1_000_000], "discs": [300], "batch": [10_000]},
     "full": {"cradle": [3, 10, 100, 1000, 10_000, 100_000, 1_000_000],
-             "random": [2, 5, 10, 20, 50], "redundant": [6, 12, 30, 50],
+             "random": [2, 4, 5, 10, 20, 50], "redundant": [6, 12, 30, 50],
              "mass-ratio": [10, 1000, 1_000_000], "discs": [100, 1000, 10_000],
-             "batch": [10_000, 100_000, 1_000_000]},
+             "batch": [10_000, 100_000, 1_000_000, 10_000_000]},
 }
 
 

@@ -36,13 +36,25 @@ def relative_error(case: Case, u_plus: np.ndarray, *, law: str = "moreau") -> fl
     return float(np.max(num / np.where(den > 0, den, 1.0)))
 
 
+def output_size(raw: Any) -> float | None:
+    """MB of a batch result's own arrays (u⁺, Λ, the residuals): what peak memory must hold
+    anyway, so that what a batch needs beyond input and output can be told apart."""
+    residuals = getattr(raw, "residuals", None)
+    if not isinstance(residuals, dict):
+        return None
+    arrays = [raw.u_plus, raw.impulses, *residuals.values()]
+    return sum(a.nbytes for a in arrays) / 2**20
+
+
 def record(case: Case, method: str, group: str, *, status: str, message: str = "",
            times: list[float] | None = None, error: float | None = None,
-           peak_mb: float | None = None, note: str = "") -> dict[str, Any]:
+           peak_mb: float | None = None, note: str = "",
+           output_mb: float | None = None) -> dict[str, Any]:
     """One tidy row: a method on one case instance."""
     return {"family": case.family, "size": case.size, "instance": case.instance,
             "method": method, "group": group, "status": status, "message": message[:300],
             "times": list(times or []), "error": error, "peak_mb": peak_mb,
+            "output_mb": output_mb,
             "reference": case.ref_label, "note": note}
 
 
@@ -101,5 +113,5 @@ def measure(method: Method, case: Case, *, budget: float, max_repeats: int) -> d
     err = relative_error(case, u_plus, law=method.law)
     status = "ok" if err <= ACCURATE else "inaccurate"
     return record(case, method.name, method.group, status=status, times=times, error=err,
-                  peak_mb=peak, note=method.note,
+                  peak_mb=peak, note=method.note, output_mb=output_size(raw),
                   message="" if status == "ok" else f"relative error {err:.1e}")

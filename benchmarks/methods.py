@@ -16,6 +16,7 @@ import cvxpy as cp
 import numpy as np
 import qpsolvers
 import scipy.sparse as sp
+from scipy.optimize import isotonic_regression
 
 import impactqp as iq
 from impactqp.qp.active_set import MAX_CONTACTS
@@ -185,6 +186,29 @@ def _cvxpy_dpp(case: Case) -> tuple[Solve, Finish]:
     return solve, _cvxpy_finish(case, delta, prob)
 
 
+# --- the floor for chains ----------------------------------------------------------------------
+def _free_chain(case: Case) -> str | None:
+    c = case.problem.chain
+    if c is None or c.left_wall or c.right_wall:
+        return "free chains only"
+    return None
+
+
+def _raw_isotonic(case: Case) -> tuple[Solve, Finish]:
+    """scipy's weighted isotonic regression on the same data: the floor of a chain impact."""
+    p, e = case.problem, case.eps
+    masses, u = p.chain.masses, p.u_minus
+    return ((lambda: isotonic_regression(u, weights=masses)),
+            (lambda r: (1.0 + e) * r.x - e * u))
+
+
+def _iq_cold(case: Case) -> tuple[Solve, Finish]:
+    """Build the chain problem from masses and u⁻, then solve (nothing cached)."""
+    p, e = case.problem, case.eps
+    masses, u = p.chain.masses.copy(), p.u_minus.copy()
+    return (lambda: iq.moreau(iq.chain(masses, u), e)), (lambda r: r.u_plus)
+
+
 # --- batches ---------------------------------------------------------------------------------
 def _moreau_batch(case: Case) -> tuple[Solve, Finish]:
     return (lambda: iq.moreau_batch(case.problem, case.U, case.eps)), (lambda r: r.u_plus)
@@ -215,6 +239,10 @@ METHODS: list[Method] = [
     Method("raw:qpsolvers:daqp", "raw", _raw_qpsolvers("daqp"), max_size=1000),
     Method("raw:qpsolvers:piqp", "raw", _raw_qpsolvers("piqp"), max_size=BIG),
     Method("raw:qpsolvers:highs", "raw", _raw_qpsolvers("highs"), max_size=1000),
+    Method("iq:cold", "impactqp", _iq_cold, kinds=("chain",), fits=_free_chain,
+           note="builds the chain problem (validation, structure), then solves"),
+    Method("raw:isotonic_regression", "raw", _raw_isotonic, kinds=("chain",),
+           fits=_free_chain, note="scipy.optimize.isotonic_regression alone, no certificate"),
     Method("iq:moreau_batch", "batch", _moreau_batch, kinds=("batch",)),
     Method("iq:sector_law_batch", "batch", _sector_batch, kinds=("batch",),
            law="sector"),

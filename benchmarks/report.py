@@ -17,7 +17,8 @@ import numpy as np  # noqa: E402
 from .families import SIZE_LABEL  # noqa: E402
 
 COLUMNS = ["family", "size", "method", "group", "instances", "ran", "ok", "success_rate",
-           "median_s", "p90_s", "max_error", "peak_mb", "status", "message", "reference", "note"]
+           "median_s", "p90_s", "max_error", "peak_mb", "output_mb", "status", "message",
+           "reference", "note"]
 
 
 def aggregate(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -32,6 +33,7 @@ def aggregate(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
         times = [t for r in ran for t in r["times"]]
         errors = [r["error"] for r in ran if r["error"] is not None]
         peaks = [r["peak_mb"] for r in ran if r["peak_mb"] is not None]
+        outputs = [r.get("output_mb") for r in ran if r.get("output_mb") is not None]
         statuses = sorted({r["status"] for r in recs})
         ok = sum(r["status"] == "ok" for r in ran)
         rows.append({
@@ -42,6 +44,7 @@ def aggregate(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
             "p90_s": float(np.percentile(times, 90)) if times else None,
             "max_error": max(errors) if errors else None,
             "peak_mb": max(peaks) if peaks else None,
+            "output_mb": max(outputs) if outputs else None,
             "status": statuses[0] if len(statuses) == 1 else "mixed",
             "message": next((r["message"] for r in recs if r["message"]), ""),
             "reference": recs[0]["reference"], "note": recs[0]["note"],
@@ -87,17 +90,51 @@ def targets(rows: list[dict]) -> list[tuple[str, str, str]]:
                                                                 "siconos:lemke")
     if iq3 and lemke:
         ratio = iq3["median_s"] / lemke["median_s"]
-        out.append(("3-ball cradle: iq.moreau within 2× of Siconos Lemke (incl. construction)",
+        beside = []
+        for m in (4, 10):
+            a, b = _median(rows, "random", m, "iq:auto"), _median(rows, "random", m,
+                                                                   "siconos:lemke")
+            if a and b:
+                beside.append(f"m = {m}: {a['median_s'] / b['median_s']:.1f}× "
+                              f"({fmt_time(a['median_s'])} vs {fmt_time(b['median_s'])})")
+        out.append(("3-ball cradle: iq.moreau ≤ 2× Siconos Lemke (incl. construction)",
                     f"{ratio:.1f}× ({fmt_time(iq3['median_s'])} vs "
-                    f"{fmt_time(lemke['median_s'])})",
-                    "met" if ratio <= 2 else f"MISSED by {ratio / 2:.0f}×"))
+                    f"{fmt_time(lemke['median_s'])})"
+                    + (f"; random impacts {'; '.join(beside)}" if beside else ""),
+                    "met" if ratio <= 2 else f"MISSED by {ratio / 2:.1f}×"))
+    floor = _median(rows, "cradle", 1_000_000, "raw:isotonic_regression")
+    for method, limit, what in (("iq:auto", 3, "warm"), ("iq:cold", 10, "cold build + solve")):
+        r = _median(rows, "cradle", 1_000_000, method)
+        if r and floor:
+            ratio = r["median_s"] / floor["median_s"]
+            out.append((f"chain N=10⁶, {what}: ≤ {limit}× isotonic_regression",
+                        f"{ratio:.1f}× ({fmt_time(r['median_s'])} vs "
+                        f"{fmt_time(floor['median_s'])})",
+                        "met" if ratio <= limit else f"MISSED by {ratio / limit:.1f}×"))
     for method in ("iq:moreau_batch", "iq:sector_law_batch"):
         b = _median(rows, "batch", None, method)
         if b:
             rate = b["size"] / b["median_s"]
-            out.append((f"batch {method}: ≥ 10⁶ three-ball impacts/s (k = {b['size']:g})",
-                        f"{rate:.3g} impacts/s",
-                        "met" if rate >= 1e6 else f"MISSED by {1e6 / rate:.1f}×"))
+            goal = 5e6 if method == "iq:moreau_batch" and b["size"] >= 10**7 else 1e6
+            out.append((f"batch {method}: ≥ {goal:.0e} three-ball impacts/s, one thread "
+                        f"(k = {b['size']:g})", f"{rate:.3g} impacts/s",
+                        "met" if rate >= goal else f"MISSED by {goal / rate:.1f}×"))
+            if b.get("peak_mb") is not None and b.get("output_mb") is not None \
+                    and b["size"] >= 10**6:  # below, fixed costs dominate a per-impact figure
+                extra = (b["peak_mb"] - b["output_mb"]) * 2**20 / b["size"]
+                out.append((f"batch {method}: memory beyond input and output ≤ 100 B/impact",
+                            f"{extra:.0f} B/impact (tracemalloc peak {b['peak_mb']:.0f} MB, "
+                            f"output {b['output_mb']:.0f} MB)",
+                            "met" if extra <= 100 else "MISSED"))
+    one = _median(rows, "sweep", None, "iq:fremond_map n_jobs=1")
+    two = _median(rows, "sweep", None, "iq:fremond_map n_jobs=2")
+    if one and two:
+        speedup = one["median_s"] / two["median_s"]
+        same = one["status"] == two["status"] == "ok"
+        out.append(("sweep on 2 local processes ≥ 1.7× faster than 1, identical results",
+                    f"{speedup:.2f}× ({fmt_time(one['median_s'])} vs "
+                    f"{fmt_time(two['median_s'])}), {'identical' if same else 'DIFFERENT'}",
+                    "met" if speedup >= 1.7 and same else "MISSED"))
     for r in rows:
         if r["family"] == "discs" and r["size"] >= 1000 and r["method"] == "iq:clarabel":
             raw = _median(rows, "discs", r["size"], "raw:clarabel")
@@ -199,8 +236,9 @@ def _styles(rows: list[dict]) -> dict[str, dict[str, Any]]:
     for _, groups in PANELS:
         members = [m for m in group_of if group_of[m] in groups]
         for i, method in enumerate(members):
+            # colours cycle fastest, the marker shifts each cycle: pairs never repeat
             styles[method] = {"color": PALETTE[i % len(PALETTE)],
-                              "marker": MARKERS[i % len(MARKERS)],
+                              "marker": MARKERS[(i + i // len(PALETTE)) % len(MARKERS)],
                               "ls": LINESTYLES.get(group_of[method], "-")}
     return styles
 

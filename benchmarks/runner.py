@@ -14,6 +14,7 @@ from . import families, peers, report
 from .families import Case
 from .measure import measure, quiet_stdout
 from .methods import METHODS, Method
+from .sweeps import run_sweeps
 
 #: per suite: (seconds of timed repeats per method and case, most repeats)
 TIMING = {"smoke": (0.01, 10), "quick": (0.02, 30), "full": (0.3, 500)}
@@ -72,6 +73,8 @@ def run_suite(suite: str, out_dir: Path | str, *, methods: Sequence[Method] | No
         records += peers.run_siconos(peer_cases, budget=budget, max_repeats=max_repeats,
                                      python=siconos_python)
     bar.update()
+    bar.set_postfix_str("sweeps on 1 and 2 processes", refresh=False)
+    records += run_sweeps(suite)
     bar.close()
     meta = {"suite": suite, "seconds": round(time.perf_counter() - started, 1),
             "timing_budget_s": budget, "max_repeats": max_repeats,

@@ -68,7 +68,7 @@ def _has_flag(value: list | tuple) -> bool:
 
 
 def as_array(name: str, value: Any, *, ndim: int | None = None,
-             allow_nonfinite: bool = False) -> np.ndarray:
+             allow_nonfinite: bool = False, copy: bool = True) -> np.ndarray:
     """A float ndarray from ``value`` (list, tuple, ndarray), checked for kind and finiteness.
 
     Raises
@@ -79,6 +79,8 @@ def as_array(name: str, value: Any, *, ndim: int | None = None,
         Ragged nesting or a number of dimensions other than ``ndim``.
     NonFiniteError
         NaN or infinity (unless ``allow_nonfinite``).
+
+    With ``copy=False`` a float array is returned as it is (read-only use of big inputs).
     """
     if value is None:
         raise InputError(f"{name} is required, got None")
@@ -102,7 +104,8 @@ def as_array(name: str, value: Any, *, ndim: int | None = None,
     _numeric_dtype(name, arr, value)
     if isinstance(value, (list, tuple)) and _has_flag(value):
         raise _kind_error(name, "booleans", value)
-    arr = np.array(arr, dtype=float)  # a private copy: callers may keep it
+    # a private copy (callers may keep it), unless the caller only reads a large input
+    arr = np.array(arr, dtype=float) if copy else np.asarray(arr, dtype=float)
     if ndim is not None and arr.ndim != ndim:
         raise ShapeError(f"{name} must have {ndim} dimension{'s' if ndim != 1 else ''}, "
                          f"got shape {arr.shape}")
@@ -133,7 +136,8 @@ def as_matrix(name: str, value: Any) -> Matrix:
 def as_real(name: str, value: Any, *, low: float | None = None, high: float | None = None,
             positive: bool = False) -> float:
     """One finite real number (a Python or numpy number, not bool), optionally in a range."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+    if type(value) is not float and (isinstance(value, (bool, np.bool_))
+                                     or not isinstance(value, numbers.Real)):
         if isinstance(value, np.ndarray) and value.shape == () and value.dtype.kind in "fiu":
             value = value.item()
         else:

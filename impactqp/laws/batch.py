@@ -100,7 +100,7 @@ def certified_rows(residuals: dict, tol: float) -> np.ndarray:
 
 def as_rows(problem: ImpactProblem, U_minus: Any) -> np.ndarray:
     """Validate a (k, n) matrix of pre-impact velocities."""
-    U = as_array("U_minus", U_minus)
+    U = as_array("U_minus", U_minus, copy=False)  # only read
     if U.ndim != 2 or U.shape[1] != problem.n_dof:
         raise ShapeError(f"U_minus must have shape (k, {problem.n_dof}), got {U.shape}")
     return U

@@ -129,7 +129,7 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
     check_form(law, form)
     tol = check_tol(tol)
     law.check(problem)
-    if problem.n_contacts == 0 or not np.any(problem.u_minus):
+    if problem.n_contacts == 0 or not problem.u_minus.any():
         answer = _trivial(problem)
         return _result(problem, law, answer, "none", law.certificate(problem, answer, tol),
                        start, attempts=["no contact or u⁻ = 0: u⁺ = u⁻, Λ = 0"])

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import time
+from operator import mul
 
 import numpy as np
 
@@ -53,11 +54,11 @@ def _q(law: ImpactLaw, gamma: list[float]) -> list[float]:
 
 
 def _dot(row: tuple[float, ...], x: list[float]) -> float:
-    return sum(a * b for a, b in zip(row, x))
+    return sum(map(mul, row, x))
 
 
 def _m_norm2(M: tuple[tuple[float, ...], ...], x: list[float]) -> float:
-    return sum(xi * _dot(row, x) for xi, row in zip(x, M))
+    return sum(map(mul, x, [sum(map(mul, row, x)) for row in M]))
 
 
 def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float,
@@ -74,11 +75,12 @@ def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float,
     lam = prepared_for(st, "impulse", st.delassus).solve_floats(q)
     if lam is None:
         return None
-    up = [u + _dot(row, lam) for u, row in zip(um, rows.Minv_W)]
-    # the residuals of docs/theory.md §8, recomputed from (u⁻, u⁺, Λ) alone
+    jump = [_dot(row, lam) for row in rows.Minv_W]  # M⁻¹WΛ
+    up = [u + d for u, d in zip(um, jump)]
+    # the residuals of docs/theory.md §8, recomputed from (u⁻, u⁺, Λ)
     V2 = _m_norm2(rows.M, um)
     V = math.sqrt(V2)
-    du = [a - b - _dot(row, lam) for a, b, row in zip(up, um, rows.Minv_W)]
+    du = [a - b - d for a, b, d in zip(up, um, jump)]
     momentum = math.sqrt(max(_m_norm2(rows.M, du), 0.0)) / V
     s = rows.contact_scale
     impulse_sign = max(0.0, -min(li * si / V for li, si in zip(lam, s)))
@@ -92,7 +94,7 @@ def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float,
         e = law.eps
         z = [(a + e * b) / (1.0 + e) for a, b in zip(up, um)]
         zp = [b - a for a, b in zip(z, um)]
-        energy = 2.0 * e * abs(sum(zi * _dot(row, zp) for zi, row in zip(z, rows.M))) / V2
+        energy = 2.0 * e * abs(sum(map(mul, z, [_dot(row, zp) for row in rows.M]))) / V2
         gap = sum(products) / V2 + momentum * momentum
     cert = Certificate(momentum=momentum, impulse_sign=impulse_sign,
                        law_feasibility=law_feasibility, complementarity=complementarity,
