@@ -7,7 +7,8 @@ impact laws as objects (:class:`Moreau`, :class:`Newton`, :class:`Fremond`,
 one-call forms :func:`moreau`, :func:`newton`, :func:`fremond`, :func:`sector_law`,
 :func:`reflection_law`), many impacts at once (:func:`solve_batch`, :func:`moreau_batch`,
 :func:`sector_law_batch`), the law verifier :func:`verify_law`, LCPs with symmetric matrices
-(:func:`solve_lcp`) and the geometric classification (:func:`classify`). The theory and the
+(:func:`solve_lcp`), the geometric classification (:func:`classify`) and motion with any
+law (:class:`LinearSystem`, :func:`simulate`). The theory and the
 conventions are in docs/theory.md of the repository.
 """
 
@@ -53,6 +54,12 @@ from .model.classify import Classification, classify
 from .model.problem import ImpactProblem
 from .model.structure import ChainInfo, ImpactStructure
 from .qp.lcp import LCPResult, solve_lcp
+from .simulation.builders import bead_chain, bouncing_ball, cradle_system
+from .simulation.impacts import ImpactEvent
+from .simulation.simulate import simulate
+from .simulation.step_law import MoreauJeanStep
+from .simulation.system import LinearForce, LinearSystem
+from .simulation.trajectory import Trajectory
 from .tables.certificate import SectorCertificate
 from .tables.coxeter import continuous_mass_ratios
 from .tables.reflection_table import reflection_law_table
@@ -67,18 +74,19 @@ except PackageNotFoundError:  # running from a source tree that was never instal
     __version__ = "0+unknown"
 
 __all__ = [
-    "DEFAULT_TOL", "AdmissibleSet", "Answer", "BackendUnsuitableError", "BatchResult",
-    "Certificate", "CertificateError", "ChainInfo", "Classification", "Counterexample",
-    "Fremond", "ImpactError", "ImpactLaw", "ImpactProblem", "ImpactResult", "ImpactStructure",
-    "InputError", "LCPResult", "LawReport", "MassMatrixError", "Membership", "Moreau",
-    "Newton", "NoSolutionError", "NonConvexLCPError", "NonFiniteError", "NonSymmetricLCPError",
-    "OptionalDependencyError", "ProblemFile", "ProblemFileError", "ReflectionLaw",
-    "ResidualChecks", "RestitutionError", "SectorCertificate", "SectorCone",
-    "SectorInputError", "SectorLaw", "SectorLawCertificate", "SectorLawError", "SectorTable",
-    "SectorTableTooLarge", "ShapeError", "SolverError", "UnknownBackendError",
-    "available_backends", "chain", "classify", "continuous_mass_ratios", "fremond",
+    "AdmissibleSet", "Answer", "BackendUnsuitableError", "BatchResult", "Certificate",
+    "CertificateError", "ChainInfo", "Classification", "Counterexample", "DEFAULT_TOL",
+    "Fremond", "ImpactError", "ImpactEvent", "ImpactLaw", "ImpactProblem", "ImpactResult",
+    "ImpactStructure", "InputError", "LCPResult", "LawReport", "LinearForce", "LinearSystem",
+    "MassMatrixError", "Membership", "Moreau", "MoreauJeanStep", "Newton", "NoSolutionError",
+    "NonConvexLCPError", "NonFiniteError", "NonSymmetricLCPError", "OptionalDependencyError",
+    "ProblemFile", "ProblemFileError", "ReflectionLaw", "ResidualChecks", "RestitutionError",
+    "SectorCertificate", "SectorCone", "SectorInputError", "SectorLaw", "SectorLawCertificate",
+    "SectorLawError", "SectorTable", "SectorTableTooLarge", "ShapeError", "SolverError",
+    "Trajectory", "UnknownBackendError", "available_backends", "bead_chain", "bouncing_ball",
+    "chain", "classify", "continuous_mass_ratios", "cradle_system", "fremond",
     "fremond_admissibility_map", "load_problem", "moreau", "moreau_batch", "newton",
     "newtons_cradle", "random_impact", "reflection_law", "reflection_law_table",
-    "save_problem", "sector_law", "sector_law_batch", "sector_law_table", "solve",
+    "save_problem", "sector_law", "sector_law_batch", "sector_law_table", "simulate", "solve",
     "solve_batch", "solve_lcp", "verify_law",
 ]

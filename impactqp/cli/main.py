@@ -8,9 +8,9 @@ import sys
 from importlib.metadata import PackageNotFoundError, version
 
 from ..errors import ImpactError
-from .commands import demo, plot, sector, solve, verify
+from .commands import demo, plot, sector, simulate, solve, verify
 
-COMMANDS = [demo, solve, verify, plot, sector]
+COMMANDS = [demo, solve, verify, plot, sector, simulate]
 
 
 def build_parser() -> argparse.ArgumentParser:

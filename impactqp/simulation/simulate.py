@@ -1,0 +1,124 @@
+"""The one simulation entry point: :func:`simulate` (docs/theory.md §14)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ..base.arrays import as_count, as_flag, as_real, check_tol
+from ..base.checks import DEFAULT_TOL
+from ..errors import InputError
+from ..laws.base import ImpactLaw
+from ..laws.pipeline import check_backend, check_law
+from ..model.problem import ImpactProblem
+from .event_driven import event_driven
+from .system import LinearSystem
+from .time_stepping import moreau_jean
+from .trajectory import Trajectory
+
+SCHEMES = ("moreau-jean", "event-driven")
+METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
+_POSITIVE = ("gap_tol", "rest_velocity", "rtol", "atol")
+OPTIONS = {
+    "moreau-jean": ("record_every", "keep_events"),
+    "event-driven": ("gap_tol", "rest_velocity", "method", "rtol", "atol", "max_events",
+                     "keep_events"),
+}
+
+
+def _options(scheme: str, options: dict[str, Any]) -> dict[str, Any]:
+    unknown = sorted(set(options) - set(OPTIONS[scheme]))
+    if unknown:
+        raise InputError(f"unknown option(s) {unknown} for scheme {scheme!r}; it takes "
+                         f"{list(OPTIONS[scheme])}")
+    out: dict[str, Any] = {}
+    for key, value in options.items():
+        if key in _POSITIVE:
+            out[key] = as_real(key, value, positive=True)
+        elif key in ("record_every", "max_events"):
+            out[key] = as_count(key, value, minimum=1)
+        elif key == "keep_events":
+            out[key] = as_flag(key, value)
+        elif key == "method":
+            if value not in METHODS:
+                raise InputError(f"method must be one of {METHODS}, got {value!r}")
+            out[key] = value
+    return out
+
+
+def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
+             scheme: str = "moreau-jean", h: float | None = None, theta: float = 0.5, *,
+             t0: float = 0.0, backend: str = "auto", tol: float = DEFAULT_TOL,
+             progress: Callable[[float], None] | None = None, **options: Any) -> Trajectory:
+    """Simulate a system with unilateral contacts and any impact law (docs/theory.md §14).
+
+    Parameters
+    ----------
+    system : LinearSystem
+        ``iq.LinearSystem(M, q0, v0, force, H, b)`` or a builder's (``iq.bouncing_ball()``,
+        ``iq.cradle_system(n)``, ``iq.bead_chain(n)``).
+    law : ImpactLaw
+        ``iq.Moreau(eps)``, ``iq.Newton(e)`` (one coefficient, or one per contact of the
+        system), ``iq.Fremond(E)`` (m × m), ``iq.SectorLaw()``, ``iq.ReflectionLaw()`` or any
+        :class:`impactqp.ImpactLaw`.
+    t_end : float
+        Final time, after ``t0``.
+    scheme : {"moreau-jean", "event-driven"}
+        Time-stepping (θ-scheme, velocity-level impacts with the contacts closed at each
+        step) or event-driven integration (impacts at located events).
+    h : float, optional
+        Moreau–Jean: the time step. Event-driven: the output interval. Default
+        (t_end − t0)/1000.
+    theta : float
+        θ ∈ [0, 1] of the Moreau–Jean scheme (unused by event-driven integration).
+    t0 : float
+        Initial time.
+    backend, tol : str, float
+        For every impact problem, passed to :func:`impactqp.solve`.
+    progress : callable, optional
+        Called with the simulated time now and then.
+    **options
+        Moreau–Jean: ``record_every`` (int), ``keep_events`` (bool). Event-driven:
+        ``gap_tol`` (1e-10), ``rest_velocity`` (1e-7), ``method`` ("DOP853"), ``rtol``
+        (1e-12), ``atol`` (1e-14), ``max_events`` (100000), ``keep_events``.
+
+    Returns
+    -------
+    Trajectory
+        t, q, v, contact impulses, energies and every impact event with its certificate
+        and its u⁺ ∈ S verdict.
+
+    Raises
+    ------
+    InputError
+        Bad arguments (naming them); a law that does not fit the system's contacts (e.g.
+        ``SectorLawError`` for the sector law on a chain with a wall).
+    SolverError, CertificateError, NoSolutionError
+        From the integrator or from an impact no backend could certify.
+    """
+    if not isinstance(system, LinearSystem):
+        raise InputError(f"system must be an impactqp LinearSystem, got "
+                         f"{type(system).__name__}")
+    check_law(law)
+    law.check(ImpactProblem.from_structure(system.structure, np.zeros(system.n_dof)))
+    if scheme not in SCHEMES:
+        raise InputError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
+    t0 = as_real("t0", t0)
+    t_end = as_real("t_end", t_end)
+    if not t_end > t0:
+        raise InputError(f"t_end must be after t0 = {t0!r}, got {t_end!r}")
+    h = (t_end - t0) / 1000.0 if h is None else as_real("h", h, positive=True)
+    theta = as_real("theta", theta, low=0.0, high=1.0)
+    if law.forms or backend != law.closed_form_backend:
+        check_backend(backend)
+    tol = check_tol(tol)
+    if progress is not None and not callable(progress):
+        raise InputError(f"progress must be a callable, got {type(progress).__name__}")
+    opts = _options(scheme, options)
+    if scheme == "moreau-jean":
+        return moreau_jean(system, law, t_end, h, theta, t0=t0, backend=backend, tol=tol,
+                           progress=progress, **opts)
+    return event_driven(system, law, t_end, h, t0=t0, backend=backend, tol=tol,
+                        progress=progress, **opts)

@@ -1,0 +1,211 @@
+"""A linear mechanical system with unilateral contacts (docs/theory.md §14):
+
+    M q̈ = f(t, q, q̇) + H Λ̇,      g = Hᵀq + b ≥ 0,      Λ ≥ 0,
+
+with a constant symmetric positive definite mass matrix M (dense or scipy.sparse), one column
+of H per contact (the contact matrix W of every impact is H restricted to the closed contacts)
+and an external force that is a constant vector, a :class:`LinearForce` c − Kq, or any
+callable force(t, q, v).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..base.arrays import Matrix, as_matrix, as_vector
+from ..errors import InputError, MassMatrixError, ShapeError
+from ..model.builders import chain_directions
+from ..model.structure import ChainInfo, ImpactStructure
+
+Force = Callable[[float, np.ndarray, np.ndarray], Any]
+
+
+class LinearForce:
+    """The force f(q) = c − Kq of springs and of uniform fields, with its potential.
+
+    Parameters
+    ----------
+    stiffness : (n, n) array_like or scipy.sparse matrix
+        K, symmetric positive semidefinite (not checked beyond symmetry).
+    constant : (n,) array_like, optional
+        c (gravity, say); zero when omitted.
+
+    Raises
+    ------
+    ShapeError, NonFiniteError
+        K not square, c of another length, non-finite entries.
+    MassMatrixError
+        K not symmetric.
+    """
+
+    def __init__(self, stiffness: Matrix, constant: Any = None) -> None:
+        K = as_matrix("stiffness", stiffness)
+        if K.ndim != 2 or K.shape[0] != K.shape[1]:
+            raise ShapeError(f"stiffness must be a square (n, n) matrix, got shape {K.shape}")
+        asym = abs(K - K.T).max() if sp.issparse(K) else np.abs(K - K.T).max(initial=0.0)
+        scale = abs(K).max() if sp.issparse(K) else np.abs(K).max(initial=0.0)
+        if asym > 1e-12 * max(scale, 1e-300):
+            raise MassMatrixError(f"stiffness must be symmetric; max |K - Kᵀ| = {asym:.3g}")
+        n = K.shape[0]
+        self.stiffness = sp.csr_matrix(K) if sp.issparse(K) else K
+        self.constant = np.zeros(n) if constant is None else as_vector("constant", constant, n)
+
+    @property
+    def n(self) -> int:
+        """Number of degrees of freedom."""
+        return self.constant.size
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return self.constant - self.stiffness @ q
+
+    def potential(self, q: np.ndarray) -> float:
+        """V(q) = ½qᵀKq − cᵀq, so that f = −∇V."""
+        return float(0.5 * q @ (self.stiffness @ q) - self.constant @ q)
+
+
+def _check_force(force: Any, n: int) -> tuple[Force, Callable[[np.ndarray], float] | None,
+                                              np.ndarray | None]:
+    """(callable, potential or None, constant vector or None) from the user's force."""
+    if force is None:
+        force = np.zeros(n)
+    if isinstance(force, LinearForce):
+        if force.n != n:
+            raise ShapeError(f"force acts on {force.n} degrees of freedom, the system has {n}")
+        return force, force.potential, None
+    if callable(force):
+        return force, None, None
+    f = as_vector("force", force, n)
+    f.setflags(write=False)
+    return (lambda t, q, v: f), (lambda q: float(-f @ q)), f
+
+
+class LinearSystem:
+    """Motion of a linear mechanical system with unilateral contacts (docs/theory.md §14).
+
+    Parameters
+    ----------
+    M : (n, n) array_like or scipy.sparse matrix
+        Constant mass matrix, symmetric positive definite.
+    q0, v0 : (n,) array_like
+        Initial generalized positions and velocities.
+    force : (n,) array_like, LinearForce or callable, optional
+        External force: a constant vector, ``LinearForce(K, c)`` (c − Kq), or any callable
+        ``force(t, q, v)`` returning an (n,) array. Zero when omitted.
+    H : (n, m) array_like or scipy.sparse matrix, optional
+        One column per contact: gap gᵢ = Hᵢᵀq + bᵢ, open when positive (docs/theory.md §12
+        for the sign). No contact when omitted.
+    b : (m,) array_like, optional
+        Gap offsets (zero when omitted).
+    potential : callable, optional
+        V(q) with f = −∇V, for a callable force; constant and linear forces bring their own.
+        Without one the potential energy of a callable force is reported as NaN.
+    chain : ChainInfo, optional
+        Marks a 1-D chain of balls (docs/theory.md §5): M = diag(masses) and H in the column
+        order of :func:`impactqp.chain`, checked here. Chains are what the sector law and the
+        O(N) isotonic path need.
+
+    Raises
+    ------
+    ShapeError, NonFiniteError, MassMatrixError, InputError
+        On malformed input, naming the argument.
+    """
+
+    def __init__(self, M: Matrix, q0: Any, v0: Any, force: Any = None, H: Matrix = None,
+                 b: Any = None, *, potential: Callable[[np.ndarray], float] | None = None,
+                 chain: ChainInfo | None = None) -> None:
+        M = as_matrix("M", M)
+        if M.ndim != 2 or M.shape[0] != M.shape[1] or M.shape[0] == 0:
+            raise ShapeError(f"M must be a non-empty square (n, n) matrix, got shape {M.shape}")
+        n = M.shape[0]
+        H = np.zeros((n, 0)) if H is None else as_matrix("H", H)
+        if H.ndim != 2 or H.shape[0] != n:
+            raise ShapeError(f"H must have shape (n, m) = ({n}, m), one column per contact, "
+                             f"got {H.shape}")
+        norms = np.asarray(abs(H).sum(axis=0)).ravel()
+        if np.any(norms == 0):
+            raise ShapeError(f"H column(s) {np.flatnonzero(norms == 0).tolist()[:5]} are zero: "
+                             "every contact needs a non-zero direction")
+        self.structure = ImpactStructure(M, H, chain=self._check_chain(chain, M, H))
+        n, m = self.structure.n, self.structure.m
+        self.q0 = as_vector("q0", q0, n)
+        self.v0 = as_vector("v0", v0, n)
+        self.b = np.zeros(m) if b is None else as_vector("b", b, m)
+        self.force, self._potential, self.constant_force = _check_force(force, n)
+        if potential is not None:
+            if not callable(potential):
+                raise InputError(f"potential must be a callable V(q), got "
+                                 f"{type(potential).__name__}")
+            self._potential = potential
+        self.linear_force = force if isinstance(force, LinearForce) else None
+        as_vector("force(0, q0, v0)", self.force(0.0, self.q0, self.v0), n)
+        self.Ht = sp.csr_matrix(self.H.T) if self.structure.sparse else np.asarray(self.H).T
+
+    @staticmethod
+    def _check_chain(chain: Any, M: Matrix, H: Matrix) -> ChainInfo | None:
+        if chain is None:
+            return None
+        if not isinstance(chain, ChainInfo):
+            raise InputError(f"chain must be an impactqp ChainInfo, got {type(chain).__name__}")
+        n = chain.masses.size
+        Ms, Hs = sp.csr_matrix(M), sp.csr_matrix(as_matrix("H", H))
+        if Ms.shape != (n, n) or (Ms - sp.diags(chain.masses)).count_nonzero():
+            raise InputError("chain: M must be diag(chain.masses)")
+        W = chain_directions(n, left_wall=chain.left_wall, right_wall=chain.right_wall,
+                             sparse=True)
+        if Hs.shape != W.shape or (Hs - W).count_nonzero():
+            raise InputError("chain: H must hold the chain's contact directions in the order "
+                             "[left wall, q₂ − q₁, …, q_N − q_{N−1}, right wall] "
+                             "(impactqp.model.builders.chain_directions)")
+        return chain
+
+    # --- data ----------------------------------------------------------------------------
+    M = property(lambda self: self.structure.M, doc="Mass matrix (n, n).")
+    H = property(lambda self: self.structure.W, doc="Contact directions (n, m).")
+    n_dof = property(lambda self: self.structure.n, doc="Number of degrees of freedom n.")
+    n_contacts = property(lambda self: self.structure.m, doc="Number of contacts m.")
+    chain = property(lambda self: self.structure.chain, doc="ChainInfo of a 1-D chain, or None.")
+
+    # --- contact geometry and energy -----------------------------------------------------
+    def gaps(self, q: np.ndarray) -> np.ndarray:
+        """g = Hᵀq + b for a position or for every row of a (k, n) array."""
+        return np.asarray(self.Ht @ np.asarray(q).T).T + self.b
+
+    def contact_velocities(self, v: np.ndarray) -> np.ndarray:
+        """γ = Hᵀv (γᵢ > 0 opens contact i) for a velocity or every row of a (k, n) array."""
+        return np.asarray(self.Ht @ np.asarray(v).T).T
+
+    def force_at(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The external force as a float vector."""
+        return np.asarray(self.force(t, q, v), dtype=float)
+
+    def kinetic_energy(self, v: np.ndarray) -> np.ndarray | float:
+        """T = ½vᵀMv of a velocity or of every row of a (k, n) array."""
+        v = np.asarray(v, dtype=float)
+        return 0.5 * np.sum(self.structure.mass_rows(v) * v, axis=-1)
+
+    def potential_energy(self, q: np.ndarray) -> np.ndarray | float:
+        """V(q) of a position or of every row; NaN for a callable force without potential."""
+        q = np.asarray(q, dtype=float)
+        if self._potential is None:
+            return np.full(q.shape[:-1], np.nan) if q.ndim > 1 else float("nan")
+        if q.ndim == 1:
+            return float(self._potential(q))
+        K = self.linear_force
+        if K is not None:
+            return 0.5 * np.sum(np.asarray(K.stiffness @ q.T).T * q, axis=-1) - q @ K.constant
+        if self.constant_force is not None:
+            return -(q @ self.constant_force)
+        return np.array([self._potential(row) for row in q])
+
+    def energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray | float:
+        """Total mechanical energy T + V."""
+        return self.kinetic_energy(v) + self.potential_energy(q)
+
+    def __repr__(self) -> str:
+        kind = "chain" if self.chain is not None else \
+            ("sparse" if self.structure.sparse else "dense")
+        return f"LinearSystem(n_dof={self.n_dof}, n_contacts={self.n_contacts}, {kind})"

@@ -1,0 +1,190 @@
+"""The result of a simulation: states, contact impulses, energies and certified impact events
+(docs/theory.md §14), saved as NPZ or CSV."""
+
+from __future__ import annotations
+
+import csv
+import json
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ..laws.base import ImpactLaw
+from .impacts import ImpactEvent
+from .system import LinearSystem
+
+FORMATS = (".npz", ".csv")
+
+
+class Trajectory:
+    """States of a simulated system and the impacts on the way.
+
+    Attributes
+    ----------
+    system : LinearSystem
+    law : ImpactLaw
+        The law the user chose.
+    scheme : str
+        ``"moreau-jean"`` or ``"event-driven"``.
+    t : (k,) ndarray
+        Record times: every step (time-stepping), or the output grid plus the state just
+        before and just after every impact (event-driven; such times appear twice).
+    q, v : (k, n) ndarray
+        Positions and velocities.
+    impulses : (k, m) ndarray
+        Contact impulses Λ of the step ending at that record (time-stepping), or of the
+        impact just before it (event-driven); zero elsewhere.
+    events : list of ImpactEvent
+        Every impact problem solved, in order, each with its certificate.
+    settings : dict
+        The integrator's parameters.
+    """
+
+    def __init__(self, system: LinearSystem, law: ImpactLaw, scheme: str, t: np.ndarray,
+                 q: np.ndarray, v: np.ndarray, impulses: np.ndarray,
+                 events: list[ImpactEvent], settings: dict[str, Any]) -> None:
+        self.system, self.law, self.scheme = system, law, scheme
+        self.t, self.q, self.v, self.impulses = t, q, v, impulses
+        self.events = events
+        self.settings = settings
+
+    # --- derived quantities --------------------------------------------------------------
+    @property
+    def generalized_impulses(self) -> np.ndarray:
+        """p = HΛ of every record (Siconos' ``p(1)``), (k, n)."""
+        return np.asarray(self.system.H @ self.impulses.T).T
+
+    @cached_property
+    def kinetic_energy(self) -> np.ndarray:
+        """T = ½vᵀMv at every record."""
+        return np.atleast_1d(self.system.kinetic_energy(self.v))
+
+    @cached_property
+    def potential_energy(self) -> np.ndarray:
+        """V(q) at every record (NaN for a callable force without potential)."""
+        return np.atleast_1d(self.system.potential_energy(self.q))
+
+    @property
+    def total_energy(self) -> np.ndarray:
+        """T + V at every record."""
+        return self.kinetic_energy + self.potential_energy
+
+    @property
+    def gaps(self) -> np.ndarray:
+        """g = Hᵀq + b at every record, (k, m)."""
+        return np.atleast_2d(self.system.gaps(self.q))
+
+    @property
+    def impact_times(self) -> np.ndarray:
+        """Times of the recorded impact events."""
+        return np.array([e.time for e in self.events])
+
+    def energy_drift(self) -> float:
+        """max abs(E(t) − E(t₀)) / abs(E(t₀)) over the records (absolute when E(t₀) = 0)."""
+        E = self.total_energy
+        scale = abs(E[0]) if E[0] != 0 else 1.0
+        return float(np.max(np.abs(E - E[0])) / scale)
+
+    @property
+    def certified(self) -> bool:
+        """True when every impact event passed its certificate (always, when returned)."""
+        return all(e.certified for e in self.events)
+
+    def admissible(self) -> np.ndarray:
+        """u⁺ ∈ S for every event (computed on first call per event, docs/theory.md §2)."""
+        return np.array([bool(e.admissible) for e in self.events], dtype=bool)
+
+    def summary(self) -> str:
+        """A few lines: scheme, law, records, events, certificates, S-verdicts, energy."""
+        adm = self.admissible()
+        drift = self.energy_drift()
+        kept = self.settings.get("keep_events", True)
+        return "\n".join([
+            f"{self.scheme} simulation of {self.system!r} with {self.law!r}",
+            f"  t ∈ [{self.t[0]:.6g}, {self.t[-1]:.6g}], {self.t.size} records, "
+            + (f"{len(self.events)} impact problems" if kept else "impact events not kept"),
+            f"  certificates: {'all ok' if self.certified else 'FAILED'}; "
+            f"u⁺ ∈ S: {int(adm.sum())} of {adm.size}" if kept else
+            "  certificates: every impact passed (a failing one stops the run)",
+            f"  energy: {self.total_energy[0]:.10g} → {self.total_energy[-1]:.10g} "
+            f"(largest relative change {drift:.3g})",
+        ])
+
+    def __repr__(self) -> str:
+        return (f"Trajectory(scheme={self.scheme!r}, records={self.t.size}, "
+                f"events={len(self.events)})")
+
+    # --- saving --------------------------------------------------------------------------
+    def event_arrays(self) -> dict[str, np.ndarray]:
+        """The events as flat arrays (ragged fields as values plus offsets)."""
+        ev = self.events
+
+        def ragged(name: str, rows: list[np.ndarray]) -> dict[str, np.ndarray]:
+            sizes = np.array([r.size for r in rows], dtype=int)
+            flat = np.concatenate(rows) if rows else np.zeros(0)
+            return {name: flat, f"{name}_offsets": np.concatenate([[0], np.cumsum(sizes)])}
+
+        worst = [e.certificate.worst for e in ev]
+        return {
+            "event_time": np.array([e.time for e in ev], dtype=float),
+            "event_kind": np.array([e.kind for e in ev], dtype=str),
+            "event_law": np.array([e.law for e in ev], dtype=str),
+            "event_certified": np.array([e.certified for e in ev], dtype=bool),
+            "event_worst_residual": np.array([w[1] for w in worst], dtype=float),
+            "event_admissible": self.admissible(),
+            **ragged("event_dofs", [e.dofs for e in ev]),
+            **ragged("event_contacts", [e.contacts for e in ev]),
+            **ragged("event_u_minus", [e.u_minus for e in ev]),
+            **ragged("event_u_plus", [e.u_plus for e in ev]),
+            **ragged("event_impulses", [e.impulses for e in ev]),
+        }
+
+    def save(self, path: str | Path) -> Path:
+        """Write the trajectory: ``.npz`` (everything, events included) or ``.csv`` (one row
+        per record; the events go to ``<name>.events.csv`` beside it).
+
+        Raises
+        ------
+        InputError
+            Another suffix.
+        """
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix not in FORMATS:
+            raise InputError(f"trajectory file must end in one of {FORMATS}, got {path.name!r}")
+        if suffix == ".npz":
+            meta = json.dumps({"scheme": self.scheme, "law": repr(self.law),
+                               "settings": self.settings})
+            np.savez_compressed(path, t=self.t, q=self.q, v=self.v, impulses=self.impulses,
+                                kinetic_energy=self.kinetic_energy,
+                                potential_energy=self.potential_energy,
+                                meta=np.array(meta), **self.event_arrays())
+            return path
+        n, m = self.system.n_dof, self.system.n_contacts
+        header = (["t"] + [f"q{i}" for i in range(n)] + [f"v{i}" for i in range(n)]
+                  + [f"lambda{j}" for j in range(m)] + ["kinetic_energy", "potential_energy"])
+        table = np.column_stack([self.t, self.q, self.v, self.impulses, self.kinetic_energy,
+                                 self.potential_energy])
+        np.savetxt(path, table, fmt="%.17g", delimiter=",", header=",".join(header),
+                   comments="", encoding="utf-8")
+        self._save_events_csv(path.with_name(path.stem + ".events.csv"))
+        return path
+
+    def _save_events_csv(self, path: Path) -> None:
+        def joined(values: np.ndarray) -> str:
+            return " ".join(repr(float(x)) if values.dtype.kind == "f" else str(x)
+                            for x in values)
+
+        with path.open("w", newline="", encoding="utf-8") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(["time", "kind", "law", "certified", "worst_residual",
+                             "admissible", "dofs", "contacts", "u_minus", "u_plus",
+                             "impulses"])
+            for e, ok in zip(self.events, self.admissible()):
+                writer.writerow([repr(float(e.time)), e.kind, e.law, e.certified,
+                                 repr(float(e.certificate.worst[1])), bool(ok),
+                                 joined(e.dofs), joined(e.contacts), joined(e.u_minus),
+                                 joined(e.u_plus), joined(e.impulses)])
