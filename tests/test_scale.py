@@ -186,3 +186,17 @@ def test_membership_at_every_scale(v: float) -> None:
             for u in candidates:
                 want = exact_membership(q, u)
                 assert S.contains(u).member == want, (v, mu, u / v)
+
+
+@pytest.mark.parametrize("v", VELOCITY_SCALES + [1e-200, 1e200])
+def test_optimizer_membership_at_every_scale(v: float) -> None:
+    for mu in (1e-12, 1.0, 1e12):
+        p = iq.newtons_cradle(3, v=v, mass=mu)
+        S = p.admissible_set()
+        inside = [np.array([1, 1, 1]) / 3, np.array([0.0, 0.0, 1.0]), np.array([0.2, 0.3, 0.5])]
+        outside = [np.array([1.0, 0.0, 0.0]), np.array([-7.0, 0.0, 8.0]),
+                   np.array([0.0, 1.0, 0.0])]
+        for u in inside:
+            assert S.contains(u * v, method="optimizer").member, (v, mu, u)
+        for u in outside:
+            assert not S.contains(u * v, method="optimizer").member, (v, mu, u)
