@@ -8,7 +8,8 @@ one-call forms :func:`moreau`, :func:`newton`, :func:`fremond`, :func:`sector_la
 :func:`reflection_law`), many impacts at once (:func:`solve_batch`, :func:`moreau_batch`,
 :func:`sector_law_batch`), the law verifier :func:`verify_law`, LCPs with symmetric matrices
 (:func:`solve_lcp`), the geometric classification (:func:`classify`) and motion with any
-law (:class:`LinearSystem`, :func:`simulate`). The theory and the
+law (:class:`LinearSystem`, :func:`simulate`), and the dispersive LZB model of multiple
+impacts (:class:`LZB`) beside the rigid laws (:func:`compare_chain`). The theory and the
 conventions are in docs/theory.md of the repository.
 """
 
@@ -43,6 +44,9 @@ from .laws.catalogue import available_backends
 from .laws.certificate import Certificate
 from .laws.complementarity import Fremond, Newton
 from .laws.functions import fremond, moreau, newton, reflection_law, sector_law
+from .laws.lzb import LZB, LZBAnswer
+from .laws.lzb_certificate import LZBCertificate
+from .laws.lzb_integration import LZBRecord
 from .laws.moreau import Moreau
 from .laws.pipeline import solve
 from .laws.reflection import ReflectionLaw
@@ -51,6 +55,14 @@ from .laws.sector import SectorLaw, SectorLawCertificate
 from .model.admissible import AdmissibleSet, Membership
 from .model.builders import chain, newtons_cradle, random_impact
 from .model.classify import Classification, classify
+from .model.physical_chains import (
+    PhysicalChain,
+    ball_chain,
+    hertz_stiffness,
+    monodisperse_chain,
+    sphere_mass,
+    tapered_chain,
+)
 from .model.problem import ImpactProblem
 from .model.structure import ChainInfo, ImpactStructure
 from .qp.lcp import LCPResult, solve_lcp
@@ -64,6 +76,7 @@ from .tables.certificate import SectorCertificate
 from .tables.coxeter import continuous_mass_ratios
 from .tables.reflection_table import reflection_law_table
 from .tables.sector_table import SectorCone, SectorTable, sector_law_table
+from .verification.compare import LawComparison, LawOutcome, compare_chain, compare_laws
 from .verification.fremond_map import fremond_admissibility_map
 from .verification.report import Counterexample, LawReport
 from .verification.sampled import verify_law
@@ -77,16 +90,19 @@ __all__ = [
     "AdmissibleSet", "Answer", "BackendUnsuitableError", "BatchResult", "Certificate",
     "CertificateError", "ChainInfo", "Classification", "Counterexample", "DEFAULT_TOL",
     "Fremond", "ImpactError", "ImpactEvent", "ImpactLaw", "ImpactProblem", "ImpactResult",
-    "ImpactStructure", "InputError", "LCPResult", "LawReport", "LinearForce", "LinearSystem",
+    "ImpactStructure", "InputError", "LCPResult", "LZB", "LZBAnswer", "LZBCertificate",
+    "LZBRecord", "LawComparison", "LawOutcome", "LawReport", "LinearForce", "LinearSystem",
     "MassMatrixError", "Membership", "Moreau", "MoreauJeanStep", "Newton", "NoSolutionError",
     "NonConvexLCPError", "NonFiniteError", "NonSymmetricLCPError", "OptionalDependencyError",
-    "ProblemFile", "ProblemFileError", "ReflectionLaw", "ResidualChecks", "RestitutionError",
-    "SectorCertificate", "SectorCone", "SectorInputError", "SectorLaw", "SectorLawCertificate",
-    "SectorLawError", "SectorTable", "SectorTableTooLarge", "ShapeError", "SolverError",
-    "Trajectory", "UnknownBackendError", "available_backends", "bead_chain", "bouncing_ball",
-    "chain", "classify", "continuous_mass_ratios", "cradle_system", "fremond",
-    "fremond_admissibility_map", "load_problem", "moreau", "moreau_batch", "newton",
-    "newtons_cradle", "random_impact", "reflection_law", "reflection_law_table",
-    "save_problem", "sector_law", "sector_law_batch", "sector_law_table", "simulate", "solve",
-    "solve_batch", "solve_lcp", "verify_law",
+    "PhysicalChain", "ProblemFile", "ProblemFileError", "ReflectionLaw", "ResidualChecks",
+    "RestitutionError", "SectorCertificate", "SectorCone", "SectorInputError", "SectorLaw",
+    "SectorLawCertificate", "SectorLawError", "SectorTable", "SectorTableTooLarge",
+    "ShapeError", "SolverError", "Trajectory", "UnknownBackendError", "available_backends",
+    "ball_chain", "bead_chain", "bouncing_ball", "chain", "classify", "compare_chain",
+    "compare_laws", "continuous_mass_ratios", "cradle_system", "fremond",
+    "fremond_admissibility_map", "hertz_stiffness", "load_problem", "monodisperse_chain",
+    "moreau", "moreau_batch", "newton", "newtons_cradle", "random_impact", "reflection_law",
+    "reflection_law_table", "save_problem", "sector_law", "sector_law_batch",
+    "sector_law_table", "simulate", "solve", "solve_batch", "solve_lcp", "sphere_mass",
+    "tapered_chain", "verify_law",
 ]

@@ -190,4 +190,5 @@ def test_readme_table_is_the_registry() -> None:
     assert backend_table() in readme
     rows = re.findall(r"^\| `\"([a-z]+)\"` \|", readme, flags=re.M)
     assert rows == ["auto"] + BACKENDS
-    assert [law.name for law in LAWS] == ["moreau", "newton", "fremond", "sector", "reflection"]
+    assert [law.name for law in LAWS] == ["moreau", "newton", "fremond", "sector", "reflection",
+                                          "lzb"]

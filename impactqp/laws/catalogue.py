@@ -7,11 +7,12 @@ from ..qp import backends
 from ..qp.certified import FAST_PATHS
 from .base import ImpactLaw
 from .complementarity import Fremond, Newton
+from .lzb import LZB
 from .moreau import Moreau
 from .reflection import ReflectionLaw
 from .sector import SectorLaw
 
-LAWS: tuple[type[ImpactLaw], ...] = (Moreau, Newton, Fremond, SectorLaw, ReflectionLaw)
+LAWS: tuple[type[ImpactLaw], ...] = (Moreau, Newton, Fremond, SectorLaw, ReflectionLaw, LZB)
 """The law classes impactqp ships."""
 
 
@@ -29,7 +30,7 @@ def available_backends() -> list[dict]:
     list of dict
         Keys ``name``, ``installed``, ``forms``, ``exact``, ``serves``, ``install`` and
         ``laws`` (law name → forms served, empty when the law is out of its reach). Closed-
-        form laws (sector, reflection) are evaluated by ``"auto"`` only.
+        form laws (sector, reflection, LZB) are evaluated by ``"auto"`` only.
     """
     out = []
     for item in backends.available_backends():

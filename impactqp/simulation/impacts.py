@@ -18,6 +18,7 @@ from ..base.checks import DEFAULT_TOL
 from ..errors import CertificateError
 from ..laws.base import Answer, ImpactLaw
 from ..laws.complementarity import Fremond, Newton
+from ..laws.lzb import LZB
 from ..laws.moreau import Moreau
 from ..laws.pipeline import solve
 from ..laws.result import ImpactResult
@@ -83,11 +84,14 @@ class ImpactEvent:
 
 def cluster_law(law: ImpactLaw, contacts: np.ndarray) -> ImpactLaw:
     """``law`` on a subset of the system's contacts: per-contact coefficients restricted
-    (Newton's eᵢ, Frémond's E_ij within the cluster), other laws unchanged."""
+    (Newton's eᵢ, Frémond's E_ij within the cluster, LZB's stiffness and restitution),
+    other laws unchanged."""
     if isinstance(law, Newton) and law.e.size > 1:
         return Newton(law.e[contacts])
     if isinstance(law, Fremond):
         return Fremond(law.E[np.ix_(contacts, contacts)])
+    if isinstance(law, LZB):
+        return law.restrict(contacts)
     return law
 
 
