@@ -20,6 +20,9 @@ from ..model.problem import ImpactProblem
 from ..model.structure import ImpactStructure
 from ..qp.program import QPSolution, QuadraticProgram
 
+SMALL_CHAIN = 10
+"""Chains with at most this many contacts prefer the impulse form (the prepared kernel)."""
+
 
 class Answer(NamedTuple):
     """A law's answer: post-impact velocity, impulses and (Moreau's family) the projection z.
@@ -81,11 +84,13 @@ class ImpactLaw(ABC):
         the default accepts every problem."""
 
     def preferred_forms(self, problem: ImpactProblem) -> tuple[str, ...]:
-        """The forms to try, best first: the velocity form for sparse problems and chains
-        (well posed for any W, and the isotonic path), the impulse form otherwise (smaller
-        when m < n)."""
-        order = ("velocity", "impulse") if problem.structure.sparse or problem.chain \
-            else ("impulse", "velocity")
+        """The forms to try, best first: the velocity form for sparse problems and long
+        chains (well posed for any W, and the isotonic path), the impulse form otherwise
+        (smaller when m < n, and the kernel's and exact enumeration's shape: an impact that
+        closes every contact is their first candidate there, their last in velocity form)."""
+        st = problem.structure
+        long_chain = problem.chain is not None and st.m > SMALL_CHAIN
+        order = ("velocity", "impulse") if st.sparse or long_chain else ("impulse", "velocity")
         return tuple(f for f in order if f in self.forms)
 
     def program(self, problem: ImpactProblem, form: str) -> QuadraticProgram:

@@ -141,7 +141,6 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
             return result
 
     forms = (form,) if form != "auto" else law.preferred_forms(problem)
-    programs = {f: law.program(problem, f) for f in forms}
 
     def finisher(f: str):
         def finish(solution: QPSolution):
@@ -149,16 +148,31 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
             return answer, law.certificate(problem, answer, tol)
         return finish
 
-    candidates = plan(programs, {f: finisher(f) for f in forms}, backend)
-    try:
-        out = solve_certified(candidates, named=backend != "auto")
-    except NoSolutionError as exc:
-        if law.always_solvable:  # a solution exists: failing to find it is the solvers'
-            raise CertificateError(f"{law.title} has a solution for every u⁻, but no "
-                                   f"backend certified one: {exc}") from exc
-        raise
-    return _result(problem, law, out.answer, out.backend, out.checks, start, form=out.form,
-                   attempts=out.attempts)
+    # one form at a time, the preferred first: a program is built only when it is needed
+    # (the impulse form of a long chain would form its Delassus matrix for nothing)
+    unsuitable, failures, log = [], [], []
+    for f in forms:
+        try:
+            candidates = plan({f: law.program(problem, f)}, {f: finisher(f)}, backend)
+        except BackendUnsuitableError as exc:
+            unsuitable.append(str(exc))
+            continue
+        try:
+            out = solve_certified(candidates, named=backend != "auto")
+        except CertificateError as exc:
+            failures.append(str(exc))
+            log.append(f"{f} form: {exc}")
+            continue
+        except NoSolutionError as exc:
+            if law.always_solvable:  # a solution exists: failing to find it is the solvers'
+                raise CertificateError(f"{law.title} has a solution for every u⁻, but no "
+                                       f"backend certified one: {exc}") from exc
+            raise
+        return _result(problem, law, out.answer, out.backend, out.checks, start,
+                       form=out.form, attempts=log + out.attempts)
+    if failures:
+        raise CertificateError("; ".join(failures))
+    raise BackendUnsuitableError("; ".join(dict.fromkeys(unsuitable)))
 
 
 def _closed_form(problem: ImpactProblem, law: ImpactLaw, backend: str, tol: float,

@@ -155,7 +155,10 @@ class ImpactStructure:
         sum of squares would lose range)."""
         with np.errstate(over="ignore", under="ignore"):
             q = row_sum(self.mass_rows(X) * X)
-        if np.all(np.isfinite(q)) and np.min(q, initial=np.inf) > 1e-250:
+        if X.ndim == 1:
+            if 1e-250 < q < np.inf:
+                return np.sqrt(q)
+        elif np.isfinite(q).all() and q.min(initial=np.inf) > 1e-250:
             return np.sqrt(q)
         s = row_max(np.abs(X))
         safe = np.where(s > 0, s, 1.0)
@@ -180,8 +183,9 @@ class ImpactStructure:
         c = self.chain
         if c is None:
             return np.asarray(self.Minv_W @ Lam.T).T
-        pad = [(0, 0)] * (Lam.ndim - 1) + [(0 if c.left_wall else 1, 0 if c.right_wall else 1)]
-        L = np.pad(Lam, pad)
+        n = self.n
+        L = np.zeros(Lam.shape[:-1] + (n + 1,))
+        L[..., (0 if c.left_wall else 1):(n + 1 if c.right_wall else n)] = Lam
         return (L[..., :-1] - L[..., 1:]) / c.masses
 
     @cached_property
@@ -246,8 +250,21 @@ class ImpactStructure:
 
     @cached_property
     def delassus_diagonal(self) -> np.ndarray:
-        """Diagonal of G: the squared M⁻¹-length of each contact direction."""
+        """Diagonal of G: the squared M⁻¹-length of each contact direction, without forming
+        G (a chain's gap i has 1/mᵢ + 1/mᵢ₊₁, a wall 1/m of its ball)."""
+        c = self.chain
+        if c is not None:
+            inv = 1.0 / c.masses
+            parts = [inv[:1]] if c.left_wall else []
+            parts.append(inv[:-1] + inv[1:])
+            if c.right_wall:
+                parts.append(inv[-1:])
+            return np.concatenate(parts)
+        if not self.sparse:
+            return np.einsum("ij,ij->j", self.scaled_W, self.scaled_W)
+        if self.diagonal_mass:
+            return np.asarray(self.W.power(2).T @ (1.0 / self._diag)).ravel()
         G = self.delassus
-        return np.asarray(G.diagonal()).ravel() if sp.issparse(G) else np.diag(G).copy()
+        return np.asarray(G.diagonal()).ravel()
 
 
