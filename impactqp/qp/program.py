@@ -107,8 +107,8 @@ class QuadraticProgram:
 
     def kkt_residuals(self, x: np.ndarray, y: np.ndarray) -> dict[str, float]:
         """Absolute KKT residuals of a primal-dual pair (stationarity Px + c = Aᵀy)."""
-        A = self.constraint_matrix()
-        stat = self.gradient(x) - np.asarray(A.T @ y).ravel()
+        grad = self.gradient(x)
+        stat = grad - (y if self.A is None else np.asarray(self.A.T @ y).ravel())
         s = self.slack(x)
         return {
             "stationarity": float(np.max(np.abs(stat), initial=0.0)),

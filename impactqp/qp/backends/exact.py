@@ -71,7 +71,9 @@ def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None
             active = np.array(active, dtype=int)
             tried += 1
             if qp.nonnegative:
-                free = np.setdiff1d(np.arange(r), active)
+                mask = np.ones(r, dtype=bool)
+                mask[active] = False
+                free = np.flatnonzero(mask)
                 x, y = _nonneg_candidate(P, c, free)
             else:
                 x, y = _general_candidate(P, c, A, b, active)
