@@ -40,23 +40,34 @@ class ActiveSetKernel:
             raise ValueError(f"the active-set kernel takes at most {MAX_CONTACTS} contacts, "
                              f"got {m}")
         self.G, self.m = G, m
-        scale = max(np.abs(G).max(initial=0.0), 1e-300)
-        supports = []
-        for size in range(m, 0, -1):  # large supports first: impacts close most contacts
-            for J in combinations(range(m), size):
-                J = np.array(J)
-                block = G[np.ix_(J, J)]
-                if np.linalg.cond(block) > 1e12:
-                    continue
-                F = np.setdiff1d(np.arange(m), J)
-                supports.append((J, F, np.linalg.inv(block), G[np.ix_(F, J)]))
-        self.supports = supports
+        self._scale = max(np.abs(G).max(initial=0.0), 1e-300)
+        # large supports first (impacts close most contacts); each support's inverse is
+        # computed when it is first tried and kept, so a fresh kernel costs what it uses
+        self._order = [J for size in range(m, 0, -1) for J in combinations(range(m), size)]
+        self._arrays: dict[int, tuple | None] = {}
+        self._floats: dict[int, tuple | None] = {}
         self._last = 0
-        self._scale = scale
-        # the same supports on Python floats, for single small impacts (no array overhead)
-        self._float_supports = [(tuple(J.tolist()), tuple(F.tolist()),
-                                 tuple(map(tuple, inv.tolist())), tuple(map(tuple, GFJ.tolist())))
-                                for J, F, inv, GFJ in supports]
+
+    def support(self, idx: int) -> tuple | None:
+        """(J, F, G_JJ⁻¹, G_FJ) of support ``idx``, or None when G_JJ is singular."""
+        if idx not in self._arrays:
+            J = np.array(self._order[idx])
+            block = self.G[np.ix_(J, J)]
+            if np.linalg.cond(block) > 1e12:
+                self._arrays[idx] = None
+            else:
+                F = np.setdiff1d(np.arange(self.m), J)
+                self._arrays[idx] = (J, F, np.linalg.inv(block), self.G[np.ix_(F, J)])
+        return self._arrays[idx]
+
+    def _float_support(self, idx: int) -> tuple | None:
+        """:meth:`support` as tuples of Python floats."""
+        if idx not in self._floats:
+            found = self.support(idx)
+            self._floats[idx] = None if found is None else (
+                tuple(found[0].tolist()), tuple(found[1].tolist()),
+                tuple(map(tuple, found[2].tolist())), tuple(map(tuple, found[3].tolist())))
+        return self._floats[idx]
 
     def solve_floats(self, q: list[float], tol: float = _TOL) -> list[float] | None:
         """:meth:`solve` on Python floats: Λ as a list, or None when no support fits."""
@@ -64,10 +75,13 @@ class ActiveSetKernel:
         if min(q) >= 0.0:
             return [0.0] * self.m
         lam_tol, w_tol = -tol * qs / self._scale, -tol * qs
-        n_sup = len(self._float_supports)
+        n_sup = len(self._order)
         for k in range(n_sup):
             idx = (self._last + k) % n_sup
-            J, F, inv, GFJ = self._float_supports[idx]
+            found = self._float_support(idx)
+            if found is None:
+                continue
+            J, F, inv, GFJ = found
             qJ = [q[j] for j in J]
             lam_J = [-sum(a * b for a, b in zip(row, qJ)) for row in inv]
             if min(lam_J) < lam_tol:
@@ -87,10 +101,13 @@ class ActiveSetKernel:
         qs = max(float(np.abs(q).max(initial=0.0)), 1e-300)
         if np.all(q >= 0):
             return np.zeros(self.m)
-        n_sup = len(self.supports)
+        n_sup = len(self._order)
         for k in range(n_sup):
             idx = (self._last + k) % n_sup
-            J, F, inv, GFJ = self.supports[idx]
+            found = self.support(idx)
+            if found is None:
+                continue
+            J, F, inv, GFJ = found
             lam_J = -(inv @ q[J])
             if lam_J.min() < -tol * qs / self._scale:
                 continue
@@ -114,9 +131,13 @@ class ActiveSetKernel:
         qs = np.maximum(row_max(np.abs(Q)), 1e-300)
         done = row_min(Q) >= 0
         lam_tol, w_tol = -tol * qs / self._scale, -tol * qs
-        for J, F, inv, GFJ in self.supports:
+        for idx in range(len(self._order)):
             if done.all():
                 break
+            found = self.support(idx)
+            if found is None:
+                continue
+            J, F, inv, GFJ = found
             full = J.size == self.m
             LJ = (Q if full else Q[:, J]) @ (-inv.T)
             ok = ~done & (row_min(LJ) >= lam_tol)
