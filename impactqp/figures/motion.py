@@ -17,33 +17,9 @@ import numpy as np
 from ..base.arrays import as_count, as_real
 from ..errors import InputError, OptionalDependencyError
 from ..simulation.trajectory import Trajectory
+from .plots import DPI, figure_format, new_figure, save_figure
 
-FIGURE_FORMATS = {".png": "png", ".svg": "svg"}
 MOVIE_FORMATS = (".gif", ".mp4")
-DPI = 100
-
-
-def _figure(width: float, height: float) -> Any:
-    try:
-        from matplotlib.figure import Figure
-    except ImportError:
-        raise OptionalDependencyError("figures need matplotlib: pip install 'impactqp[plot]'") \
-            from None
-    return Figure(figsize=(width, height), dpi=DPI, layout="constrained")
-
-
-def _format(path: str | Path) -> str:
-    fmt = FIGURE_FORMATS.get(Path(path).suffix.lower())
-    if fmt is None:
-        raise InputError(f"figure file must end in one of {sorted(FIGURE_FORMATS)}, got "
-                         f"{Path(path).name!r}")
-    return fmt
-
-
-def _save(fig: Any, path: str | Path) -> Path:
-    fmt = _format(path)
-    fig.savefig(path, format=fmt, metadata={"Software": None} if fmt == "png" else {"Date": None})
-    return Path(path)
 
 
 def _check(trajectory: Any) -> Trajectory:
@@ -64,8 +40,8 @@ def plot_energy(trajectory: Trajectory, path: str | Path, title: str = "") -> Pa
     """Write kinetic, potential and total energy over time (PNG or SVG); impacts of an
     event-driven run are marked by thin vertical lines."""
     tr = _check(trajectory)
-    _format(path)
-    fig = _figure(6.4, 3.6)
+    figure_format(path)
+    fig = new_figure(6.4, 3.6)
     ax = fig.add_subplot()
     _impact_marks(ax, tr)
     ax.plot(tr.t, tr.kinetic_energy, lw=1.0, label="kinetic T")
@@ -75,7 +51,7 @@ def plot_energy(trajectory: Trajectory, path: str | Path, title: str = "") -> Pa
     ax.set_ylabel("energy")
     ax.legend(loc="upper right", fontsize=8)
     ax.set_title(title or f"{tr.scheme}, {tr.law!r}: energy", fontsize=10)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_positions(trajectory: Trajectory, path: str | Path, title: str = "",
@@ -83,13 +59,13 @@ def plot_positions(trajectory: Trajectory, path: str | Path, title: str = "",
     """Write the positions q_i(t) of the chosen degrees of freedom (all, up to 12, when
     omitted) over time (PNG or SVG)."""
     tr = _check(trajectory)
-    _format(path)
+    figure_format(path)
     n = tr.q.shape[1]
     chosen = np.arange(min(n, 12)) if dofs is None else np.atleast_1d(np.asarray(dofs))
     if chosen.dtype.kind not in "iu" or chosen.size == 0 or chosen.min() < 0 or \
             chosen.max() >= n:
         raise InputError(f"dofs must be indices in [0, {n - 1}], got {dofs!r}")
-    fig = _figure(6.4, 3.6)
+    fig = new_figure(6.4, 3.6)
     ax = fig.add_subplot()
     _impact_marks(ax, tr)
     for i in chosen:
@@ -98,7 +74,7 @@ def plot_positions(trajectory: Trajectory, path: str | Path, title: str = "",
     ax.set_ylabel("position")
     ax.legend(loc="upper right", fontsize=8, ncol=2)
     ax.set_title(title or f"{tr.scheme}, {tr.law!r}: positions", fontsize=10)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def cradle_frames(trajectory: Trajectory, frames: int) -> tuple[np.ndarray, np.ndarray]:
@@ -143,7 +119,7 @@ def animate_cradle(trajectory: Trajectory, path: str | Path, *, length: float = 
     length = as_real("length", length, positive=True)
     radius = as_real("radius", radius, positive=True)
     frames, fps = as_count("frames", frames, minimum=2), as_count("fps", fps, minimum=1)
-    fig = _figure(size, 0.75 * size)
+    fig = new_figure(size, 0.75 * size)
     try:
         from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
         from matplotlib.patches import Circle

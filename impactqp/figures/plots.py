@@ -39,14 +39,16 @@ COLORS = {"reaction": ("#d6e6f4", "tab:blue"), "tangent": "tab:orange", "S": "#7
 """Fill and edge colours of the regions of :func:`draw_plane`."""
 
 
-def _figure(size: float = 6.4) -> Any:
-    """A pyplot-free matplotlib Figure, or a clear error naming the extra to install."""
+def new_figure(width: float = 6.4, height: float | None = None) -> Any:
+    """A pyplot-free matplotlib Figure (square unless ``height`` is given), or a clear error
+    naming the extra to install."""
     try:
         from matplotlib.figure import Figure
     except ImportError:
         raise OptionalDependencyError("figures need matplotlib: pip install 'impactqp[plot]'") \
             from None
-    return Figure(figsize=(size, size), dpi=DPI, layout="constrained")
+    return Figure(figsize=(width, width if height is None else height), dpi=DPI,
+                  layout="constrained")
 
 
 def figure_format(path: str | Path) -> str:
@@ -74,7 +76,8 @@ def figure_format(path: str | Path) -> str:
     return fmt
 
 
-def _save(fig: Any, path: str | Path) -> Path:
+def save_figure(fig: Any, path: str | Path) -> Path:
+    """Write ``fig`` in the format of the suffix of ``path``, without time stamps."""
     fmt = figure_format(path)
     fig.savefig(path, format=fmt, metadata=_NO_DATES[fmt])
     return Path(path)
@@ -235,10 +238,10 @@ def plot_S(problem: ImpactProblem, path: str | Path,
     """
     figure_format(path)
     picture = plane_picture(problem, candidates)
-    fig = _figure()
+    fig = new_figure()
     draw_plane(picture, fig.add_subplot(), title or "S = (u⁻ + N) ∩ T_C ∩ B(0, ‖u⁻‖) in the "
                "plane u⁻ + range(M⁻¹W)", plane=plane)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_cradle(path: str | Path, v: float = 1.0) -> Path:
@@ -291,6 +294,6 @@ def plot_sectors(path: str | Path) -> Path:
         When matplotlib is not installed.
     """
     figure_format(path)
-    fig = _figure()
+    fig = new_figure()
     draw_sectors(sector_picture(), fig.add_subplot())
-    return _save(fig, path)
+    return save_figure(fig, path)
