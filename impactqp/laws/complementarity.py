@@ -7,6 +7,7 @@ has no solution; the result's certificate checks the law, ``result.admissible`` 
 
 from __future__ import annotations
 
+from abc import abstractmethod
 from typing import Any
 
 import numpy as np
@@ -43,8 +44,9 @@ class _ComplementarityLaw(ImpactLaw):
 
     forms = ("impulse",)
 
+    @abstractmethod
     def _E(self, m: int) -> np.ndarray:
-        raise NotImplementedError
+        """The law's E for m contacts: an (m,) diagonal or an (m, m) matrix."""
 
     def program(self, problem: ImpactProblem, form: str) -> QuadraticProgram:
         E, g = self._E(problem.n_contacts), problem.gamma_minus
