@@ -17,11 +17,9 @@ import numpy as np
 
 from ..base.checks import ResidualChecks
 from ..model.problem import ImpactProblem
+from ..model.programs import preferred_forms
 from ..model.structure import ImpactStructure
 from ..qp.program import QPSolution, QuadraticProgram
-
-SMALL_CHAIN = 10
-"""Chains with at most this many contacts prefer the impulse form (the prepared kernel)."""
 
 
 class Answer(NamedTuple):
@@ -84,14 +82,8 @@ class ImpactLaw(ABC):
         the default accepts every problem."""
 
     def preferred_forms(self, problem: ImpactProblem) -> tuple[str, ...]:
-        """The forms to try, best first: the velocity form for sparse problems and long
-        chains (well posed for any W, and the isotonic path), the impulse form otherwise
-        (smaller when m < n, and the kernel's and exact enumeration's shape: an impact that
-        closes every contact is their first candidate there, their last in velocity form)."""
-        st = problem.structure
-        long_chain = problem.chain is not None and st.m > SMALL_CHAIN
-        order = ("velocity", "impulse") if st.sparse or long_chain else ("impulse", "velocity")
-        return tuple(f for f in order if f in self.forms)
+        """The law's forms to try, best first (:func:`impactqp.model.programs.preferred_forms`)."""
+        return tuple(f for f in preferred_forms(problem) if f in self.forms)
 
     def program(self, problem: ImpactProblem, form: str) -> QuadraticProgram:
         """The program of ``form`` whose solution determines the law's answer."""

@@ -9,6 +9,7 @@ enough to return.
 from __future__ import annotations
 
 import time
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -24,7 +25,7 @@ from ..errors import (
 from ..model.problem import ImpactProblem
 from ..qp import backends
 from ..qp.backends import FORMS
-from ..qp.certified import plan, solve_certified
+from ..qp.certified import solve_in_forms
 from ..qp.program import QPSolution
 from . import small
 from .base import Answer, ImpactLaw
@@ -142,37 +143,21 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
 
     forms = (form,) if form != "auto" else law.preferred_forms(problem)
 
-    def finisher(f: str):
+    def stage(f: str):
         def finish(solution: QPSolution):
             answer = law.recover(problem, f, solution)
             return answer, law.certificate(problem, answer, tol)
-        return finish
+        return f, partial(law.program, problem, f), finish
 
-    # one form at a time, the preferred first: a program is built only when it is needed
-    # (the impulse form of a long chain would form its Delassus matrix for nothing)
-    unsuitable, failures, log = [], [], []
-    for f in forms:
-        try:
-            candidates = plan({f: law.program(problem, f)}, {f: finisher(f)}, backend)
-        except BackendUnsuitableError as exc:
-            unsuitable.append(str(exc))
-            continue
-        try:
-            out = solve_certified(candidates, named=backend != "auto")
-        except CertificateError as exc:
-            failures.append(str(exc))
-            log.append(f"{f} form: {exc}")
-            continue
-        except NoSolutionError as exc:
-            if law.always_solvable:  # a solution exists: failing to find it is the solvers'
-                raise CertificateError(f"{law.title} has a solution for every u⁻, but no "
-                                       f"backend certified one: {exc}") from exc
-            raise
-        return _result(problem, law, out.answer, out.backend, out.checks, start,
-                       form=out.form, attempts=log + out.attempts)
-    if failures:
-        raise CertificateError("; ".join(failures))
-    raise BackendUnsuitableError("; ".join(dict.fromkeys(unsuitable)))
+    try:
+        out = solve_in_forms([stage(f) for f in forms], backend)
+    except NoSolutionError as exc:
+        if law.always_solvable:  # a solution exists: failing to find it is the solvers'
+            raise CertificateError(f"{law.title} has a solution for every u⁻, but no "
+                                   f"backend certified one: {exc}") from exc
+        raise
+    return _result(problem, law, out.answer, out.backend, out.checks, start, form=out.form,
+                   attempts=out.attempts)
 
 
 def _closed_form(problem: ImpactProblem, law: ImpactLaw, backend: str, tol: float,

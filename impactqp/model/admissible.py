@@ -26,10 +26,10 @@ from ..base.arrays import as_vector, check_tol
 from ..base.checks import DEFAULT_TOL, NamedChecks
 from ..errors import InputError
 from ..qp.backends.clarabel_ import run as run_clarabel
-from ..qp.certified import plan, solve_certified
+from ..qp.certified import solve_in_forms
 from ..qp.lcp import solve_psd_lcp
 from ..qp.program import QPSolution
-from .programs import impulse_program, velocity_program
+from .programs import impulse_program, preferred_forms, velocity_program
 from .residuals import law_residuals
 
 OPTIMIZER_TOL = 1e-6
@@ -143,12 +143,10 @@ class AdmissibleSet:
         u = p.u_minus
         if st.m == 0 or not np.any(u):
             return u.copy(), np.zeros_like(u)
-        forms = ("velocity", "impulse") if st.sparse or st.chain else ("impulse", "velocity")
-        programs = {"velocity": velocity_program(p), "impulse": impulse_program(
-            p, p.gamma_minus, 1.0)}
-        programs = {f: programs[f] for f in forms}
+        build = {"velocity": lambda: velocity_program(p),
+                 "impulse": lambda: impulse_program(p, p.gamma_minus, 1.0)}
 
-        def finisher(form: str):
+        def finish_for(form: str):
             def finish(sol: QPSolution):
                 if form == "velocity":
                     z, lam = sol.x, sol.y
@@ -158,8 +156,8 @@ class AdmissibleSet:
                 return z, NamedChecks({k: float(v) for k, v in res.items()}, tol)
             return finish
 
-        out = solve_certified(plan(programs, {f: finisher(f) for f in forms}, "auto"),
-                              named=False)
+        out = solve_in_forms([(f, build[f], finish_for(f)) for f in preferred_forms(p)],
+                             "auto")
         return out.answer, u - out.answer
 
     # --- exact membership -------------------------------------------------------------

@@ -42,3 +42,17 @@ def velocity_program(problem: Any) -> QuadraticProgram:
     shape = None if c is None else ChainShape(c.masses, c.left_wall, c.right_wall)
     return QuadraticProgram(P=st.M, c=-st.mass_rows(problem.u_minus), A=A, b=np.zeros(st.m),
                             cache_owner=st, cache_tag="velocity", chain=shape)
+
+
+SMALL_CHAIN = 10
+"""Chains with at most this many contacts prefer the impulse form (the prepared kernel)."""
+
+
+def preferred_forms(problem: Any) -> tuple[str, str]:
+    """The two forms, best first: the velocity form for sparse problems and long chains
+    (well posed for any W, and the isotonic path), the impulse form otherwise (smaller when
+    m < n, and the kernel's and exact enumeration's shape: an impact that closes every
+    contact is their first candidate there, their last in velocity form)."""
+    st = problem.structure
+    long_chain = problem.chain is not None and st.m > SMALL_CHAIN
+    return ("velocity", "impulse") if st.sparse or long_chain else ("impulse", "velocity")

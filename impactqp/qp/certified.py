@@ -97,44 +97,61 @@ def _auto_order(qp: QuadraticProgram, form: str) -> list[str]:
     return names
 
 
-def plan(programs: dict[str, QuadraticProgram], finishers: dict[str, Finish],
-         backend: str) -> list[Candidate]:
-    """Candidates for the programs of each form (in order of preference).
-
-    ``backend="auto"`` interleaves the auto order of each form (one candidate per backend,
-    on the first form it suits); a named backend is tried on every form it suits, the
-    preferred one first (quadprog, say, refuses the singular impulse form of redundant
-    contacts and solves their velocity form).
+def plan(form: str, qp: QuadraticProgram, finish: Finish, backend: str) -> list[Candidate]:
+    """The candidates for one program: the auto order, or the named backend alone.
 
     Raises
     ------
     UnknownBackendError
         Unknown or uninstalled backend.
     BackendUnsuitableError
-        A named backend that suits none of the programs (the message says why).
+        A named backend that cannot take the program (the message says why).
     """
     if backend == "auto":
-        per_form = [(form, auto_order(qp, form)) for form, qp in programs.items()]
-        fast = [(n, f) for n in FAST_PATHS for f, names in per_form if n in names]
-        rest = [(n, f) for f, names in per_form for n in names if n not in FAST_PATHS]
-        out: list[Candidate] = []
-        seen: set[str] = set()
-        for name, form in fast + rest:  # the preferred form first, the others after
-            if name not in seen:
-                seen.add(name)
-                out.append(Candidate(name, form, programs[form], finishers[form]))
-        return out
+        return [Candidate(name, form, qp, finish) for name in auto_order(qp, form)]
     entry, _ = backends.parse_backend(backend)
-    reasons, out = [], []
-    for form, qp in programs.items():  # every form it suits, preferred first
-        reason = backends.unsuitable(entry, qp, form)
-        if reason is None:
-            out.append(Candidate(backend, form, qp, finishers[form]))
-        else:
-            reasons.append(reason)
-    if not out:
-        raise BackendUnsuitableError("; ".join(dict.fromkeys(reasons)))
-    return out
+    reason = backends.unsuitable(entry, qp, form)
+    if reason is not None:
+        raise BackendUnsuitableError(reason)
+    return [Candidate(backend, form, qp, finish)]
+
+
+Stage = tuple[str, Callable[[], QuadraticProgram], Finish]
+
+
+def solve_in_forms(stages: Sequence[Stage], backend: str) -> Outcome:
+    """Solve the first form (form, build the program, finish) that gives a certified answer;
+    a program is built only when its form is reached (the impulse form of a long chain
+    would form its Delassus matrix for nothing).
+
+    Raises
+    ------
+    UnknownBackendError
+        Unknown or uninstalled backend.
+    BackendUnsuitableError
+        A named backend that suits none of the forms (the message says why).
+    NoSolutionError
+        An impulse-form LCP without a feasible point.
+    CertificateError
+        No form and backend gave an answer within the certificate's tolerance.
+    """
+    unsuitable, failures, log = [], [], []
+    for form, build, finish in stages:
+        try:
+            candidates = plan(form, build(), finish, backend)
+        except BackendUnsuitableError as exc:
+            unsuitable.append(str(exc))
+            continue
+        try:
+            out = solve_certified(candidates, named=backend != "auto")
+        except CertificateError as exc:
+            failures.append(str(exc))
+            log.append(f"{form} form: {exc}")
+            continue
+        return Outcome(out.answer, out.checks, out.backend, out.form, log + out.attempts)
+    if failures:
+        raise CertificateError("; ".join(failures))
+    raise BackendUnsuitableError("; ".join(dict.fromkeys(unsuitable)))
 
 
 def lcp_feasible(qp: QuadraticProgram) -> bool:

@@ -18,7 +18,7 @@ from ..base.arrays import as_array, check_tol
 from ..base.checks import DEFAULT_TOL, NamedChecks, ResidualChecks
 from ..errors import NonConvexLCPError, NonSymmetricLCPError, NoSolutionError, ShapeError
 from . import backends
-from .certified import plan, solve_certified
+from .certified import solve_in_forms
 from .program import QPSolution, QuadraticProgram
 
 
@@ -179,8 +179,7 @@ def solve_psd_lcp(G: Any, q: np.ndarray, backend: str = "auto", *,
         w, res = _residuals(Gn, qn, z)
         return (z, w, res), NamedChecks(res, tol)
 
-    out = solve_certified(plan({"impulse": qp}, {"impulse": finish}, backend),
-                          named=backend != "auto")
+    out = solve_in_forms([("impulse", lambda: qp, finish)], backend)
     z, w, res = out.answer
     return LCPResult(z=z * (q_scale / g_scale), w=w * q_scale, error=res["natural_map"],
                      residuals=res, backend=out.backend, tol=tol, attempts=out.attempts,
