@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import impactqp as iq
-from impactqp.laws import small
+from impactqp.laws import small, unrolled
 
 
 def cases():
@@ -52,9 +52,64 @@ def test_float_path_is_taken_and_declines_out_of_range() -> None:
 
 
 def test_a_failing_float_answer_is_not_returned(monkeypatch) -> None:
-    p = iq.newtons_cradle(3)
-    kernel = small.prepared_for(p.structure, "impulse", p.structure.delassus)
-    monkeypatch.setattr(kernel, "solve_floats", lambda q, tol=0: [0.0, 0.0])  # no impulse
+    """A program compiled from a wrong kernel (every inverse halved: Λ half the impulse) finds
+    candidates, but its own residual checks refuse them; the general path answers."""
+    from impactqp.qp.active_set import ActiveSetKernel
+
+    honest = ActiveSetKernel.support
+
+    def halved(self, idx):
+        found = honest(self, idx)
+        return None if found is None else (found[0], found[1], 0.5 * found[2], found[3])
+
+    monkeypatch.setattr(ActiveSetKernel, "support", halved)
+    p = iq.newtons_cradle(3)  # a fresh structure: its program is compiled now, wrongly
+    program = unrolled.program_for(p.structure, "moreau", small._kernel)
+    assert program(p.u_minus.tolist(), (1.0,), 1e-9) is None
+    assert program(p.u_minus.tolist(), (1.0,), 0.9) is not None  # it did find a candidate
+    monkeypatch.undo()
     r = iq.moreau(p, 1.0)
-    assert "on floats" not in r.attempts[-1]
+    assert "on floats" not in r.attempts[-1] and r.certificate.ok
     np.testing.assert_allclose(r.u_plus, [-1 / 3, 2 / 3, 2 / 3])
+
+
+def test_programs_are_kept_per_structure_and_released() -> None:
+    import gc
+
+    p = iq.newtons_cradle(4)
+    first = unrolled.program_for(p.structure, "newton", small._kernel)
+    assert unrolled.program_for(p.structure, "newton", small._kernel) is first
+    key = (id(p.structure), "newton")
+    assert key in unrolled._PROGRAMS
+    del p, first
+    gc.collect()
+    assert key not in unrolled._PROGRAMS
+    with pytest.raises(ValueError, match="kind"):
+        unrolled.program_for(iq.newtons_cradle(3).structure, "sector", small._kernel)
+
+
+def test_the_certificate_is_built_on_first_read_from_the_checked_residuals() -> None:
+    p = iq.newtons_cradle(3)
+    r = iq.moreau(p, 0.5)
+    assert not isinstance(r._certificate, iq.Certificate)  # not built yet
+    cert = r.certificate
+    assert isinstance(cert, iq.Certificate) and r.certificate is cert and cert.ok
+    assert set(cert.residuals) == {"momentum", "impulse_sign", "law_feasibility",
+                                   "complementarity", "energy_balance", "duality_gap"}
+    assert isinstance(r.z, np.ndarray) and r.z is r.z
+    np.testing.assert_allclose(r.z, [1 / 3] * 3)
+
+
+@pytest.mark.parametrize("n, m", [(1, 1), (2, 1), (5, 4), (12, 4)])
+def test_compiled_programs_of_every_small_shape(n, m) -> None:
+    if n == 1:
+        p = iq.chain([2.0], [-1.5], left_wall=True)
+    else:
+        p = iq.random_impact(n, m, seed=n + m)
+    for law in (iq.Moreau(0.3), iq.Newton(0.7), iq.Fremond(0.2 * np.eye(m))):
+        r = iq.solve(p, law)
+        ref = iq.solve(p, law, backend="exact")
+        np.testing.assert_allclose(r.u_plus, ref.u_plus, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(r.impulses, ref.impulses, rtol=1e-7,
+                                   atol=1e-9 * np.abs(ref.impulses).max())
+        assert r.attempts == ["kernel (impulse, on floats): certified"]

@@ -173,6 +173,8 @@ def as_count(name: str, value: Any, *, minimum: int = 0) -> int:
 
 def check_tol(tol: Any, name: str = "tol") -> float:
     """A certificate tolerance: a real number in (0, 1)."""
+    if type(tol) is float and 0.0 < tol < 1.0:  # the common case, without conversions
+        return tol
     t = as_real(name, tol)
     if not 0.0 < t < 1.0:
         raise InputError(f"{name} must be a tolerance in (0, 1), got {tol!r}")

@@ -29,6 +29,8 @@ def check_eps(value: Any) -> float:
     RestitutionError
         Not one real number in [0, 1] (NaN, strings, booleans, arrays included).
     """
+    if type(value) is float and 0.0 <= value <= 1.0:  # the common case, without conversions
+        return value
     try:
         e = as_real("eps", value)
     except ValueError as exc:

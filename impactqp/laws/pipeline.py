@@ -44,7 +44,7 @@ def check_problem(problem: Any) -> ImpactProblem:
 
 def check_law(law: Any) -> ImpactLaw:
     """``law`` itself, or InputError when it is not an impact law object."""
-    if not isinstance(law, ImpactLaw):
+    if ImpactLaw not in type(law).__mro__:  # isinstance, without the ABC machinery
         raise InputError(f"law must be an impact law object such as iq.Moreau(0.5), "
                          f"iq.Newton(e), iq.Fremond(E) or iq.SectorLaw(), got "
                          f"{type(law).__name__}")
@@ -130,16 +130,16 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
     check_form(law, form)
     tol = check_tol(tol)
     law.check(problem)
+    if small.applies(problem, law, backend, form):  # declines when u⁻ = 0
+        result = small.solve_small(problem, law, tol, start)
+        if result is not None:
+            return result
     if problem.n_contacts == 0 or not problem.u_minus.any():
         answer = _trivial(problem)
         return _result(problem, law, answer, "none", law.certificate(problem, answer, tol),
                        start, attempts=["no contact or u⁻ = 0: u⁺ = u⁻, Λ = 0"])
     if not law.forms:
         return _closed_form(problem, law, backend, tol, start)
-    if small.applies(problem, law, backend, form):
-        result = small.solve_small(problem, law, tol, start)
-        if result is not None:
-            return result
 
     forms = (form,) if form != "auto" else law.preferred_forms(problem)
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import cached_property
 from typing import Any
 
@@ -35,7 +36,8 @@ class ImpactResult:
     backend : str
         What produced the numbers (e.g. ``"nnls"``, ``"clarabel"``, ``"exact"``).
     certificate : Certificate or SectorLawCertificate
-        Recomputed residuals of the law that was solved.
+        Recomputed residuals of the law that was solved. A fast path may pass a callable
+        that builds it from residuals it has already checked; it is called on first read.
     form : str or None
         ``"velocity"`` or ``"impulse"`` for laws solved through a program.
     z : (n,) ndarray
@@ -52,8 +54,9 @@ class ImpactResult:
     """
 
     def __init__(self, problem: ImpactProblem, law: str, coefficients, u_plus: np.ndarray,
-                 impulses: np.ndarray, backend: str, certificate: ResidualChecks, *,
-                 form: str | None = None, z: np.ndarray | None = None,
+                 impulses: np.ndarray, backend: str,
+                 certificate: ResidualChecks | Callable[[], ResidualChecks], *,
+                 form: str | None = None, z: np.ndarray | tuple | None = None,
                  attempts: list[str] | None = None, impact_law: Any = None,
                  solve_time: float = 0.0) -> None:
         self.problem = problem
@@ -64,12 +67,20 @@ class ImpactResult:
         self.u_plus = u_plus
         self.impulses = impulses
         self.backend = backend
-        self.certificate = certificate
+        self._certificate = certificate
         self.form = form
         self.attempts = attempts or []
         self._z = z
 
     status = "solved"
+
+    @property
+    def certificate(self) -> ResidualChecks:
+        """The recomputed residuals of the law that was solved (see the class docstring)."""
+        cert = self._certificate
+        if not isinstance(cert, ResidualChecks):
+            cert = self._certificate = cert()
+        return cert
 
     @property
     def ok(self) -> bool:
@@ -92,7 +103,12 @@ class ImpactResult:
     @property
     def z(self) -> np.ndarray:
         """z = prox_{T_C}(u⁻), the least-energy point of S (docs/theory.md §3)."""
-        return self._z if self._z is not None else self.problem.moreau_split[0]
+        z = self._z
+        if z is None:
+            return self.problem.moreau_split[0]
+        if not isinstance(z, np.ndarray):  # a fast path's floats, converted when first read
+            z = self._z = np.array(z, dtype=float)
+        return z
 
     @property
     def z_perp(self) -> np.ndarray:

@@ -21,7 +21,8 @@ import numpy as np
 from ..base.rowwise import row_max, row_min
 
 MAX_CONTACTS = 10
-_TOL = 1e-12
+SUPPORT_TOL = 1e-12
+"""Relative slack with which a support is accepted (Λ_J ≥ −tol·‖q‖/‖G‖, w_F ≥ −tol·‖q‖)."""
 
 
 class ActiveSetKernel:
@@ -40,13 +41,17 @@ class ActiveSetKernel:
             raise ValueError(f"the active-set kernel takes at most {MAX_CONTACTS} contacts, "
                              f"got {m}")
         self.G, self.m = G, m
-        self._scale = max(np.abs(G).max(initial=0.0), 1e-300)
+        self.scale = max(np.abs(G).max(initial=0.0), 1e-300)
         # large supports first (impacts close most contacts); each support's inverse is
         # computed when it is first tried and kept, so a fresh kernel costs what it uses
         self._order = [J for size in range(m, 0, -1) for J in combinations(range(m), size)]
         self._arrays: dict[int, tuple | None] = {}
-        self._floats: dict[int, tuple | None] = {}
         self._last = 0
+
+    @property
+    def n_supports(self) -> int:
+        """How many supports there are (2^m − 1, largest first; see :meth:`support`)."""
+        return len(self._order)
 
     def support(self, idx: int) -> tuple | None:
         """(J, F, G_JJ⁻¹, G_FJ) of support ``idx``, or None when G_JJ is singular."""
@@ -60,43 +65,7 @@ class ActiveSetKernel:
                 self._arrays[idx] = (J, F, np.linalg.inv(block), self.G[np.ix_(F, J)])
         return self._arrays[idx]
 
-    def _float_support(self, idx: int) -> tuple | None:
-        """:meth:`support` as tuples of Python floats."""
-        if idx not in self._floats:
-            found = self.support(idx)
-            self._floats[idx] = None if found is None else (
-                tuple(found[0].tolist()), tuple(found[1].tolist()),
-                tuple(map(tuple, found[2].tolist())), tuple(map(tuple, found[3].tolist())))
-        return self._floats[idx]
-
-    def solve_floats(self, q: list[float], tol: float = _TOL) -> list[float] | None:
-        """:meth:`solve` on Python floats: Λ as a list, or None when no support fits."""
-        qs = max(max(q), -min(q))
-        if min(q) >= 0.0:
-            return [0.0] * self.m
-        lam_tol, w_tol = -tol * qs / self._scale, -tol * qs
-        n_sup = len(self._order)
-        for k in range(n_sup):
-            idx = (self._last + k) % n_sup
-            found = self._float_support(idx)
-            if found is None:
-                continue
-            J, F, inv, GFJ = found
-            qJ = [q[j] for j in J]
-            lam_J = [-sum(a * b for a, b in zip(row, qJ)) for row in inv]
-            if min(lam_J) < lam_tol:
-                continue
-            if F and min(sum(a * b for a, b in zip(row, lam_J)) + q[f]
-                         for row, f in zip(GFJ, F)) < w_tol:
-                continue
-            self._last = idx
-            lam = [0.0] * self.m
-            for j, value in zip(J, lam_J):
-                lam[j] = value if value > 0.0 else 0.0
-            return lam
-        return None
-
-    def solve(self, q: np.ndarray, tol: float = _TOL) -> np.ndarray | None:
+    def solve(self, q: np.ndarray, tol: float = SUPPORT_TOL) -> np.ndarray | None:
         """Return Λ solving the LCP, or None when no invertible support fits."""
         qs = max(float(np.abs(q).max(initial=0.0)), 1e-300)
         if np.all(q >= 0):
@@ -109,7 +78,7 @@ class ActiveSetKernel:
                 continue
             J, F, inv, GFJ = found
             lam_J = -(inv @ q[J])
-            if lam_J.min() < -tol * qs / self._scale:
+            if lam_J.min() < -tol * qs / self.scale:
                 continue
             if F.size and (GFJ @ lam_J + q[F]).min() < -tol * qs:
                 continue
@@ -120,7 +89,8 @@ class ActiveSetKernel:
 
         return None
 
-    def solve_batch(self, Q: np.ndarray, tol: float = _TOL) -> tuple[np.ndarray, np.ndarray]:
+    def solve_batch(self, Q: np.ndarray,
+                    tol: float = SUPPORT_TOL) -> tuple[np.ndarray, np.ndarray]:
         """Solve k LCPs with the rows of Q (k × m) as q; return (Λ (k × m), solved mask).
 
         Every support is tried on all rows at once (dense products beat row gathers for the
@@ -130,7 +100,7 @@ class ActiveSetKernel:
         lam = np.zeros((k, self.m))
         qs = np.maximum(row_max(np.abs(Q)), 1e-300)
         done = row_min(Q) >= 0
-        lam_tol, w_tol = -tol * qs / self._scale, -tol * qs
+        lam_tol, w_tol = -tol * qs / self.scale, -tol * qs
         for idx in range(len(self._order)):
             if done.all():
                 break
