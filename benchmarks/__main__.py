@@ -1,4 +1,4 @@
-"""``python -m benchmarks run --suite smoke|quick|full [--out DIR]``."""
+"""``python -m benchmarks run --suite smoke|quick|full [--out DIR] [--n-jobs N]``."""
 
 from __future__ import annotations
 
@@ -9,6 +9,13 @@ from pathlib import Path
 from .families import SUITES
 from .peers import SICONOS_PYTHON
 from .runner import run_suite
+
+
+def _jobs(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"--n-jobs must be at least 1, got {value}")
+    return value
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -23,9 +30,12 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--siconos-python", default=SICONOS_PYTHON,
                      help="interpreter that imports siconos ('' skips the peer)")
     run.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    run.add_argument("--n-jobs", type=_jobs, default=2,
+                     help="local processes of the sweep benchmark, timed against one "
+                          "(default 2)")
     args = parser.parse_args(argv)
     run_suite(args.suite, args.out, siconos_python=args.siconos_python,
-              progress=not args.no_progress)
+              progress=not args.no_progress, n_jobs=args.n_jobs)
     print(f"wrote {args.out}/results.csv, results.json, summary.md, plot.png")
     return 0
 

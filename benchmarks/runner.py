@@ -22,7 +22,7 @@ TIMING = {"smoke": (0.01, 10), "quick": (0.02, 30), "full": (0.3, 500)}
 
 def run_suite(suite: str, out_dir: Path | str, *, methods: Sequence[Method] | None = None,
               siconos_python: str = peers.SICONOS_PYTHON,
-              progress: bool = True) -> list[dict[str, Any]]:
+              progress: bool = True, n_jobs: int = 2) -> list[dict[str, Any]]:
     """Run ``suite`` and write results.csv, results.json, summary.md and plot.png.
 
     Parameters
@@ -37,6 +37,9 @@ def run_suite(suite: str, out_dir: Path | str, *, methods: Sequence[Method] | No
     progress : bool
         Show a progress bar on stderr when stderr is a terminal (never in logs: no
         carriage returns are written to a file or pipe).
+    n_jobs : int
+        Local processes of the scaled-out sweep, timed against one process (timed methods
+        always run one at a time: parallel timings would disturb each other).
 
     Returns
     -------
@@ -73,8 +76,8 @@ def run_suite(suite: str, out_dir: Path | str, *, methods: Sequence[Method] | No
         records += peers.run_siconos(peer_cases, budget=budget, max_repeats=max_repeats,
                                      python=siconos_python)
     bar.update()
-    bar.set_postfix_str("sweeps on 1 and 2 processes", refresh=False)
-    records += run_sweeps(suite)
+    bar.set_postfix_str(f"sweeps on 1 and {n_jobs} processes", refresh=False)
+    records += run_sweeps(suite, n_jobs)
     bar.close()
     meta = {"suite": suite, "seconds": round(time.perf_counter() - started, 1),
             "timing_budget_s": budget, "max_repeats": max_repeats,

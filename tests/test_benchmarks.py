@@ -102,3 +102,21 @@ def test_plot_keeps_methods_apart(smoke):
         looks = {(styles[m]["color"], styles[m]["marker"]) for m in members}
         assert len(looks) == len(members)  # no two methods of a panel look alike
     assert report._size_label(100_000) == "10$^{5}$" and report._size_label(50) == "50"
+
+
+def test_sweep_worker_count_is_an_option(capsys):
+    from benchmarks.__main__ import main
+    from benchmarks.report import targets
+    from benchmarks.sweeps import run_sweeps
+
+    with pytest.raises(SystemExit) as exc:
+        main(["run", "--n-jobs", "0"])
+    assert exc.value.code == 2 and "--n-jobs must be at least 1" in capsys.readouterr().err
+    rows = run_sweeps("quick", n_jobs=3)
+    assert [r["method"] for r in rows] == ["iq:fremond_map n_jobs=1", "iq:fremond_map n_jobs=3"]
+    assert all(r["status"] == "ok" for r in rows)  # identical maps
+    for r in rows:
+        r["median_s"] = sorted(r["times"])[len(r["times"]) // 2]
+    (line,) = [t for t in targets(rows) if t[0].startswith("sweep")]
+    assert "3 local processes" in line[0] and line[2] == "identical"
+    assert run_sweeps("smoke") == []
