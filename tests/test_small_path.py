@@ -10,6 +10,12 @@ import impactqp as iq
 from impactqp.laws import small, unrolled
 
 
+@pytest.fixture(autouse=True)
+def compile_at_once(monkeypatch):
+    """Programs compiled at a structure's first solve, so each test's first call is tested."""
+    monkeypatch.setattr(unrolled, "COMPILE_AFTER", 1)
+
+
 def cases():
     rng = np.random.default_rng(5)
     for seed in range(12):
@@ -71,6 +77,16 @@ def test_a_failing_float_answer_is_not_returned(monkeypatch) -> None:
     r = iq.moreau(p, 1.0)
     assert "on floats" not in r.attempts[-1] and r.certificate.ok
     np.testing.assert_allclose(r.u_plus, [-1 / 3, 2 / 3, 2 / 3])
+
+
+def test_programs_are_compiled_for_structures_in_use(monkeypatch) -> None:
+    """Structures met once or twice (compiling costs ~100 solves) go by the array path."""
+    monkeypatch.setattr(unrolled, "COMPILE_AFTER", 3)
+    p = iq.newtons_cradle(3)
+    paths = [iq.moreau(p.with_u_minus([1.0, 0.0, -k]), 0.5).attempts[-1] for k in range(4)]
+    assert paths[:2] == ["kernel (impulse): certified"] * 2
+    assert paths[2:] == ["kernel (impulse, on floats): certified"] * 2
+    assert iq.newton(p, 0.5).attempts[-1] == "kernel (impulse): certified"  # per law kind
 
 
 def test_programs_are_kept_per_structure_and_released() -> None:

@@ -69,6 +69,8 @@ def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float,
     """
     st = problem.structure
     program = program_for(st, _KINDS[type(law)], _kernel)
+    if program is None:  # not compiled yet for this structure
+        return None
     out = program(problem.u_minus.tolist(), _coefficients(law, st.m), tol)
     if out is None:
         return None

@@ -38,14 +38,20 @@ program declines and the general path, which rescales, answers."""
 
 FloatProgram = Callable[[Sequence[float], Sequence[float], float], tuple | None]
 
-_PROGRAMS: dict[tuple[int, str], FloatProgram] = {}
-"""Compiled programs by (id of the structure, kind); an entry leaves when its structure is
-collected (before the id can be reused)."""
+COMPILE_AFTER = 3
+"""A structure's program is compiled at its third solve by a law of one kind. Compiling
+costs 1–5 ms (as much as ~100 solves), so structures met once or twice (a simulation's
+changing contact sets) are answered by the array path instead."""
+
+_PROGRAMS: dict[tuple[int, str], FloatProgram | int] = {}
+"""By (id of the structure, kind): its compiled program, or how often it was asked for so
+far. An entry leaves when its structure is collected (before the id can be reused)."""
 
 
 def program_for(structure: ImpactStructure, kind: str,
-                kernel: Callable[[ImpactStructure], ActiveSetKernel]) -> FloatProgram:
-    """The compiled program of ``structure`` for a law of ``kind``, made on first use.
+                kernel: Callable[[ImpactStructure], ActiveSetKernel]) -> FloatProgram | None:
+    """The compiled program of ``structure`` for a law of ``kind``, once it has been asked
+    for :data:`COMPILE_AFTER` times (None before).
 
     Parameters
     ----------
@@ -59,7 +65,7 @@ def program_for(structure: ImpactStructure, kind: str,
 
     Returns
     -------
-    callable
+    callable or None
         ``program(u_minus, coefficients, tol)`` with u⁻ as n floats and the coefficients as
         (ε,), (e₁, …, e_m) or E row by row; it returns ``(u⁺, Λ, z, residuals)`` (tuples of
         floats, z None except for Moreau's law, residuals in the order of
@@ -67,13 +73,18 @@ def program_for(structure: ImpactStructure, kind: str,
         support fits or a residual misses ``tol``.
     """
     key = (id(structure), kind)
-    program = _PROGRAMS.get(key)
-    if program is None:
-        if kind not in KINDS:
-            raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
-        program = _PROGRAMS[key] = _compile(structure, kind, kernel(structure))
+    program = _PROGRAMS.get(key, 0)
+    if type(program) is not int:
+        return program
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+    if program == 0:
         weakref.finalize(structure, _PROGRAMS.pop, key, None)
-    return program
+    if program + 1 < COMPILE_AFTER:
+        _PROGRAMS[key] = program + 1
+        return None
+    compiled = _PROGRAMS[key] = _compile(structure, kind, kernel(structure))
+    return compiled
 
 
 def _combination(coefficients: Sequence[float], names: Sequence[str]) -> str:
