@@ -129,3 +129,15 @@ def test_compiled_programs_of_every_small_shape(n, m) -> None:
         np.testing.assert_allclose(r.impulses, ref.impulses, rtol=1e-7,
                                    atol=1e-9 * np.abs(ref.impulses).max())
         assert r.attempts == ["kernel (impulse, on floats): certified"]
+
+
+def test_operators_beyond_float_literals_are_not_compiled() -> None:
+    p = iq.newtons_cradle(3)
+    rows = p.structure.float_rows
+    p.structure.__dict__["float_rows"] = rows._replace(M=((np.inf, 0.0, 0.0),) + rows.M[1:])
+    program = unrolled.program_for(p.structure, "moreau", small._kernel)
+    assert program is unrolled._declines and program([1.0, 0.0, 0.0], (0.5,), 1e-9) is None
+    del p.structure.__dict__["float_rows"]
+    r = iq.moreau(p, 0.5)  # the array path answers
+    assert r.attempts[-1] == "kernel (impulse): certified"
+    np.testing.assert_allclose(r.u_plus, [0.0, 0.5, 0.5], atol=1e-15)

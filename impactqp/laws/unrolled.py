@@ -25,6 +25,8 @@ import math
 import weakref
 from collections.abc import Callable, Sequence
 
+import numpy as np
+
 from ..model.structure import ImpactStructure
 from ..qp.active_set import SUPPORT_TOL, ActiveSetKernel
 
@@ -148,8 +150,20 @@ def _law_terms(kind: str, m: int) -> list[str]:
             for i in range(m)]
 
 
+def _finite(values) -> bool:
+    """Every entry finite (constants must be float literals)."""
+    return bool(np.isfinite(np.asarray(values, dtype=float)).all())
+
+
+def _declines(u: Sequence[float], e: Sequence[float], tol: float) -> None:
+    """The program of a structure that cannot be written with float literals."""
+    return None
+
+
 def _compile(structure: ImpactStructure, kind: str, kernel: ActiveSetKernel) -> FloatProgram:
     rows = structure.float_rows
+    if not all(map(_finite, (*rows, [kernel.scale]))):
+        return _declines  # operators beyond the float range (extreme units): arrays rescale
     n, m = structure.n, structure.m
     u, q, lam = _names("u", n), _names("q", m), _names("l", m)
     p, d = _names("p", n), _names("d", n)
@@ -158,7 +172,7 @@ def _compile(structure: ImpactStructure, kind: str, kernel: ActiveSetKernel) -> 
     supports = []
     for index in range(kernel.n_supports):
         found = kernel.support(index)
-        if found is not None:
+        if found is not None and _finite(found[2]) and _finite(found[3]):
             lines += _support_source(index, found, m)
             supports.append(index)
     low, high = SCALE_RANGE
