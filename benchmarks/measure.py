@@ -100,7 +100,11 @@ def measure(method: Method, case: Case, *, budget: float, max_repeats: int) -> d
         with quiet_stdout():
             solve, finish = method.prepare(case)
             raw, peak = _first_run(solve, case.work >= LARGE)
-            u_plus = finish(raw)
+            err, output_mb = relative_error(case, finish(raw), law=method.law), output_size(raw)
+            # Released before timing: otherwise every timed run of a large batch writes its
+            # output into pages the process has never touched, and on a virtual machine that
+            # backs memory lazily that first touch can cost more than the solve itself.
+            del raw
             times: list[float] = []
             start = time.perf_counter()
             while len(times) < max_repeats and (not times or time.perf_counter() - start < budget):
@@ -110,8 +114,7 @@ def measure(method: Method, case: Case, *, budget: float, max_repeats: int) -> d
     except Exception as exc:  # a failing method is a result, never an abort
         return record(case, method.name, method.group, status="failed",
                       message=f"{type(exc).__name__}: {exc}", note=method.note)
-    err = relative_error(case, u_plus, law=method.law)
     status = "ok" if err <= ACCURATE else "inaccurate"
     return record(case, method.name, method.group, status=status, times=times, error=err,
-                  peak_mb=peak, note=method.note, output_mb=output_size(raw),
+                  peak_mb=peak, note=method.note, output_mb=output_mb,
                   message="" if status == "ok" else f"relative error {err:.1e}")
