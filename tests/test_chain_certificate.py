@@ -93,8 +93,7 @@ def test_chain_certificate_equals_the_general_one(walls, scale, eps):
         unit = p.velocity_scale / st.contact_scale  # the impulse unit of contact i
         bad_lam = r.impulses + 1e-6 * unit * rng.standard_normal(p.n_contacts)
         for up, lam in ((r.u_plus, r.impulses), (bad_u, r.impulses), (r.u_plus, bad_lam)):
-            fast = chain_law_residuals(st, um, up, lam, eps, eps=eps,
-                                       gamma_minus=p.gamma_minus)
+            fast = chain_law_residuals(st, um, up, lam, eps, eps=eps, V=p.norm_minus)
             close(fast, law_residuals(st, um, up, lam, eps, eps=eps))
             close(chain_law_residuals(st, um, up, lam, eps),  # without ε's extra residuals
                   law_residuals(st, um, up, lam, eps))
@@ -169,3 +168,18 @@ def test_long_chain_with_walls_is_exact():
     s = chain_moreau(np.ones(n), -u[::-1], left_wall=True)
     np.testing.assert_array_equal(s.z, 0.0)
     assert np.abs(s.impulses - 1.0).max() < 1e-12
+
+
+@pytest.mark.parametrize("walls", WALLS)
+@pytest.mark.parametrize("chunk", [1, 2, 5, 16])
+def test_chain_certificate_chunks(walls, chunk, monkeypatch):
+    """Chunks of any size (here far below N) give the residuals of the whole chain."""
+    import impactqp.model.chain_residuals as chain_residuals
+    rng = np.random.default_rng(chunk)
+    p = random_chain(rng, 37, walls, 1.0)
+    r = iq.moreau(p, 0.5)
+    bad = r.impulses + 1e-6 * rng.standard_normal(p.n_contacts)
+    monkeypatch.setattr(chain_residuals, "CHUNK", chunk)
+    for lam in (r.impulses, bad):
+        close(chain_law_residuals(p.structure, p.u_minus, r.u_plus, lam, 0.5, eps=0.5),
+              law_residuals(p.structure, p.u_minus, r.u_plus, lam, 0.5, eps=0.5))

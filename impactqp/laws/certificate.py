@@ -110,7 +110,7 @@ def certify(problem: ImpactProblem, u_plus: np.ndarray, impulses: np.ndarray, E,
     st = problem.structure
     if st.chain is not None and np.ndim(E) == 0:  # O(N), no matrix (docs/theory.md §5)
         raw = chain_law_residuals(st, problem.u_minus, u_plus, impulses, float(E), eps=eps,
-                                  gamma_minus=problem.gamma_minus if E else None)
+                                  V=problem.norm_minus)
     else:
         raw = law_residuals(st, problem.u_minus, u_plus, impulses, E, eps=eps)
     r = {k: as_residual(v) for k, v in raw.items()}

@@ -75,8 +75,9 @@ class Moreau(ImpactLaw):
             z = solution.x
             if e == 0.0:
                 return Answer(z.copy(), solution.y, z)
-            u_plus = (1.0 + e) * z
-            u_plus -= e * u_m
+            u_plus = np.subtract(z, u_m)  # u⁺ = z − εz⊥, z⊥ = u⁻ − z, in one array
+            u_plus *= e
+            u_plus += z
             return Answer(u_plus, (1.0 + e) * solution.y, z)
         u = u_m + problem.structure.impulse_velocity(solution.x)
         return Answer(u, solution.x, (u + e * u_m) / (1.0 + e))
