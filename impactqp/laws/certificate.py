@@ -6,7 +6,8 @@ against V = ‖u⁻‖ (the kinetic norm), the velocity of contact i against s�
 sᵢ = sqrt(Gᵢᵢ) (|γᵢ| ≤ sᵢ‖u‖ by Cauchy–Schwarz in M), impulse Λᵢ against V/sᵢ (the
 impulse that changes the velocity by V along contact i), energies against V². The
 computations live in
-:mod:`impactqp.model.residuals`, which makes them safe at any velocity scale.
+:mod:`impactqp.model.residuals`, which makes them safe at any velocity scale; a chain's are
+recomputed in O(N) passes without a matrix by :mod:`impactqp.model.chain_residuals`.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..base.checks import DEFAULT_TOL, ResidualChecks
+from ..model.chain_residuals import chain_law_residuals
 from ..model.problem import ImpactProblem
 from ..model.residuals import (
     impact_residuals,
@@ -105,8 +107,13 @@ def certify(problem: ImpactProblem, u_plus: np.ndarray, impulses: np.ndarray, E,
     tol : float
         Tolerance of every dimensionless residual.
     """
-    r = {k: as_residual(v) for k, v in law_residuals(problem.structure, problem.u_minus, u_plus,
-                                                impulses, E, eps=eps).items()}
+    st = problem.structure
+    if st.chain is not None and np.ndim(E) == 0:  # O(N), no matrix (docs/theory.md §5)
+        raw = chain_law_residuals(st, problem.u_minus, u_plus, impulses, float(E), eps=eps,
+                                  V=problem.norm_minus)
+    else:
+        raw = law_residuals(st, problem.u_minus, u_plus, impulses, E, eps=eps)
+    r = {k: as_residual(v) for k, v in raw.items()}
     return Certificate(momentum=r["momentum"], impulse_sign=r["impulse_sign"],
                        law_feasibility=r["law_feasibility"], complementarity=r["complementarity"],
                        energy_balance=r.get("energy_balance"), tol=tol,

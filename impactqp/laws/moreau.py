@@ -75,7 +75,12 @@ class Moreau(ImpactLaw):
         e, u_m = self.eps, problem.u_minus
         if form == "velocity":
             z = solution.x
-            return Answer((1.0 + e) * z - e * u_m, (1.0 + e) * solution.y, z)
+            if e == 0.0:
+                return Answer(z.copy(), solution.y, z)
+            u_plus = np.subtract(z, u_m)  # u⁺ = z − εz⊥, z⊥ = u⁻ − z, in one array
+            u_plus *= e
+            u_plus += z
+            return Answer(u_plus, (1.0 + e) * solution.y, z)
         u = u_m + problem.structure.impulse_velocity(solution.x)
         return Answer(u, solution.x, (u + e * u_m) / (1.0 + e))
 

@@ -6,40 +6,15 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 from scipy.optimize import nnls
 
 from ..base.arrays import as_array, as_count, as_flag, as_real
-from ..errors import InputError, SectorLawError, ShapeError
+from ..errors import InputError, SectorLawError
+from .chain_structure import ChainStructure, chain_directions
 from .problem import ImpactProblem
-from .structure import ChainInfo, ImpactStructure
+from .structure import ChainInfo
 
-
-def chain_directions(n_balls: int, *, left_wall: bool = False, right_wall: bool = False,
-                     sparse: bool = False):
-    """W of a 1-D chain: column order [left wall, gaps q₂−q₁ … q_N−q_{N−1}, right wall].
-
-    A neighbour gap gᵢ = q_{i+1} − q_i has direction e_{i+1} − e_i; a left wall at rest
-    (gap q₁ − wall) has e₁, a right wall (gap wall − q_N) has −e_N.
-    """
-    n = n_balls
-    gaps = np.arange(n - 1)
-    first = 1 if left_wall else 0
-    m = first + n - 1 + (1 if right_wall else 0)
-    rows = [gaps, gaps + 1]
-    cols = [gaps + first, gaps + first]
-    vals = [np.full(n - 1, -1.0), np.ones(n - 1)]
-    for present, row, col, val in ((left_wall, 0, 0, 1.0), (right_wall, n - 1, m - 1, -1.0)):
-        if present:
-            rows.append(np.array([row]))
-            cols.append(np.array([col]))
-            vals.append(np.array([val]))
-    rows, cols, vals = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
-    if sparse:
-        return sp.csc_matrix((vals, (rows, cols)), shape=(n, m))
-    W = np.zeros((n, m))
-    W[rows, cols] = vals
-    return W
+__all__ = ["chain", "chain_directions", "newtons_cradle", "random_impact", "require_chain"]
 
 
 def chain(masses: Any, u_minus: Any, *, left_wall: bool = False, right_wall: bool = False,
@@ -55,32 +30,27 @@ def chain(masses: Any, u_minus: Any, *, left_wall: bool = False, right_wall: boo
     left_wall, right_wall : bool
         Fixed walls touching the first / last ball.
     sparse : bool, optional
-        Store M and W as scipy.sparse (default: when N > 200).
+        Store M and W as scipy.sparse (default: when N > 200). Either way they are formed
+        only when something asks for them: the chain's own operators, the isotonic backend
+        and the chain certificate are O(N) without them (docs/theory.md §5).
 
     Returns
     -------
     ImpactProblem
         With ``problem.chain`` set, which the O(N) fast paths recognise.
+
+    Raises
+    ------
+    ShapeError, NonFiniteError, InputError
+        Masses that are not a non-empty 1-D array of positive finite numbers (a
+        non-positive mass raises MassMatrixError, an InputError), u⁻ of another shape or
+        not finite, walls that are not flags.
     """
     masses = as_array("masses", masses)
-    if masses.ndim != 1 or masses.size == 0:
-        raise ShapeError(f"masses must be a non-empty 1-D array, got shape {masses.shape}")
     left_wall, right_wall = as_flag("left_wall", left_wall), as_flag("right_wall", right_wall)
-    if sparse is not None:
-        sparse = as_flag("sparse", sparse)
-    if np.any(masses <= 0):
-        raise InputError(f"masses must be positive; got {masses[masses <= 0][:5].tolist()}")
-    n = masses.size
-    if n == 1 and not (left_wall or right_wall):
-        W = np.zeros((1, 0))
-    else:
-        W = None
-    sparse = n > 200 if sparse is None else sparse
-    if W is None:
-        W = chain_directions(n, left_wall=left_wall, right_wall=right_wall, sparse=sparse)
-    M = sp.diags(masses, format="csc") if sparse else np.diag(masses)
-    info = ChainInfo(masses=masses.copy(), left_wall=left_wall, right_wall=right_wall)
-    return ImpactProblem.from_structure(ImpactStructure(M, W, chain=info), u_minus)
+    sparse = masses.size > 200 if sparse is None else as_flag("sparse", sparse)
+    info = ChainInfo(masses=masses, left_wall=left_wall, right_wall=right_wall)
+    return ImpactProblem.from_structure(ChainStructure(info, sparse=sparse), u_minus)
 
 
 def newtons_cradle(n_balls: int = 3, v: float = 1.0, mass: float = 1.0,

@@ -75,10 +75,16 @@ class ImpactProblem:
         u = self.u_minus if u is None else u
         return 0.5 * self.norm(u) ** 2
 
+    @cached_property
+    def norm_minus(self) -> float:
+        """‖u⁻‖ (kinetic norm, no overflow or underflow), kept: the certificates' unit V
+        (docs/theory.md §8)."""
+        return self.norm(self.u_minus)
+
     @property
     def velocity_scale(self) -> float:
         """‖u⁻‖, the natural velocity unit of certificates (1 when u⁻ = 0)."""
-        s = self.norm(self.u_minus)
+        s = self.norm_minus
         return s if s > 0 else 1.0
 
     @cached_property

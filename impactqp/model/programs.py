@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ..qp.program import ChainShape, QuadraticProgram
+from ..qp.program import ChainProgram, ChainShape, QuadraticProgram
 
 
 def impulse_program(problem: Any, q: np.ndarray,
@@ -35,13 +35,17 @@ def impulse_program(problem: Any, q: np.ndarray,
 
 def velocity_program(problem: Any) -> QuadraticProgram:
     """Velocity form min ½‖v − u⁻‖²_M s.t. Wᵀv ≥ 0: its solution is z = prox_{T_C}(u⁻)
-    and its multipliers are the impulses Λ_z of M(z − u⁻) = WΛ_z."""
+    and its multipliers are the impulses Λ_z of M(z − u⁻) = WΛ_z. A chain's program is a
+    :class:`~impactqp.qp.program.ChainProgram`: its matrices are the structure's, formed only
+    if a backend other than the isotonic one asks for them (docs/theory.md §5)."""
     st = problem.structure
-    A = st.contact_rows
     c = problem.chain
-    shape = None if c is None else ChainShape(c.masses, c.left_wall, c.right_wall)
-    return QuadraticProgram(P=st.M, c=-st.mass_rows(problem.u_minus), A=A, b=np.zeros(st.m),
-                            cache_owner=st, cache_tag="velocity", chain=shape)
+    if c is not None:
+        shape = ChainShape(c.masses, c.left_wall, c.right_wall, center=problem.u_minus)
+        return ChainProgram(shape, lambda: (st.M, st.contact_rows), sparse=st.sparse,
+                            cache_owner=st, cache_tag="velocity")
+    return QuadraticProgram(P=st.M, c=-st.mass_rows(problem.u_minus), A=st.contact_rows,
+                            b=np.zeros(st.m), cache_owner=st, cache_tag="velocity")
 
 
 SMALL_CHAIN = 10

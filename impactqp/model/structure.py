@@ -60,7 +60,9 @@ class ImpactStructure:
         Generalized force directions, one column per closed contact; ``m = 0`` is allowed.
     chain : ChainInfo, optional
         Marks W as the chain's directions (:func:`impactqp.model.builders.chain_directions`),
-        which lets chains use O(N) operators and the isotonic backend; set by the builders.
+        which lets chains use O(N) operators and the isotonic backend. The builders make a
+        :class:`~impactqp.model.chain_structure.ChainStructure` instead, which checks the
+        masses in O(N) and forms M and W only when they are asked for.
 
     Raises
     ------
@@ -249,12 +251,17 @@ class ImpactStructure:
         return np.sqrt(self.delassus_diagonal)
 
     @cached_property
+    def inverse_masses(self) -> np.ndarray:
+        """1/mᵢ of a chain's balls (chains only): the chain's M⁻¹."""
+        return 1.0 / self.chain.masses
+
+    @cached_property
     def delassus_diagonal(self) -> np.ndarray:
         """Diagonal of G: the squared M⁻¹-length of each contact direction, without forming
         G (a chain's gap i has 1/mᵢ + 1/mᵢ₊₁, a wall 1/m of its ball)."""
         c = self.chain
         if c is not None:
-            inv = 1.0 / c.masses
+            inv = self.inverse_masses
             parts = [inv[:1]] if c.left_wall else []
             parts.append(inv[:-1] + inv[1:])
             if c.right_wall:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import isotonic_regression
 
-__all__ = ["ChainSolution", "chain_moreau", "chain_moreau_batch"]
+__all__ = ["ChainSolution", "chain_moreau", "chain_moreau_batch", "chain_projection"]
 
 
 @dataclass(frozen=True)
@@ -148,6 +148,76 @@ def _finish(m, u, z, eps, left: bool, right: bool) -> ChainSolution:
     return ChainSolution(u_plus=(1.0 + eps) * z - eps * u, impulses=(1.0 + eps) * lam, z=z)
 
 
+def _scan(v: np.ndarray) -> None:
+    """Inclusive prefix sums of ``v`` in place, by pairs: each level adds neighbours (vector
+    operations over strided views, not numpy's sequential loop) and recurses on the pair
+    sums, so rounding grows like ``log2 N`` ulps. ``v.size`` must be a power of two times
+    at most 64 (the size below which ``np.cumsum`` finishes)."""
+    if v.size <= 64:
+        np.cumsum(v, out=v)
+        return
+    pairs = v.reshape(-1, 2)
+    first, second = pairs[:, 0], pairs[:, 1]
+    second += first
+    _scan(second)
+    first[1:] += second[:-1]
+
+
+def _prefix_buffer(n: int) -> np.ndarray:
+    """Zeros of length 1 + n', n' ≥ n the size :func:`_scan` takes (n' / 2^k ≤ 64)."""
+    k = max(0, int(np.ceil(np.log2(max(n, 1) / 64))))
+    return np.zeros(1 + -(-n // 2**k) * 2**k)
+
+
+def chain_projection(m: np.ndarray, u: np.ndarray, left: bool,
+                     right: bool) -> tuple[np.ndarray, np.ndarray]:
+    """z = prox_{T_C}(u⁻) and the impulses Λ_z of M(z − u⁻) = WΛ_z of one chain, without
+    checking the inputs (positive finite ``m``, finite ``u``): one isotonic regression, one
+    prefix sum, anchors from the regression's blocks (docs/theory.md §3, §5).
+
+    Each block of the regression is a run of equal z whose mean is the weighted mean of u,
+    so Σ m(z − u) over a block is 0 and the contact before each block start carries no
+    impulse: with E_j = Σ_{i<j} mᵢ(zᵢ − uᵢ), the impulse left of ball j is
+    L_j = E_a − E_j for the block start a ≤ j. A clipped run at a wall (z = 0) takes the
+    first free block start as anchor; with both walls z = 0 and Λ_z is the least of its
+    half-line (see :func:`chain_moreau`).
+    """
+    n = m.size
+    if n > 1:
+        res = isotonic_regression(u, weights=m)
+        z, starts = res.x, res.blocks
+    else:
+        z, starts = u.copy(), np.array([0, 1])
+    # blocks whose mean is at most 0, before the walls clip them
+    free = int(np.searchsorted(z[starts[:-1]], 0.0, side="right")) if left or right else 0
+    if left and right:
+        z[:] = 0.0
+    elif left:
+        np.maximum(z, 0.0, out=z)
+    elif right:
+        np.minimum(z, 0.0, out=z)
+    E = _prefix_buffer(n)
+    d = E[1:n + 1]
+    np.subtract(z, u, out=d)
+    d *= m
+    _scan(E[1:])
+    if left and right:
+        return z, E[:n + 1].max() - E[:n + 1]
+    values, lengths = E[starts[:-1]], np.diff(starts)
+    if left:  # the clipped blocks (z = 0) and the wall hang from the first free block start
+        k = starts[free]
+        values = np.concatenate((E[k:k + 1], values[free:]))
+        lengths = np.concatenate(([k], lengths[free:]))
+    elif right:  # the clipped blocks and the wall hang from the first clipped block start
+        k = starts[free]
+        values = np.concatenate((values[:free], E[k:k + 1]))
+        lengths = np.concatenate((lengths[:free], [n + 1 - k]))
+    lam = np.repeat(values, lengths)  # E at each contact's anchor
+    lo = 0 if left else 1
+    np.subtract(lam[lo:], E[lo:lo + lam.size - lo], out=lam[lo:])
+    return z, lam[lo:]
+
+
 def chain_moreau(
     masses, u_minus, eps: float = 0.0, *, left_wall: bool = False, right_wall: bool = False
 ) -> ChainSolution:
@@ -186,9 +256,10 @@ def chain_moreau(
     array([1., 1., 1.])
     """
     m, u, e = _check(masses, u_minus, eps, 1)
-    z = isotonic_regression(u, weights=m).x if m.size > 1 else u.copy()
-    s = _finish(m, u[None, :], z[None, :], e, bool(left_wall), bool(right_wall))
-    return ChainSolution(u_plus=s.u_plus[0], impulses=s.impulses[0], z=s.z[0])
+    z, lam = chain_projection(m, u, bool(left_wall), bool(right_wall))
+    if e == 0.0:
+        return ChainSolution(u_plus=z.copy(), impulses=lam, z=z)
+    return ChainSolution(u_plus=(1.0 + e) * z - e * u, impulses=(1.0 + e) * lam, z=z)
 
 
 def chain_moreau_batch(

@@ -11,14 +11,17 @@ with P symmetric positive semidefinite. Two shapes occur (docs/theory.md §3, §
 * impulse form:   x = Λ, P = G, c = q,      A = I,  b = 0 (an LCP with a symmetric matrix).
 
 A velocity program of a 1-D chain says so (:class:`ChainShape`), so that the isotonic
-backend can solve it in O(N) (docs/theory.md §5).
+backend can solve it in O(N) (docs/theory.md §5); built as a :class:`ChainProgram`, its
+matrices are formed only when a backend other than that one asks for them.
 
 Backends only see a :class:`QuadraticProgram`; they never know which law produced it.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -34,6 +37,14 @@ class ChainShape:
     weights: np.ndarray
     left_wall: bool = False
     right_wall: bool = False
+    center: np.ndarray | None = field(default=None, compare=False)
+    """The point the program projects, when known exactly (c = −diag(weights)·center):
+    the isotonic backend regresses it as it is instead of dividing c by the weights."""
+
+    @property
+    def n_constraints(self) -> int:
+        """Number of rows of A: the gaps and the walls."""
+        return self.weights.size - 1 + self.left_wall + self.right_wall
 
 
 @dataclass(frozen=True)
@@ -128,3 +139,53 @@ class QPSolution:
     backend: str
     iterations: int | None = None
     info: dict = field(default_factory=dict)
+
+
+class ChainProgram(QuadraticProgram):
+    """The velocity program of a 1-D chain (docs/theory.md §5) with P, A and c formed on first
+    access: the isotonic backend reads only :attr:`chain`, so an O(N) solve never forms a
+    matrix; any other backend gets P and A from ``matrices`` when it asks for them.
+
+    Parameters
+    ----------
+    shape : ChainShape
+        Weights (P = diag(weights)), walls and ``center`` (required: c = −P·center).
+    matrices : callable
+        Returns (P, A) when first needed (the owner's cached matrices).
+    sparse : bool
+        What :attr:`sparse` reports (the owner's storage), without forming P.
+    cache_owner, cache_tag
+        As for :class:`QuadraticProgram`.
+    """
+
+    def __init__(self, shape: ChainShape, matrices: Callable[[], tuple[Any, Any]], *,
+                 sparse: bool, cache_owner: Any = None, cache_tag: str = "") -> None:
+        if shape.center is None:
+            raise ValueError("a ChainProgram needs the chain's center (c = −P·center)")
+        for name, value in (("factor", None), ("factor_rhs", None),
+                            ("cache_owner", cache_owner), ("cache_tag", cache_tag),
+                            ("chain", shape), ("_matrices", matrices), ("_sparse", sparse)):
+            object.__setattr__(self, name, value)
+
+    @cached_property
+    def _formed(self) -> tuple[Any, Any]:
+        return self._matrices()
+
+    P = property(lambda self: self._formed[0], doc="diag(weights), formed on first access.")
+    A = property(lambda self: self._formed[1], doc="The gap (and wall) rows, formed on first "
+                                                   "access.")
+
+    @cached_property
+    def c(self) -> np.ndarray:
+        """−diag(weights)·center."""
+        return -(self.chain.weights * self.chain.center)
+
+    @cached_property
+    def b(self) -> np.ndarray:
+        """Zeros: the rows are Av ≥ 0."""
+        return np.zeros(self.chain.n_constraints)
+
+    n_vars = property(lambda self: int(self.chain.weights.size))
+    n_constraints = property(lambda self: self.chain.n_constraints)
+    nonnegative = property(lambda self: False)
+    sparse = property(lambda self: self._sparse)

@@ -54,8 +54,9 @@ def normalize(qp: QuadraticProgram) -> tuple[QuadraticProgram, Scaling]:
     if not (alpha > 0 and np.isfinite(alpha) and back.x_scale > 0
             and np.isfinite(back.x_scale) and np.isfinite(back.y_scale)):
         return qp, Scaling(1.0, 1.0)  # not representable scaled: leave it as it is
-    chain = None if qp.chain is None else ChainShape(qp.chain.weights * s * s,
-                                                     qp.chain.left_wall, qp.chain.right_wall)
+    chain = None if qp.chain is None else ChainShape(
+        qp.chain.weights * s * s, qp.chain.left_wall, qp.chain.right_wall,
+        None if qp.chain.center is None else qp.chain.center / (alpha * s))
     scaled = QuadraticProgram(
         P=qp.P * (s * s), c=qp.c * (s / alpha), A=qp.A,
         b=None if qp.b is None else qp.b / (alpha * s),

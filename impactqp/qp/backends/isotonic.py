@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..isotonic import chain_moreau, chain_moreau_batch
+from ..isotonic import chain_moreau_batch, chain_projection
 from ..program import QPSolution, QuadraticProgram
 
 
@@ -22,15 +22,15 @@ def unsuitable(qp: QuadraticProgram) -> str | None:
 
 
 def _shift(qp: QuadraticProgram, C: np.ndarray) -> np.ndarray:
-    """u⁻ from the linear term c = −Du⁻."""
+    """u⁻ from the linear term c = −Du⁻ (programs that do not carry it as their center)."""
     return -C / qp.chain.weights
 
 
 def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
     shape = qp.chain
-    sol = chain_moreau(shape.weights, _shift(qp, qp.c), 0.0, left_wall=shape.left_wall,
-                       right_wall=shape.right_wall)
-    return QPSolution(x=sol.z, y=sol.impulses, status="solved", backend="isotonic")
+    u = shape.center if shape.center is not None else _shift(qp, qp.c)
+    z, lam = chain_projection(shape.weights, u, shape.left_wall, shape.right_wall)
+    return QPSolution(x=z, y=lam, status="solved", backend="isotonic")
 
 
 def solve_many(qp: QuadraticProgram, C: np.ndarray, *, tol: float = 1e-10,

@@ -1,0 +1,185 @@
+"""Long chains at the floor: no matrix on the isotonic path, the O(N) chain certificate equal to
+the general one (docs/theory.md §5, §8), and the single-chain prefix sums against the batch
+path."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import impactqp as iq
+from impactqp.laws.certificate import certify
+from impactqp.model.chain_residuals import chain_law_residuals
+from impactqp.model.chain_structure import ChainStructure, chain_directions
+from impactqp.model.programs import velocity_program
+from impactqp.model.residuals import law_residuals
+from impactqp.model.structure import ChainInfo
+from impactqp.qp.isotonic import chain_moreau, chain_moreau_batch
+
+WALLS = [(False, False), (True, False), (False, True), (True, True)]
+FORMED = ("M", "W", "delassus", "Minv_W", "contact_rows", "_chol", "scaled_W", "float_rows",
+          "delassus_lu", "_formed")
+
+
+def random_chain(rng: np.random.Generator, n: int, walls, scale: float) -> iq.ImpactProblem:
+    masses = 10.0 ** rng.uniform(-3, 3, n)
+    return iq.chain(masses, rng.standard_normal(n) * scale, left_wall=walls[0],
+                    right_wall=walls[1])
+
+
+def close(a: dict, b: dict) -> None:
+    """Same keys, same values up to rounding (far below the default tolerance 1e-9)."""
+    assert a.keys() == b.keys()
+    for k in a:
+        assert abs(a[k] - float(b[k])) <= 1e-9 * abs(float(b[k])) + 1e-12, (k, a[k], b[k])
+
+
+@pytest.mark.parametrize("n", [10**5])
+@pytest.mark.parametrize("walls", [(False, False), (True, False)])
+def test_cold_chain_solve_forms_no_matrix(n, walls):
+    u = np.zeros(n)
+    u[0] = 1.0
+    p = iq.chain(np.ones(n), u, left_wall=walls[0], right_wall=walls[1])
+    r = iq.moreau(p, 0.5)
+    assert r.backend == "isotonic" and r.certificate.ok
+    assert not set(FORMED) & set(vars(p.structure))
+    # the matrices are still there for whoever asks
+    assert p.M.shape == (n, n) and p.W.shape == (n, p.n_contacts)
+    assert (p.W != chain_directions(n, left_wall=walls[0], right_wall=walls[1],
+                                    sparse=True)).nnz == 0
+
+
+@pytest.mark.parametrize("sparse", [False, True])
+def test_lazy_structure_serves_every_consumer(sparse):
+    m, u = np.array([1.0, 2.0, 0.5, 3.0]), np.array([2.0, -1.0, 0.5, -2.0])
+    lazy = iq.chain(m, u, left_wall=True, sparse=sparse)
+    eager = iq.ImpactProblem(np.diag(m), chain_directions(4, left_wall=True), u)
+    assert isinstance(lazy.structure, ChainStructure) and lazy.structure.sparse == sparse
+    np.testing.assert_allclose(np.asarray(lazy.delassus.todense() if sparse else lazy.delassus),
+                               eager.delassus, rtol=1e-15)
+    np.testing.assert_allclose(lazy.structure.solve_mass(u), eager.structure.solve_mass(u))
+    for backend in ("exact", "clarabel", "isotonic"):
+        a, b = iq.moreau(lazy, 0.3, backend=backend), iq.moreau(eager, 0.3, backend="exact")
+        np.testing.assert_allclose(a.u_plus, b.u_plus, atol=1e-8)
+    qp = velocity_program(lazy)
+    np.testing.assert_array_equal(qp.c, -m * u)
+    assert qp.n_vars == 4 and qp.n_constraints == 4 and not qp.nonnegative
+    assert qp.sparse == sparse and qp.A.shape == (4, 4)
+
+
+@pytest.mark.parametrize("masses,error", [
+    ([[1.0, 2.0]], iq.ShapeError), ([], iq.ShapeError), ([1.0, np.nan], iq.NonFiniteError),
+    ([1.0, np.inf], iq.NonFiniteError), ([1.0, 0.0], iq.MassMatrixError),
+    ([1.0, -2.0], iq.InputError)])
+def test_chain_masses_checked(masses, error):
+    with pytest.raises(error, match="masses"):
+        iq.chain(masses, np.zeros(np.size(masses)))
+    with pytest.raises(error, match="masses"):
+        ChainStructure(ChainInfo(np.array(masses, dtype=float)), sparse=False)
+
+
+@pytest.mark.parametrize("walls", WALLS)
+@pytest.mark.parametrize("scale", [1e-200, 1.0, 1e200])
+@pytest.mark.parametrize("eps", [0.0, 0.5, 1.0])
+def test_chain_certificate_equals_the_general_one(walls, scale, eps):
+    rng = np.random.default_rng([int(walls[0]), int(walls[1]), int(eps * 2)])
+    for n in (1, 2, 7, 60):
+        p = random_chain(rng, n, walls, scale)
+        if p.n_contacts == 0:
+            continue
+        r = iq.moreau(p, eps)
+        st, um = p.structure, p.u_minus
+        bad_u = r.u_plus + 1e-6 * np.abs(um).max() * rng.standard_normal(n)
+        unit = p.velocity_scale / st.contact_scale  # the impulse unit of contact i
+        bad_lam = r.impulses + 1e-6 * unit * rng.standard_normal(p.n_contacts)
+        for up, lam in ((r.u_plus, r.impulses), (bad_u, r.impulses), (r.u_plus, bad_lam)):
+            fast = chain_law_residuals(st, um, up, lam, eps, eps=eps, V=p.norm_minus)
+            close(fast, law_residuals(st, um, up, lam, eps, eps=eps))
+            close(chain_law_residuals(st, um, up, lam, eps),  # without ε's extra residuals
+                  law_residuals(st, um, up, lam, eps))
+        assert certify(p, r.u_plus, r.impulses, eps, eps=eps).ok
+        assert not certify(p, bad_u, r.impulses, eps, eps=eps).ok
+        assert not certify(p, r.u_plus, bad_lam, eps, eps=eps).ok
+
+
+@pytest.mark.parametrize("walls", WALLS)
+def test_chain_certificate_fails_corrupted_long_answers(walls):
+    rng = np.random.default_rng(7)
+    n = 20_000
+    p = random_chain(rng, n, walls, 1.0)
+    r = iq.moreau(p, 0.5)
+    assert r.certificate.ok
+    cases, V, s = [], p.velocity_scale, p.structure.contact_scale
+    for k in (0, n // 2, n - 1):  # one velocity off by 1e-7 V in the kinetic norm
+        up = r.u_plus.copy()
+        up[k] += 1e-7 * V / np.sqrt(p.chain.masses[k])
+        cases.append((up, r.impulses))
+    for k in (0, p.n_contacts // 2, p.n_contacts - 1):  # one impulse off by 1e-7 of its unit
+        lam = r.impulses.copy()
+        lam[k] += 1e-7 * V / s[k]
+        cases.append((r.u_plus, lam))
+    cases.append((r.u_plus, -np.abs(r.impulses)))
+    for up, lam in cases:
+        fast = certify(p, up, lam, 0.5, eps=0.5)
+        assert not fast.ok
+        close(fast.residuals, law_residuals(p.structure, p.u_minus, up, lam, 0.5, eps=0.5))
+
+
+def test_chain_certificate_non_finite_and_zero_velocity():
+    p = iq.chain([1.0, 2.0, 3.0], [1.0, 0.0, -1.0], right_wall=True)
+    r = iq.moreau(p, 0.5)
+    for bad in (np.nan, np.inf):
+        up = r.u_plus.copy()
+        up[1] = bad
+        assert not certify(p, up, r.impulses, 0.5, eps=0.5).ok
+        lam = r.impulses.copy()
+        lam[0] = bad
+        assert not certify(p, r.u_plus, lam, 0.5, eps=0.5).ok
+    rest = p.with_u_minus(np.zeros(3))
+    assert certify(rest, np.zeros(3), np.zeros(3), 0.5, eps=0.5).ok
+    moving = certify(rest, np.array([0.0, 1e-300, 0.0]), np.zeros(3), 0.5, eps=0.5)
+    assert not moving.ok
+    close(moving.residuals, law_residuals(rest.structure, rest.u_minus,
+                                          np.array([0.0, 1e-300, 0.0]), np.zeros(3), 0.5,
+                                          eps=0.5))
+
+
+@pytest.mark.parametrize("walls", WALLS)
+@pytest.mark.parametrize("n", [1, 2, 65, 5000])
+def test_single_chain_prefix_sums_match_the_batch_path(walls, n):
+    rng = np.random.default_rng(n)
+    m = 10.0 ** rng.uniform(-2, 2, n)
+    for u in (rng.standard_normal(n), np.sort(rng.standard_normal(n)),
+              -np.sort(rng.standard_normal(n)), np.zeros(n)):
+        one = chain_moreau(m, u, 0.4, left_wall=walls[0], right_wall=walls[1])
+        rows = chain_moreau_batch(m, u[None, :], 0.4, left_wall=walls[0], right_wall=walls[1])
+        scale = 1.0 + np.abs(m * u).sum()
+        np.testing.assert_allclose(one.z, rows.z[0], rtol=1e-12, atol=1e-14)
+        np.testing.assert_allclose(one.impulses, rows.impulses[0], atol=1e-12 * scale)
+
+
+def test_long_chain_with_walls_is_exact():
+    n = 200_000
+    u = np.zeros(n)
+    u[0] = 1.0
+    s = chain_moreau(np.ones(n), u, right_wall=True)  # everything stops at the wall
+    np.testing.assert_array_equal(s.z, 0.0)
+    assert np.abs(s.impulses - 1.0).max() < 1e-12  # the whole momentum reaches the wall
+    s = chain_moreau(np.ones(n), -u[::-1], left_wall=True)
+    np.testing.assert_array_equal(s.z, 0.0)
+    assert np.abs(s.impulses - 1.0).max() < 1e-12
+
+
+@pytest.mark.parametrize("walls", WALLS)
+@pytest.mark.parametrize("chunk", [1, 2, 5, 16])
+def test_chain_certificate_chunks(walls, chunk, monkeypatch):
+    """Chunks of any size (here far below N) give the residuals of the whole chain."""
+    import impactqp.model.chain_residuals as chain_residuals
+    rng = np.random.default_rng(chunk)
+    p = random_chain(rng, 37, walls, 1.0)
+    r = iq.moreau(p, 0.5)
+    bad = r.impulses + 1e-6 * rng.standard_normal(p.n_contacts)
+    monkeypatch.setattr(chain_residuals, "CHUNK", chunk)
+    for lam in (r.impulses, bad):
+        close(chain_law_residuals(p.structure, p.u_minus, r.u_plus, lam, 0.5, eps=0.5),
+              law_residuals(p.structure, p.u_minus, r.u_plus, lam, 0.5, eps=0.5))
