@@ -82,6 +82,7 @@ class _Sums:
         self.product_sum += float(p.sum())
 
 
+@np.errstate(invalid="ignore", over="ignore")  # non-finite inputs give NaN residuals: they fail
 def chain_law_residuals(structure: ImpactStructure, u_minus: np.ndarray, u_plus: np.ndarray,
                         Lam: np.ndarray, E: float, *, eps: float | None = None,
                         V: float | None = None) -> dict[str, float]:

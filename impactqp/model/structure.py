@@ -14,9 +14,9 @@ from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.linalg import lapack
 
 from ..base.arrays import Matrix, as_dense, as_matrix
 from ..base.rowwise import row_max, row_sum
@@ -123,9 +123,12 @@ class ImpactStructure:
             self._lu = lu
         else:
             self.diagonal_mass = bool(np.count_nonzero(self.M - np.diag(np.diag(self.M))) == 0)
-            try:
-                self._chol = sla.cholesky(self.M, lower=True)
-            except np.linalg.LinAlgError:
+            # LAPACK directly: the same factorization without scipy.linalg's per-call checks,
+            # which cost more than the factorization itself for the small M of most impacts
+            chol, info = lapack.dpotrf(self.M, lower=1, clean=1)
+            if info == 0:
+                self._chol = chol
+            else:
                 eig = np.linalg.eigvalsh(self.M).min()
                 raise MassMatrixError("M must be positive definite; its smallest eigenvalue is "
                                       f"{eig:.3g}") from None
@@ -137,7 +140,11 @@ class ImpactStructure:
             if self.diagonal_mass:
                 return x / self._diag[:, None] if x.ndim == 2 else x / self._diag
             return self._lu.solve(np.asarray(x, dtype=float))
-        return sla.cho_solve((self._chol, True), x)
+        out, info = lapack.dpotrs(self._chol, x, lower=1)
+        if info != 0:
+            raise ValueError(f"M⁻¹x failed (LAPACK dpotrs info {info}) for x of shape "
+                             f"{np.shape(x)}")
+        return out
 
     @cached_property
     def mass_diagonal(self) -> np.ndarray | None:
@@ -151,12 +158,12 @@ class ImpactStructure:
             return X * d
         return X @ self.M if not self.sparse else np.asarray((self.M @ X.T).T)
 
+    @np.errstate(over="ignore", under="ignore", invalid="ignore")  # NaN rows give NaN norms
     def kinetic_norms(self, X: np.ndarray) -> np.ndarray:
         """‖x‖ = sqrt(xᵀMx) of a vector or of every row of X, without overflow or underflow
         (each row is divided by its largest entry before it is squared whenever the plain
         sum of squares would lose range)."""
-        with np.errstate(over="ignore", under="ignore"):
-            q = row_sum(self.mass_rows(X) * X)
+        q = row_sum(self.mass_rows(X) * X)
         if X.ndim == 1:
             if 1e-250 < q < np.inf:
                 return np.sqrt(q)
@@ -214,7 +221,10 @@ class ImpactStructure:
     @cached_property
     def scaled_W(self) -> np.ndarray:
         """B = L⁻¹W, so that G = BᵀB (dense problems): the basis of the NNLS paths."""
-        return sla.solve_triangular(self.cholesky_factor, self.W, lower=True)
+        B, info = lapack.dtrtrs(self.cholesky_factor, self.W, lower=1)
+        if info != 0:
+            raise ValueError(f"L⁻¹W failed (LAPACK dtrtrs info {info})")
+        return B
 
     @cached_property
     def Minv_W(self) -> Matrix:

@@ -57,12 +57,15 @@ class ActiveSetKernel:
         """(J, F, G_JJ⁻¹, G_FJ) of support ``idx``, or None when G_JJ is singular."""
         if idx not in self._arrays:
             J = np.array(self._order[idx])
-            block = self.G[np.ix_(J, J)]
-            if np.linalg.cond(block) > 1e12:
+            rows = self.G[J]
+            block = rows[:, J]
+            # G_JJ is symmetric positive semidefinite: its condition number is λmax/λmin
+            eig = np.linalg.eigvalsh(block)
+            if not eig[0] * 1e12 >= eig[-1] or not eig[0] > 0.0:
                 self._arrays[idx] = None
             else:
-                F = np.setdiff1d(np.arange(self.m), J)
-                self._arrays[idx] = (J, F, np.linalg.inv(block), self.G[np.ix_(F, J)])
+                F = np.array([i for i in range(self.m) if i not in self._order[idx]], dtype=int)
+                self._arrays[idx] = (J, F, np.linalg.inv(block), self.G[F][:, J])
         return self._arrays[idx]
 
     def solve(self, q: np.ndarray, tol: float = SUPPORT_TOL) -> np.ndarray | None:
