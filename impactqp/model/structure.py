@@ -271,12 +271,14 @@ class ImpactStructure:
         G (a chain's gap i has 1/mᵢ + 1/mᵢ₊₁, a wall 1/m of its ball)."""
         c = self.chain
         if c is not None:
-            inv = self.inverse_masses
-            parts = [inv[:1]] if c.left_wall else []
-            parts.append(inv[:-1] + inv[1:])
+            inv, lo = self.inverse_masses, int(c.left_wall)
+            out = np.empty(self.m)  # written in place: no concatenated copy of N entries
+            np.add(inv[:-1], inv[1:], out=out[lo:lo + inv.size - 1])
+            if c.left_wall:
+                out[0] = inv[0]
             if c.right_wall:
-                parts.append(inv[-1:])
-            return np.concatenate(parts)
+                out[-1] = inv[-1]
+            return out
         if not self.sparse:
             return np.einsum("ij,ij->j", self.scaled_W, self.scaled_W)
         if self.diagonal_mass:
