@@ -15,6 +15,7 @@ contacts known to be inactive, where ``Λ = 0`` exactly.
 """
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -163,10 +164,23 @@ def _scan(v: np.ndarray) -> None:
     first[1:] += second[:-1]
 
 
+_SCRATCH = threading.local()
+"""Each thread's prefix-sum buffer, kept between solves: a fresh buffer of a long chain costs
+more in page faults than the sums themselves (its contents never leave chain_projection)."""
+
+
 def _prefix_buffer(n: int) -> np.ndarray:
-    """Zeros of length 1 + n', n' ≥ n the size :func:`_scan` takes (n' / 2^k ≤ 64)."""
+    """A buffer of length 1 + n', n' ≥ n the size :func:`_scan` takes (n' / 2^k ≤ 64), whose
+    first entry and tail beyond n are zero (the calling thread's, reused when it fits)."""
     k = max(0, int(np.ceil(np.log2(max(n, 1) / 64))))
-    return np.zeros(1 + -(-n // 2**k) * 2**k)
+    size = 1 + -(-n // 2**k) * 2**k
+    buffer = getattr(_SCRATCH, "buffer", None)
+    if buffer is None or buffer.size < size or buffer.size > 2 * size:
+        buffer = _SCRATCH.buffer = np.empty(size)
+    E = buffer[:size]
+    E[0] = 0.0
+    E[n + 1:] = 0.0
+    return E
 
 
 def chain_projection(m: np.ndarray, u: np.ndarray, left: bool,
