@@ -136,8 +136,9 @@ def chain_law_residuals(structure: ImpactStructure, u_minus: np.ndarray, u_plus:
         t, r = work[0, :i1 - i0], work[1, :i1 - i0]
         np.subtract(up[i0:i1], um[i0:i1], out=t)  # t = u⁺ − u⁻, r = Mt − (L_j − L_{j+1})
         np.multiply(t, m[i0:i1], out=r)
-        acc.mt_u += float(np.dot(r, um[i0:i1]))
-        acc.mt_t += float(np.dot(r, t))
+        if eps:  # the energy balance is 2ε|⟨z, z⊥⟩|/V²: exactly 0 at ε = 0
+            acc.mt_u += float(np.dot(r, um[i0:i1]))
+            acc.mt_t += float(np.dot(r, t))
         j0, j1 = max(i0, lo), min(i1, hi)
         r[j0 - i0:j1 - i0] -= lam[j0 - lo:j1 - lo]
         j0, j1 = max(i0, lo - 1), min(i1, hi - 1)
