@@ -57,7 +57,7 @@ class BatchResult:
     @property
     def ok(self) -> np.ndarray:
         """Per-row verdict of the certificate (all True in a returned batch)."""
-        return certified_rows(self.residuals, self.tol)
+        return self.certificate.ok
 
     @property
     def certificate(self) -> BatchCertificate:
@@ -68,8 +68,9 @@ class BatchResult:
 
     @property
     def message(self) -> str:
+        name, value = self.certificate.worst
         return (f"{len(self.u_plus)} impacts by {self.backend} ({self.resolved} re-solved one "
-                f"by one); worst {self.certificate.worst[0]} = {self.certificate.worst[1]:.1e}")
+                f"by one); worst {name} = {value:.1e}")
 
 
 @dataclass(frozen=True)

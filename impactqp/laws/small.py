@@ -28,7 +28,8 @@ from .result import ImpactResult
 from .unrolled import program_for
 
 SMALL_CONTACTS = 4
-"""Most contacts the float path takes (beyond, arrays are cheaper than loops)."""
+"""Most contacts the float path takes (its program spells out all 2^m − 1 supports: beyond,
+compiling costs more than most structures are ever solved)."""
 
 SMALL_DOF = 12
 """Most degrees of freedom the float path takes."""

@@ -99,9 +99,3 @@ class ChainStructure(ImpactStructure):
     def _chol(self) -> np.ndarray:
         """Cholesky factor of a diagonal M: diag(√masses)."""
         return np.diag(np.sqrt(self.chain.masses))
-
-    def solve_mass(self, x: np.ndarray) -> np.ndarray:
-        """Return M⁻¹x for a vector or a matrix of right-hand sides (a division)."""
-        d = self.chain.masses
-        return x / d[:, None] if x.ndim == 2 else x / d
-

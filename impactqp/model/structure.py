@@ -70,6 +70,9 @@ class ImpactStructure:
         On malformed input (all ``ValueError`` subclasses naming the argument).
     """
 
+    _diag: np.ndarray | None = None
+    """M's diagonal when M is stored as a diagonal (sparse diagonal M, chains), else None."""
+
     def __init__(self, M: Matrix, W: Matrix, *, chain: ChainInfo | None = None) -> None:
         M, W = as_matrix("M", M), as_matrix("W", W)
         self.sparse = sp.issparse(M) or sp.issparse(W)
@@ -136,15 +139,11 @@ class ImpactStructure:
     # --- linear algebra in the kinetic metric -------------------------------------------
     def solve_mass(self, x: np.ndarray) -> np.ndarray:
         """Return M⁻¹x for a vector or a matrix of right-hand sides."""
+        if self._diag is not None:  # a stored diagonal M (sparse or a chain): a division
+            return x / self._diag[:, None] if x.ndim == 2 else x / self._diag
         if self.sparse:
-            if self.diagonal_mass:
-                return x / self._diag[:, None] if x.ndim == 2 else x / self._diag
             return self._lu.solve(np.asarray(x, dtype=float))
-        out, info = lapack.dpotrs(self._chol, x, lower=1)
-        if info != 0:
-            raise ValueError(f"M⁻¹x failed (LAPACK dpotrs info {info}) for x of shape "
-                             f"{np.shape(x)}")
-        return out
+        return lapack.dpotrs(self._chol, x, lower=1)[0]  # info ≠ 0 only for bad shapes
 
     @cached_property
     def mass_diagonal(self) -> np.ndarray | None:
@@ -221,10 +220,8 @@ class ImpactStructure:
     @cached_property
     def scaled_W(self) -> np.ndarray:
         """B = L⁻¹W, so that G = BᵀB (dense problems): the basis of the NNLS paths."""
-        B, info = lapack.dtrtrs(self.cholesky_factor, self.W, lower=1)
-        if info != 0:
-            raise ValueError(f"L⁻¹W failed (LAPACK dtrtrs info {info})")
-        return B
+        # info ≠ 0 would mean a zero pivot, which a successful Cholesky factor does not have
+        return lapack.dtrtrs(self.cholesky_factor, self.W, lower=1)[0]
 
     @cached_property
     def Minv_W(self) -> Matrix:
