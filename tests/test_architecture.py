@@ -19,7 +19,7 @@ ROOT = PACKAGE.parent
 
 # rank of each top-level part of impactqp: a module may import only from its own rank or lower
 LAYERS = {
-    "errors": 0, "base": 0,
+    "errors": 0, "base": 0, "kernels": 0,
     "qp": 1,
     "model": 2,
     "tables": 3,
@@ -30,7 +30,8 @@ LAYERS = {
     "__init__": 8, "__main__": 8,
 }
 # edges that the ranks allow but the design forbids
-FORBIDDEN = [("qp.backends", "model"), ("qp", "laws"), ("model", "laws")]
+FORBIDDEN = [("qp.backends", "model"), ("qp", "laws"), ("model", "laws"), ("base", "kernels"),
+             ("errors", "kernels")]
 
 
 def module_name(path: Path) -> str:

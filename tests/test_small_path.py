@@ -40,8 +40,11 @@ def test_float_path_matches_the_array_path(case) -> None:
     if r.attempts[-1].startswith("kernel (impulse, on floats)"):
         # the float certificate is the general one, recomputed independently
         again = law.certificate(p, iq.Answer(r.u_plus, r.impulses, r.z), r.certificate.tol)
+        # residuals of an exact answer are round-off: equal within the tolerance, not digit
+        # for digit (two orders of summation differ in the last bits)
+        assert again.residuals.keys() == r.certificate.residuals.keys()
         for key, value in r.certificate.residuals.items():
-            assert value == pytest.approx(again.residuals[key], rel=1e-6, abs=1e-15), key
+            assert abs(value - again.residuals[key]) <= r.certificate.tol, key
         assert again.ok
 
 

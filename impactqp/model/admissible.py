@@ -20,11 +20,11 @@ from typing import Any
 import clarabel
 import numpy as np
 import scipy.sparse as sp
-from scipy.optimize import nnls
 
 from ..base.arrays import as_vector, check_tol
 from ..base.checks import DEFAULT_TOL, NamedChecks
 from ..errors import InputError
+from ..kernels.active_set import solve_nnls
 from ..qp.backends.clarabel_ import run as run_clarabel
 from ..qp.certified import solve_in_forms
 from ..qp.lcp import solve_psd_lcp
@@ -102,7 +102,7 @@ def best_impulses(problem: Any, du: np.ndarray) -> tuple[np.ndarray, float]:
 def _best_impulses_unit(problem: Any, du: np.ndarray) -> tuple[np.ndarray, float]:
     st = problem.structure
     if not st.sparse:
-        lam, res = nnls(st.scaled_W, st.cholesky_factor.T @ du, maxiter=50 * st.m)
+        lam, res = solve_nnls(st.scaled_W, st.cholesky_factor.T @ du)
         return lam, float(res)
     # sparse: the normal equations of the NNLS are the LCP 0 ≤ Λ ⟂ GΛ − Wᵀdu ≥ 0 (docs/theory.md §3,
     # impulse form); with independent contacts its unconstrained solution often already

@@ -6,10 +6,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy.optimize import nnls
 
 from ..base.arrays import as_array, as_count, as_flag, as_real
 from ..errors import InputError, SectorLawError
+from ..kernels.active_set import solve_nnls
 from .chain_structure import ChainStructure, chain_directions
 from .problem import ImpactProblem
 from .structure import ChainInfo
@@ -146,7 +146,7 @@ def random_impact(n_dof: int, n_contacts: int, *, seed: int | np.random.Generato
         # −(Euclidean projection of a random point onto T_C) satisfies γ⁻ = Wᵀu ≤ 0; the
         # projection is x + Wλ with λ = argmin_{λ≥0} ‖Wλ + x‖ (non-negative least squares).
         x = u
-        lam, _ = nnls(W, -x)
+        lam, _ = solve_nnls(W, -x)
         u = -(x + W @ lam)
         if np.linalg.norm(u) < 1e-12 * np.linalg.norm(x):  # T_C = {0}: no motion is consistent
             u = np.zeros(n_dof)

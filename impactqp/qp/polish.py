@@ -23,8 +23,8 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from scipy.optimize import nnls
 
+from ..kernels.active_set import solve_nnls
 from .program import QPSolution, QuadraticProgram
 
 REFINEMENT_STEPS = 8
@@ -96,14 +96,14 @@ def least_norm_step(B, r: np.ndarray, delta: float) -> np.ndarray | None:
 
 def nonnegative_multipliers(AJ, g: np.ndarray, y0: np.ndarray, delta: float) -> np.ndarray:
     """y ≥ 0 with A_Jᵀy = g: the solver's own multipliers y0 (≥ 0, nearly right) plus the
-    least-norm correction; scipy's exact NNLS when that correction breaks y ≥ 0 on a
-    dense problem."""
+    least-norm correction; the exact NNLS of the compiled active-set search when that
+    correction breaks y ≥ 0 on a dense problem."""
     y0 = np.maximum(y0, 0.0)
     d = least_norm_step(AJ, g - np.asarray(AJ.T @ y0).ravel(), delta)
     y = y0 + (d if d is not None else 0.0)
     if y.min() >= -1e-12 * max(float(np.abs(y).max(initial=0.0)), 1e-300) or sp.issparse(AJ):
         return np.maximum(y, 0.0)
-    return nnls(np.asarray(AJ).T, g, maxiter=50 * AJ.shape[0])[0]
+    return solve_nnls(np.asarray(AJ).T, g)[0]
 
 
 ACTIVE_SET_ROUNDS = 6

@@ -1,26 +1,21 @@
-"""Exact impulse-form solve by non-negative least squares (scipy.optimize.nnls).
+"""Exact impulse-form solve by non-negative least squares (docs/theory.md §3, §9).
 
 With P = BᵀB and c = Bᵀd,  ½xᵀPx + cᵀx = ½‖Bx + d‖² − ½‖d‖², so the QP over x ≥ 0 is the
-NNLS problem min ‖Bx − (−d)‖, solved exactly by an active-set method (docs/theory.md §3, impulse
-form).
+NNLS problem min ‖Bx − (−d)‖. The compiled active-set search of
+:mod:`impactqp.kernels.active_set` finds the support and the final least-squares solve runs
+on the factor B itself. Programs without a factor, or whose c is not in the range of P (then
+no such d exists), are solved by the same search on P and c directly.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import nnls
 
-from ...errors import BackendUnsuitableError, SolverError
+from ...errors import BackendUnsuitableError, NoSolutionError, SolverError
+from ...kernels.active_set import NO_SOLUTION, SOLVED, nnls, solve_lcp_psd
 from ..program import QPSolution, QuadraticProgram
 
 MAX_VARIABLES = 400
-
-
-def psd_factor(P: np.ndarray) -> np.ndarray:
-    """B with P = BᵀB for a symmetric PSD P (via its eigendecomposition)."""
-    w, V = np.linalg.eigh(P)
-    w = np.clip(w, 0.0, None)
-    return np.sqrt(w)[:, None] * V.T
 
 
 def unsuitable(qp: QuadraticProgram) -> str | None:
@@ -32,24 +27,33 @@ def unsuitable(qp: QuadraticProgram) -> str | None:
     return None
 
 
+def _factor_form(qp: QuadraticProgram) -> tuple[np.ndarray, np.ndarray] | None:
+    """(B, d) with P = BᵀB and c = Bᵀd, when the program carries them and they fit."""
+    B, d = qp.factor, qp.factor_rhs
+    if B is None or d is None:
+        return None
+    B = np.asarray(B, dtype=float)
+    miss = np.abs(B.T @ d - qp.c).max(initial=0.0)
+    scale = np.abs(qp.c).max(initial=0.0) + np.abs(B).max(initial=0.0) * np.abs(d).max(initial=0.0)
+    return (B, np.asarray(d, dtype=float)) if miss <= 1e-10 * scale else None
+
+
 def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
-    """Solve the impulse form x ≥ 0 exactly; refuse other shapes and q ∉ range(P)."""
+    """Solve the impulse form x ≥ 0 exactly (refuse other shapes)."""
     reason = unsuitable(qp)
     if reason is not None:
         raise BackendUnsuitableError(reason)
     P = np.asarray(qp.P, dtype=float)
-    B = qp.factor if qp.factor is not None else psd_factor(P)
-    d = qp.factor_rhs
-    if d is None:
-        d, *_ = np.linalg.lstsq(B.T, qp.c, rcond=None)
-    miss = np.abs(B.T @ d - qp.c).max(initial=0.0)
-    scale = np.abs(qp.c).max(initial=0.0) + np.abs(B).max(initial=0.0) * np.abs(d).max(initial=0.0)
-    if miss > 1e-10 * scale + 1e-300:
-        raise BackendUnsuitableError("q is not in the range of the Delassus matrix (dependent "
-                                     "contacts with an inconsistent q); use 'exact' or a QP solver")
-    try:
-        x, _ = nnls(B, -d, maxiter=50 * max(qp.n_vars, 1))
-    except RuntimeError as exc:
-        raise SolverError(f"nnls did not converge: {exc}") from exc
+    factored = _factor_form(qp)
+    if factored is not None:
+        B, d = factored
+        x, _, status = nnls(np.ascontiguousarray(B), -d, 20 * qp.n_vars + 50)
+    else:
+        x, _, status = solve_lcp_psd(P, qp.c)
+    if status == NO_SOLUTION:
+        raise NoSolutionError("the impulse-form LCP has no solution: a ray x ≥ 0 with Px = 0 "
+                              "and cᵀx < 0 makes its QP unbounded below")
+    if status != SOLVED:
+        raise SolverError("nnls: the active-set search hit its step bound")
     y = P @ x + qp.c
     return QPSolution(x=x, y=np.maximum(y, 0.0), status="solved", backend="nnls")

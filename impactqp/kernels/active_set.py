@@ -1,0 +1,328 @@
+"""The small dense LCP search: a primal active-set method with Cholesky updates
+(docs/theory.md §9, "The compiled active-set search").
+
+It solves ``0 ≤ x ⟂ Gx + q ≥ 0`` for a symmetric positive semidefinite G, which is the KKT
+system of the convex QP min ½xᵀGx + qᵀx over x ≥ 0. The method is Lawson and Hanson's
+active-set scheme on this Gram form:
+
+* a passive set P holds the variables allowed to be positive; the block G_PP is kept
+  factorized (G_PP = LLᵀ), a variable joining P appends one row to L, one leaving it
+  refactors;
+* the variable with the steepest descent −(Gx + q)ⱼ joins P; the minimizer s of the
+  quadratic on P is computed and x moves towards it until a variable of P reaches zero,
+  which leaves P;
+* a joining variable whose column is dependent on those of P (a zero Schur complement:
+  redundant contacts) is reached along the ray d with dⱼ = 1, d_P = −G_PP⁻¹G_Pj, on which
+  G d = 0 and the objective falls linearly; the ray ends where a variable of P reaches zero
+  and trades places with j. A ray that never ends proves that the QP is unbounded below, i.e.
+  that the LCP has no solution (for PSD G an LCP is solvable iff feasible).
+
+It needs no inverse and no eigen-decomposition; a warm start enters the passive set of an
+earlier solve. NNLS, min ‖Ax − b‖ over x ≥ 0, is the case G = AᵀA, q = −Aᵀb
+(:func:`nnls`), finished by a least-squares solve on the factor itself.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SolverError
+from .jit import kernel
+
+SOLVED, NO_SOLUTION, ITERATION_LIMIT = 0, 1, 2
+"""Status codes of :func:`lcp_psd`."""
+
+PIVOT_TOL = 1e-12
+"""A joining column whose Schur complement is at most PIVOT_TOL·Gⱼⱼ counts as dependent."""
+
+DESCENT_TOL = 1e-13
+"""A variable joins only when −(Gx + q)ⱼ exceeds DESCENT_TOL·(max|q| + max|G|·max|x|)."""
+
+
+@kernel
+def _append(L, idx, k, G, j):
+    """Append variable j to the factor of G_PP (P = idx[:k]); False if its column is dependent."""
+    row = np.empty(k)
+    total = 0.0
+    for a in range(k):
+        s = G[idx[a], j]
+        for b in range(a):
+            s -= L[a, b] * row[b]
+        row[a] = s / L[a, a]
+        total += row[a] * row[a]
+    d = G[j, j] - total
+    if not d > PIVOT_TOL * G[j, j]:
+        return False
+    for a in range(k):
+        L[k, a] = row[a]
+    L[k, k] = np.sqrt(d)
+    idx[k] = j
+    return True
+
+
+@kernel
+def _refactor(L, idx, k, G, x):
+    """Factor G_PP anew for P = idx[:k]; variables whose columns turn out dependent leave P
+    (with x = 0). Returns the new size of P."""
+    kept = 0
+    for a in range(k):
+        j = idx[a]
+        if _append(L, idx, kept, G, j):
+            kept += 1
+        else:
+            x[j] = 0.0
+    return kept
+
+
+@kernel
+def _solve_factored(L, idx, k, rhs, out):
+    """out[idx[:k]] = G_PP⁻¹ rhs[idx[:k]] with G_PP = LLᵀ."""
+    y = np.empty(k)
+    for a in range(k):
+        s = rhs[idx[a]]
+        for b in range(a):
+            s -= L[a, b] * y[b]
+        y[a] = s / L[a, a]
+    for a in range(k - 1, -1, -1):
+        s = y[a]
+        for b in range(a + 1, k):
+            s -= L[b, a] * y[b]
+        y[a] = s / L[a, a]
+    for a in range(k):
+        out[idx[a]] = y[a]
+
+
+@kernel
+def _gradient(G, q, x, w):
+    """w = Gx + q."""
+    m = q.size
+    for i in range(m):
+        s = q[i]
+        for j in range(m):
+            if x[j] != 0.0:
+                s += G[i, j] * x[j]
+        w[i] = s
+
+
+@kernel
+def _member(idx, k, i):
+    """Whether variable i is in P = idx[:k]."""
+    for a in range(k):
+        if idx[a] == i:
+            return True
+    return False
+
+
+@kernel
+def _to_minimizer(L, idx, k, G, q, x, s, joined):
+    """Move x towards the minimizer of the quadratic on P = idx[:k] until it is reached with
+    x_P > 0, dropping the variables that reach zero on the way (Lawson–Hanson's inner loop).
+
+    Returns (new k, moved). When ``joined`` (the variable that has just entered, last in
+    idx) has a non-positive minimizer at once, it leaves again and ``moved`` is False.
+    """
+    first = True
+    while k > 0:
+        for a in range(k):
+            s[idx[a]] = -q[idx[a]]
+        _solve_factored(L, idx, k, s, s)
+        positive = True
+        for a in range(k):
+            positive &= s[idx[a]] > 0.0
+        if positive:
+            for a in range(k):
+                x[idx[a]] = s[idx[a]]
+            return k, True
+        if first and joined >= 0 and not s[joined] > 0.0:
+            x[joined] = 0.0
+            return k - 1, False
+        first = False
+        alpha = 2.0  # some s_i ≤ 0, so the step found is at most 1
+        stop = -1
+        for a in range(k):
+            i = idx[a]
+            if not s[i] > 0.0:
+                step = x[i] / (x[i] - s[i]) if x[i] > s[i] else 0.0
+                if step < alpha:
+                    alpha = step
+                    stop = i
+        kept = 0
+        for a in range(k):
+            i = idx[a]
+            x[i] += alpha * (s[i] - x[i])
+            if i != stop and (s[i] > 0.0 or x[i] > 0.0):
+                idx[kept] = i
+                kept += 1
+            else:
+                x[i] = 0.0
+        k = _refactor(L, idx, kept, G, x)
+    return k, True
+
+
+@kernel
+def lcp_psd(G, q, passive, x, w, max_iter):
+    """Solve ``0 ≤ x ⟂ Gx + q ≥ 0`` for a symmetric positive semidefinite G.
+
+    Parameters
+    ----------
+    G : (m, m) float array
+        Symmetric positive semidefinite (not checked).
+    q : (m,) float array
+    passive : (m,) bool array
+        In: the variables to start with in the passive set (a warm start; all False for a
+        cold one). Out: the final passive set (x > 0 only there).
+    x, w : (m,) float arrays
+        Out: the solution and w = Gx + q.
+    max_iter : int
+        Bound on the steps that change the passive set.
+
+    Returns
+    -------
+    int
+        :data:`SOLVED`, :data:`NO_SOLUTION` (a ray proves the QP unbounded below, so the
+        LCP has no feasible point) or :data:`ITERATION_LIMIT`.
+    """
+    m = q.size
+    L = np.zeros((m, m))
+    idx = np.empty(m, dtype=np.int64)
+    s = np.zeros(m)
+    blocked = np.zeros(m, dtype=np.bool_)
+    x[:] = 0.0
+    qmax = 0.0
+    gmax = 0.0
+    for i in range(m):
+        qmax = max(qmax, abs(q[i]))
+        for j in range(m):
+            gmax = max(gmax, abs(G[i, j]))
+    k = 0
+    for j in range(m):
+        if passive[j] and _append(L, idx, k, G, j):
+            k += 1
+    restore = k > 0  # a warm start first moves to the minimizer on its passive set
+    status = ITERATION_LIMIT
+    for _ in range(max_iter):
+        joined = -1
+        if not restore:
+            _gradient(G, q, x, w)
+            xmax = 0.0
+            for i in range(m):
+                xmax = max(xmax, x[i])
+            best = DESCENT_TOL * (qmax + gmax * xmax)
+            for i in range(m):
+                if -w[i] > best and not blocked[i] and not _member(idx, k, i):
+                    best = -w[i]
+                    joined = i
+            if joined < 0:
+                status = SOLVED
+                break
+            if not _append(L, idx, k, G, joined):
+                # dependent column: follow the ray d (d_j = 1, d_P = −G_PP⁻¹G_Pj), G d = 0
+                for a in range(k):
+                    s[idx[a]] = -G[idx[a], joined]
+                _solve_factored(L, idx, k, s, s)
+                t = np.inf
+                leave = -1
+                for a in range(k):
+                    i = idx[a]
+                    if s[i] < 0.0 and x[i] / -s[i] < t:
+                        t = x[i] / -s[i]
+                        leave = a
+                if leave < 0:
+                    status = NO_SOLUTION
+                    break
+                for a in range(k):
+                    x[idx[a]] += t * s[idx[a]]
+                x[idx[leave]] = 0.0
+                x[joined] = t
+                idx[leave] = joined
+                k = _refactor(L, idx, k, G, x)
+                blocked[:] = False
+                restore = True
+                continue
+            k += 1
+        restore = False
+        k, moved = _to_minimizer(L, idx, k, G, q, x, s, joined)
+        if moved:
+            blocked[:] = False
+        else:  # round-off: the joining variable would leave at once; keep it out
+            blocked[joined] = True
+    # one step of refinement on the final support, kept when it stays positive
+    if status == SOLVED and k > 0:
+        _gradient(G, q, x, w)
+        for a in range(k):
+            s[idx[a]] = -w[idx[a]]
+        _solve_factored(L, idx, k, s, s)
+        ok = True
+        for a in range(k):
+            ok &= x[idx[a]] + s[idx[a]] > 0.0
+        if ok:
+            for a in range(k):
+                x[idx[a]] += s[idx[a]]
+    _gradient(G, q, x, w)
+    passive[:] = False
+    for a in range(k):
+        passive[idx[a]] = x[idx[a]] > 0.0
+    return status
+
+
+@kernel
+def nnls(A, b, max_iter):
+    """min ‖Ax − b‖₂ over x ≥ 0: the active-set search on G = AᵀA, q = −Aᵀb, then the
+    least-squares problem on the final support solved on A itself (no squared condition).
+
+    Returns ``(x, ‖Ax − b‖₂, status)`` with the status codes of :func:`lcp_psd`.
+    """
+    n, m = A.shape
+    G = A.T @ A
+    q = -(A.T @ b)
+    x = np.zeros(m)
+    w = np.zeros(m)
+    passive = np.zeros(m, dtype=np.bool_)
+    status = lcp_psd(G, q, passive, x, w, max_iter)
+    k = 0
+    for j in range(m):
+        k += passive[j]
+    if status == SOLVED and 0 < k <= n:
+        support = np.flatnonzero(passive)
+        sub = np.empty((n, k))
+        for a in range(k):
+            sub[:, a] = A[:, support[a]]
+        xs = np.linalg.lstsq(sub, b.astype(np.float64), -1.0)[0]
+        if (xs > 0.0).all():
+            for a in range(k):
+                x[support[a]] = xs[a]
+    r = A @ x - b
+    return x, np.sqrt(np.sum(r * r)), status
+
+
+def solve_lcp_psd(G: np.ndarray, q: np.ndarray, passive: np.ndarray | None = None,
+                  ) -> tuple[np.ndarray, np.ndarray, int]:
+    """``(x, w, status)`` of ``0 ≤ x ⟂ w = Gx + q ≥ 0`` by :func:`lcp_psd`, cold or warm.
+
+    ``passive`` (a bool array of size m, updated in place) carries a warm start from one
+    call to the next; the step bound is 20m + 50, far above the m to 3m steps usually taken.
+    """
+    G = np.ascontiguousarray(G, dtype=np.float64)
+    q = np.ascontiguousarray(q, dtype=np.float64)
+    m = q.size
+    if passive is None:
+        passive = np.zeros(m, dtype=np.bool_)
+    x, w = np.zeros(m), np.zeros(m)
+    status = lcp_psd(G, q, passive, x, w, 20 * m + 50)
+    return x, w, int(status)
+
+
+def solve_nnls(A: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, float]:
+    """``(x, ‖Ax − b‖₂)`` for min ‖Ax − b‖₂ over x ≥ 0 by :func:`nnls`.
+
+    Raises
+    ------
+    SolverError
+        When the search hits its step bound (20m + 50 steps).
+    """
+    A = np.ascontiguousarray(A, dtype=np.float64)
+    x, rnorm, status = nnls(A, np.ascontiguousarray(b, dtype=np.float64), 20 * A.shape[1] + 50)
+    if status != SOLVED:
+        raise SolverError(f"NNLS did not finish: the active-set search on {A.shape[1]} "
+                          "variables hit its step bound")
+    return x, float(rnorm)
