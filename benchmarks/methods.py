@@ -19,8 +19,8 @@ import scipy.sparse as sp
 from scipy.optimize import isotonic_regression
 
 import impactqp as iq
-from impactqp.qp.active_set import MAX_CONTACTS
 from impactqp.qp.backends.exact import MAX_CONSTRAINTS
+from impactqp.qp.backends.kernel import MAX_VARIABLES as KERNEL_MAX
 from impactqp.qp.backends.nnls_ import MAX_VARIABLES
 
 from .families import Case
@@ -222,7 +222,7 @@ BIG = 100_000
 METHODS: list[Method] = [
     Method("iq:auto", "impactqp", _iq("auto")),
     Method("iq:isotonic", "impactqp", _iq("isotonic"), kinds=("chain",)),
-    Method("iq:kernel", "impactqp", _iq("kernel"), fits=_dense_up_to(MAX_CONTACTS)),
+    Method("iq:kernel", "impactqp", _iq("kernel"), fits=_dense_up_to(KERNEL_MAX)),
     Method("iq:nnls", "impactqp", _iq("nnls"), fits=_dense_up_to(MAX_VARIABLES)),
     Method("iq:exact", "impactqp", _iq("exact"), fits=_contacts_up_to(MAX_CONSTRAINTS - 2)),
     Method("iq:clarabel", "impactqp", _iq("clarabel"), max_size=BIG),

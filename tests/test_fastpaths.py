@@ -37,14 +37,16 @@ def test_auto_picks_fast_paths():
     assert iq.moreau(iq.newtons_cradle(20), 1.0).backend == "isotonic"
     assert iq.moreau(iq.random_impact(5, 4, seed=0), 1.0).backend == "kernel"
     assert iq.newton(iq.newtons_cradle(), [1.0, 0.5]).backend == "kernel"
-    assert iq.moreau(iq.random_impact(30, 20, seed=0), 1.0).backend == "nnls"
+    assert iq.moreau(iq.random_impact(30, 20, seed=0), 1.0).backend == "kernel"
+    assert iq.moreau(iq.random_impact(30, 20, seed=0), 1.0, backend="nnls").backend == "nnls"
 
 
 def test_named_fast_path_that_does_not_apply():
     with pytest.raises(iq.BackendUnsuitableError, match="chains"):
         iq.moreau(iq.random_impact(4, 3, seed=0), 0.5, backend="isotonic")
-    with pytest.raises(iq.BackendUnsuitableError, match="at most"):
-        iq.moreau(iq.random_impact(30, 20, seed=0), 0.5, backend="kernel")
+    with pytest.raises(iq.BackendUnsuitableError, match="dense"):
+        iq.moreau(iq.chain(np.ones(600), np.r_[1.0, np.zeros(599)], sparse=True), 0.5,
+                  backend="kernel")
 
 
 def test_long_chain_is_exact():

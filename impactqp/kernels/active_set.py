@@ -160,6 +160,35 @@ def _to_minimizer(L, idx, k, G, q, x, s, joined):
 
 
 @kernel
+def _final_solve(L, idx, k, G, q, x, w, s):
+    """The solution on the final support as a function of the support alone (indices in
+    order, a fresh factor, one step of iterative refinement), so that the path that found it
+    (cold or warm start) leaves no trace; kept only where it stays positive."""
+    idx[:k] = np.sort(idx[:k])
+    if _refactor(L, idx, k, G, s) < k:
+        return
+    for a in range(k):
+        s[idx[a]] = -q[idx[a]]
+    _solve_factored(L, idx, k, s, s)
+    for _ in range(2):  # the solve, then one refinement step
+        ok = True
+        for a in range(k):
+            ok &= s[idx[a]] > 0.0
+        if not ok:
+            return
+        for i in range(x.size):
+            x[i] = 0.0
+        for a in range(k):
+            x[idx[a]] = s[idx[a]]
+        _gradient(G, q, x, w)
+        for a in range(k):
+            s[idx[a]] = -w[idx[a]]
+        _solve_factored(L, idx, k, s, s)
+        for a in range(k):
+            s[idx[a]] += x[idx[a]]
+
+
+@kernel
 def lcp_psd(G, q, passive, x, w, max_iter):
     """Solve ``0 ≤ x ⟂ Gx + q ≥ 0`` for a symmetric positive semidefinite G.
 
@@ -246,23 +275,26 @@ def lcp_psd(G, q, passive, x, w, max_iter):
             blocked[:] = False
         else:  # round-off: the joining variable would leave at once; keep it out
             blocked[joined] = True
-    # one step of refinement on the final support, kept when it stays positive
     if status == SOLVED and k > 0:
-        _gradient(G, q, x, w)
-        for a in range(k):
-            s[idx[a]] = -w[idx[a]]
-        _solve_factored(L, idx, k, s, s)
-        ok = True
-        for a in range(k):
-            ok &= x[idx[a]] + s[idx[a]] > 0.0
-        if ok:
-            for a in range(k):
-                x[idx[a]] += s[idx[a]]
+        _final_solve(L, idx, k, G, q, x, w, s)
     _gradient(G, q, x, w)
     passive[:] = False
     for a in range(k):
         passive[idx[a]] = x[idx[a]] > 0.0
     return status
+
+
+@kernel
+def lcp_psd_rows(G, Q, passive, max_iter):
+    """:func:`lcp_psd` for every row of Q as q, each row warm-started by the support of the
+    row before. Returns (X, W, status) with X, W of Q's shape and one status per row."""
+    k, m = Q.shape
+    X = np.empty((k, m))
+    W = np.empty((k, m))
+    status = np.empty(k, dtype=np.int64)
+    for r in range(k):
+        status[r] = lcp_psd(G, Q[r], passive, X[r], W[r], max_iter)
+    return X, W, status
 
 
 @kernel

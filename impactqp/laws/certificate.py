@@ -7,7 +7,7 @@ sᵢ = sqrt(Gᵢᵢ) (|γᵢ| ≤ sᵢ‖u‖ by Cauchy–Schwarz in M), impulse
 impulse that changes the velocity by V along contact i), energies against V². The
 computations live in
 :mod:`impactqp.model.residuals`, which makes them safe at any velocity scale; a chain's are
-recomputed in O(N) passes without a matrix by :mod:`impactqp.model.chain_residuals`.
+recomputed in one O(N) pass without a matrix by :mod:`impactqp.model.chain_residuals`.
 """
 
 from __future__ import annotations
@@ -109,8 +109,7 @@ def certify(problem: ImpactProblem, u_plus: np.ndarray, impulses: np.ndarray, E,
     """
     st = problem.structure
     if st.chain is not None and np.ndim(E) == 0:  # O(N), no matrix (docs/theory.md §5)
-        raw = chain_law_residuals(st, problem.u_minus, u_plus, impulses, float(E), eps=eps,
-                                  V=problem.norm_minus)
+        raw = chain_law_residuals(st, problem.u_minus, u_plus, impulses, float(E), eps=eps)
     else:
         raw = law_residuals(st, problem.u_minus, u_plus, impulses, E, eps=eps)
     r = {k: as_residual(v) for k, v in raw.items()}

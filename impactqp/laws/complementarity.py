@@ -45,11 +45,12 @@ class _ComplementarityLaw(ImpactLaw):
     forms = ("impulse",)
 
     @abstractmethod
-    def _E(self, m: int) -> np.ndarray:
-        """The law's E for m contacts: an (m,) diagonal or an (m, m) matrix."""
+    def restitution(self, m: int) -> np.ndarray:
+        """The law's E for m contacts: an (m,) diagonal or an (m, m) matrix
+        (docs/theory.md §3)."""
 
     def program(self, problem: ImpactProblem, form: str) -> QuadraticProgram:
-        E, g = self._E(problem.n_contacts), problem.gamma_minus
+        E, g = self.restitution(problem.n_contacts), problem.gamma_minus
         return impulse_program(problem, g + (E * g if E.ndim == 1 else E @ g))
 
     def recover(self, problem: ImpactProblem, form: str, solution: QPSolution) -> Answer:
@@ -58,7 +59,7 @@ class _ComplementarityLaw(ImpactLaw):
 
     def linear_terms(self, problem: ImpactProblem, U_minus: np.ndarray,
                      form: str) -> np.ndarray:
-        E, G = self._E(problem.n_contacts), problem.structure.Wt_times(U_minus)
+        E, G = self.restitution(problem.n_contacts), problem.structure.Wt_times(U_minus)
         return G + (E * G if E.ndim == 1 else G @ E.T)
 
     def recover_rows(self, problem: ImpactProblem, form: str, U_minus: np.ndarray,
@@ -67,10 +68,11 @@ class _ComplementarityLaw(ImpactLaw):
 
     def residuals(self, structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
                   impulses: np.ndarray) -> dict[str, np.ndarray]:
-        return law_residuals(structure, U_minus, U_plus, impulses, self._E(structure.m))
+        return law_residuals(structure, U_minus, U_plus, impulses, self.restitution(structure.m))
 
     def certificate(self, problem: ImpactProblem, answer: Answer, tol: float) -> Certificate:
-        return certify(problem, answer.u_plus, answer.impulses, self._E(problem.n_contacts),
+        return certify(problem, answer.u_plus, answer.impulses,
+                       self.restitution(problem.n_contacts),
                        tol=tol)
 
 
@@ -103,15 +105,11 @@ class Newton(_ComplementarityLaw):
     def coefficients(self) -> np.ndarray:
         return self.e
 
-    def _E(self, m: int) -> np.ndarray:
+    def restitution(self, m: int) -> np.ndarray:
         return np.full(m, self.e[0]) if self._scalar else self.e
 
     def coefficients_for(self, problem: ImpactProblem) -> np.ndarray:
-        return self._E(problem.n_contacts)
-
-    def coefficients_for_size(self, m: int) -> list[float]:
-        """The m coefficients eᵢ as Python floats."""
-        return self._E(m).tolist()
+        return self.restitution(problem.n_contacts)
 
     def check(self, problem: ImpactProblem) -> None:
         if not self._scalar:
@@ -146,7 +144,7 @@ class Fremond(_ComplementarityLaw):
     def coefficients(self) -> np.ndarray:
         return self.E
 
-    def _E(self, m: int) -> np.ndarray:
+    def restitution(self, m: int) -> np.ndarray:
         return self.E
 
     def check(self, problem: ImpactProblem) -> None:

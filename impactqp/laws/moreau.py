@@ -66,6 +66,14 @@ class Moreau(ImpactLaw):
     def coefficients(self) -> float:
         return self.eps
 
+    def projection(self, problem: ImpactProblem, u_plus: np.ndarray) -> np.ndarray:
+        """z = (u⁺ + εu⁻)/(1 + ε) of this law's answer u⁺ (docs/theory.md §3)."""
+        return (u_plus + self.eps * problem.u_minus) / (1.0 + self.eps)
+
+    def restitution(self, m: int) -> np.ndarray:
+        """The law's E = εI for m contacts (docs/theory.md §3)."""
+        return np.eye(m) * self.eps
+
     def program(self, problem: ImpactProblem, form: str) -> QuadraticProgram:
         if form == "velocity":
             return velocity_program(problem)
@@ -82,7 +90,7 @@ class Moreau(ImpactLaw):
             u_plus += z
             return Answer(u_plus, (1.0 + e) * solution.y, z)
         u = u_m + problem.structure.impulse_velocity(solution.x)
-        return Answer(u, solution.x, (u + e * u_m) / (1.0 + e))
+        return Answer(u, solution.x, self.projection(problem, u))
 
     def linear_terms(self, problem: ImpactProblem, U_minus: np.ndarray,
                      form: str) -> np.ndarray:

@@ -106,8 +106,8 @@ class ImpactResult:
         z = self._z
         if z is None:
             return self.problem.moreau_split[0]
-        if not isinstance(z, np.ndarray):  # a fast path's floats, converted when first read
-            z = self._z = np.array(z, dtype=float)
+        if callable(z):  # a fast path's recipe, evaluated when first read
+            z = self._z = z()
         return z
 
     @property

@@ -1,83 +1,86 @@
-"""Single small impacts on Python floats: the pipeline's first fast path (docs/theory.md §8, §9).
+"""Single dense impacts in compiled code: the pipeline's first fast path (docs/theory.md §8, §9).
 
-For a dense impact with a few contacts, numpy's per-call overhead dwarfs the arithmetic. This
-path runs a program compiled once per structure (:mod:`impactqp.laws.unrolled`): the
-prepared active-set kernel's supports and every residual of the law's certificate
-(docs/theory.md §8: momentum, Λ ≥ 0, law feasibility, complementarity and, for Moreau's law,
-the energy balance and the duality gap) spelled out on Python floats, with the same formulas
-as :func:`impactqp.model.residuals.law_residuals`, in the same units. An answer whose
-residuals miss the tolerance is not returned: the pipeline goes on to the general path.
+For a dense impact of Moreau's law, local Newton or Frémond's law, the whole solve — γ⁻, the
+impulse-form LCP by the compiled active-set search, u⁺ and every residual of the law's
+certificate — runs in one call of :func:`impactqp.kernels.impact.solve_impact`, which says
+whether every residual is within the tolerance. An answer that misses it is not returned:
+the pipeline goes on to the general path (QP backends, polishing).
 """
 
 from __future__ import annotations
 
 import time
+import weakref
 from functools import partial
 
 import numpy as np
 
+from ..kernels.impact import solve_impact
 from ..model.problem import ImpactProblem
-from ..model.structure import ImpactStructure
-from ..qp.active_set import ActiveSetKernel
-from ..qp.backends.kernel import prepared_for
+from ..model.residuals import restitution_matrix
 from .base import ImpactLaw
 from .certificate import Certificate
 from .complementarity import Fremond, Newton
 from .moreau import Moreau
 from .result import ImpactResult
-from .unrolled import program_for
 
-SMALL_CONTACTS = 4
-"""Most contacts the float path takes (its program spells out all 2^m − 1 supports: beyond,
-compiling costs more than most structures are ever solved)."""
+MAX_CONTACTS = 400
+"""Most contacts the compiled path takes (the dense LCP search costs O(m³) at most)."""
 
-SMALL_DOF = 12
-"""Most degrees of freedom the float path takes."""
+MAX_DOF = 2000
+"""Most degrees of freedom the compiled path takes (its residuals cost O(n²) per impact)."""
+
+SHORT_CHAIN = 10
+"""Most contacts of a chain the compiled path takes; longer chains go to isotonic regression,
+exact in O(N) where the Delassus matrix of a chain grows ill-conditioned (docs/theory.md §5)."""
+
+_LAWS = (Moreau, Newton, Fremond)
+"""The laws the compiled path takes, by exact type (a subclass may change the law)."""
 
 
-_KINDS = {Moreau: "moreau", Newton: "newton", Fremond: "fremond"}
-"""The laws the float path takes, by exact type (a subclass may change the law)."""
+_RESTITUTION: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+"""The (m, m) restitution matrix of each law object, by m (laws are immutable)."""
+
+_MOREAU_E = np.zeros((0, 0))
+"""What the kernel takes as E for Moreau's law (it forms εI itself)."""
+
+
+def _restitution(law: ImpactLaw, m: int) -> np.ndarray:
+    """The law's E as the kernel takes it, formed once per law object and contact count."""
+    if type(law) is Moreau:
+        return _MOREAU_E
+    per_law = _RESTITUTION.setdefault(law, {})
+    E = per_law.get(m)
+    if E is None:
+        E = per_law[m] = restitution_matrix(law.restitution(m), m)
+    return E
 
 
 def applies(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str) -> bool:
-    """Whether the float path may answer (it may still decline after trying)."""
+    """Whether the compiled path may answer (it may still decline after trying)."""
     st = problem.structure
     return (backend in ("auto", "kernel") and form in ("auto", "impulse") and not st.sparse
-            and 0 < st.m <= SMALL_CONTACTS and st.n <= SMALL_DOF
-            and type(law) in _KINDS)
-
-
-def _coefficients(law: ImpactLaw, m: int) -> tuple[float, ...]:
-    """The law's E as the compiled program takes it: (ε,), the eᵢ, or E row by row."""
-    if type(law) is Moreau:
-        return (law.eps,)
-    if type(law) is Newton:
-        return tuple(law.coefficients_for_size(m))
-    return tuple(law.E.ravel().tolist())
-
-
-def _kernel(st: ImpactStructure) -> ActiveSetKernel:
-    return prepared_for(st, "impulse", st.delassus)
+            and 0 < st.m <= (MAX_CONTACTS if st.chain is None else SHORT_CHAIN)
+            and st.n <= MAX_DOF
+            and type(law) in _LAWS)
 
 
 def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float,
                 start: float) -> ImpactResult | None:
-    """The certified result by the float path, or None to go on to the general path.
-
-    The compiled program (:mod:`impactqp.laws.unrolled`) accepts only when every residual of
-    the law's certificate is within ``tol``; the Certificate object itself is built from
-    those residuals when it is first read.
-    """
+    """The certified result by the compiled path, or None to go on to the general path."""
     st = problem.structure
-    program = program_for(st, _KINDS[type(law)], _kernel)
-    if program is None:  # not compiled yet for this structure
+    moreau = type(law) is Moreau
+    eps = law.eps if moreau else 0.0
+    n, m = st.n, st.m
+    out = np.empty(n + m + 6)
+    if not solve_impact(st.kernel_pack, problem.u_minus, _restitution(law, m), eps, moreau, tol,
+                        st.warm_support, out):
         return None
-    out = program(problem.u_minus.tolist(), _coefficients(law, st.m), tol)
-    if out is None:
-        return None
-    up, lam, z, res = out
-    return ImpactResult(problem, law.name, law.coefficients_for(problem), np.array(up),
-                        np.array(lam), "kernel", partial(Certificate, *res[:5], tol, res[5]),
-                        form="impulse", z=z,
-                        attempts=["kernel (impulse, on floats): certified"], impact_law=law,
+    up = out[:n]
+    r = out[n + m:].tolist()
+    extra = (r[4], tol, r[5]) if moreau else (None, tol, None)
+    return ImpactResult(problem, law.name, law.coefficients_for(problem), up, out[n:n + m],
+                        "kernel", partial(Certificate, *r[:4], *extra), form="impulse",
+                        z=partial(law.projection, problem, up) if moreau else None,
+                        attempts=["kernel (compiled): certified"], impact_law=law,
                         solve_time=time.perf_counter() - start)

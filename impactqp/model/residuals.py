@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.rowwise import row_max, row_min, row_sum
+from ..kernels.residuals import RESIDUALS, dense_residual_rows, finish_rows
 from .structure import ImpactStructure
 
 
@@ -57,30 +58,42 @@ def impact_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np
     return V, out
 
 
+def restitution_matrix(E, m: int) -> np.ndarray:
+    """The law's E as an (m, m) matrix: a scalar ε is εI, a vector diag(e), a matrix itself."""
+    E = np.asarray(E, dtype=float)
+    if E.ndim == 0:
+        return np.eye(m) * float(E)
+    return np.diag(E) if E.ndim == 1 else np.ascontiguousarray(E)
+
+
 def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
                   Lam: np.ndarray, E, *, eps: float | None = None) -> dict[str, np.ndarray]:
     """Residuals of the certificate for one impact (1-D arrays) or k impacts (rows).
 
-    Returns a dict with the keys of :attr:`Certificate.residuals`: floats for one impact,
-    (k,) arrays for k. For Moreau's law, with u⁺ = z − εz⊥ the energy balance
-    ‖u⁺‖² − ‖z‖² − ε²‖z⊥‖² equals −2ε⟨z, z⊥⟩ (docs/theory.md §3), which is what is evaluated.
+    The formulas are those of :mod:`impactqp.kernels.residuals` (docs/theory.md §8), fed by
+    the structure's operators: compiled dense products for dense M and W, numpy products
+    otherwise. Returns a dict with the keys of :attr:`Certificate.residuals`: floats for one
+    impact, (k,) arrays for k; ``energy_balance`` and ``duality_gap`` only with Moreau's
+    ``eps``, where u⁺ = z − εz⊥ and the energy balance is −2ε⟨z, z⊥⟩ (docs/theory.md §3).
     """
     st = structure
-    U_minus, U_plus, Lam = normalized_rows(U_minus, U_plus, Lam)
-    V, out = impact_residuals(st, U_minus, U_plus, Lam)
-    gap = np.zeros(U_minus.shape[:-1])
-    if st.m:
-        s = st.contact_scale
-        g_minus = st.Wt_times(U_minus)
-        E = np.asarray(E, dtype=float)
-        w = st.Wt_times(U_plus) + (E * g_minus if E.ndim <= 1 else g_minus @ E.T)
-        out["law_feasibility"] = np.maximum(0.0, -row_min(w / (s * V[..., None])))
-        out["complementarity"] = row_max(np.abs(Lam * w)) / V**2
-        gap = row_sum(np.abs(Lam * w)) / V**2
+    one = np.ndim(U_minus) == 1
+    Um, Up, L = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (U_minus, U_plus, Lam))
+    moreau = eps is not None
+    e = 0.0 if eps is None else float(eps)
+    Em = restitution_matrix(E, st.m)
+    if not st.sparse and st.chain is None:
+        table = dense_residual_rows(st.dense_mass, st.dense_Wt, st.dense_Minv_W,
+                                    st.contact_scale, Um, Up, L, Em, e, moreau)
     else:
-        out["law_feasibility"] = out["complementarity"] = np.zeros(U_minus.shape[:-1])
-    if eps is not None:
-        z = (U_plus + eps * U_minus) / (1.0 + eps)
-        out["energy_balance"] = 2.0 * eps * np.abs(row_sum(st.mass_rows(z) * (U_minus - z))) / V**2
-        out["duality_gap"] = gap + out["momentum"] ** 2
-    return out
+        with np.errstate(over="ignore", invalid="ignore"):
+            Um, Up, L = normalized_rows(Um, Up, L)
+            V, _ = impact_residuals(st, Um, Up, L)
+            norms = kinetic_norms(st, Up - Um - st.impulse_velocity(L))
+            W = st.Wt_times(Up) + st.Wt_times(Um) @ Em.T if st.m else np.zeros_like(L)
+            z = (Up + e * Um) / (1.0 + e)
+            cross = row_sum(st.mass_rows(z) * (Um - z)) if moreau else np.zeros(V.size)
+        table = finish_rows(V, norms, np.ascontiguousarray(L), np.ascontiguousarray(W),
+                            st.contact_scale, e, moreau, cross)
+    names = RESIDUALS if moreau else RESIDUALS[:4]
+    return {name: (float(table[0, i]) if one else table[:, i]) for i, name in enumerate(names)}

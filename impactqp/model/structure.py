@@ -11,7 +11,6 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 from functools import cached_property
-from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
@@ -21,6 +20,7 @@ from scipy.linalg import lapack
 from ..base.arrays import Matrix, as_dense, as_matrix
 from ..base.rowwise import row_max, row_sum
 from ..errors import MassMatrixError, ShapeError
+from ..kernels.impact import pack
 
 
 @dataclass(frozen=True)
@@ -38,15 +38,6 @@ class ChainInfo:
     masses: np.ndarray
     left_wall: bool = False
     right_wall: bool = False
-
-
-class FloatRows(NamedTuple):
-    """Small dense operators as nested tuples of floats (see ImpactStructure.float_rows)."""
-
-    M: tuple[tuple[float, ...], ...]
-    Wt: tuple[tuple[float, ...], ...]
-    Minv_W: tuple[tuple[float, ...], ...]
-    contact_scale: tuple[float, ...]
 
 
 class ImpactStructure:
@@ -197,13 +188,31 @@ class ImpactStructure:
         return (L[..., :-1] - L[..., 1:]) / c.masses
 
     @cached_property
-    def float_rows(self) -> FloatRows:
-        """M, Wᵀ, M⁻¹W and the contact scales as tuples of Python floats (dense problems):
-        the operators of single small impacts without array overhead."""
-        def rows(A) -> tuple[tuple[float, ...], ...]:
-            return tuple(map(tuple, as_dense(A).tolist()))
-        return FloatRows(rows(self.M), rows(self.W.T), rows(self.Minv_W),
-                         tuple(self.contact_scale.tolist()))
+    def dense_mass(self) -> np.ndarray:
+        """M as a C-contiguous float array (dense problems): the kernels' operand."""
+        return np.ascontiguousarray(as_dense(self.M), dtype=float)
+
+    @cached_property
+    def dense_Wt(self) -> np.ndarray:
+        """Wᵀ as a C-contiguous float array (dense problems): the kernels' operand."""
+        return np.ascontiguousarray(as_dense(self.W).T, dtype=float)
+
+    @cached_property
+    def dense_Minv_W(self) -> np.ndarray:
+        """M⁻¹W as a C-contiguous float array (dense problems): the kernels' operand."""
+        return np.ascontiguousarray(as_dense(self.Minv_W), dtype=float)
+
+    @cached_property
+    def kernel_pack(self) -> np.ndarray:
+        """M, Wᵀ, M⁻¹W, G and the contact scales packed for the compiled impact solve
+        (:func:`impactqp.kernels.impact.pack`; dense problems)."""
+        return pack(self.dense_mass, self.dense_Wt, self.dense_Minv_W, as_dense(self.delassus),
+                    self.contact_scale)
+
+    @cached_property
+    def warm_support(self) -> np.ndarray:
+        """The support of the last compiled impact solve: the next one starts from it."""
+        return np.zeros(self.m, dtype=bool)
 
     @cached_property
     def contact_rows(self) -> Matrix:

@@ -67,8 +67,8 @@ class Backend:
 
 
 REGISTRY: dict[str, Backend] = {b.name: b for b in (
-    Backend("kernel", "kernel", "numpy", "numpy", ("impulse",), True,
-            "prepared active-set kernel: dense impulse form, at most 10 contacts",
+    Backend("kernel", "kernel", "numba", "numba", ("impulse",), True,
+            "compiled active-set search: dense impulse form, at most 400 contacts",
             scale_free=True),
     Backend("isotonic", "isotonic", "scipy", "scipy", ("velocity",), True,
             "weighted isotonic regression: velocity form of 1-D chains, O(N)", scale_free=True),

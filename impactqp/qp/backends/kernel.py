@@ -1,9 +1,9 @@
-"""The ``"kernel"`` backend: the prepared active-set kernel for small dense LCPs.
+"""The ``"kernel"`` backend: the compiled active-set search for dense LCPs.
 
-Serves the impulse form ``x ≥ 0`` with a dense P of at most
-:data:`~impactqp.qp.active_set.MAX_CONTACTS` variables (docs/theory.md §9). The kernel (the
-inverses of every invertible principal block of P) is prepared once per program owner and
-tag, so repeated impacts of one structure pay only a few tiny products.
+Serves the impulse form ``x ≥ 0`` with a dense P of at most :data:`MAX_VARIABLES` variables
+(docs/theory.md §9) by :func:`impactqp.kernels.active_set.lcp_psd`. The support found last is
+kept per program owner and tag, so repeated impacts of one structure start from it; a batch
+warm-starts each row from the row before.
 """
 
 from __future__ import annotations
@@ -12,48 +12,50 @@ import weakref
 
 import numpy as np
 
-from ...errors import SolverError
-from ..active_set import MAX_CONTACTS, ActiveSetKernel
+from ...errors import NoSolutionError, SolverError
+from ...kernels.active_set import NO_SOLUTION, SOLVED, lcp_psd_rows, solve_lcp_psd
 from ..program import QPSolution, QuadraticProgram
 
-_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+MAX_VARIABLES = 400
+"""Most impulse variables served (the search costs O(m³) at most)."""
+
+_WARM: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def unsuitable(qp: QuadraticProgram) -> str | None:
     if qp.sparse:
         return "'kernel' takes dense programs only"
-    if not 0 < qp.n_vars <= MAX_CONTACTS:
-        return (f"'kernel' takes at most {MAX_CONTACTS} contacts (impulse variables), "
+    if not 0 < qp.n_vars <= MAX_VARIABLES:
+        return (f"'kernel' takes 1 to {MAX_VARIABLES} contacts (impulse variables), "
                 f"got {qp.n_vars}")
     return None
 
 
-def prepared(qp: QuadraticProgram) -> ActiveSetKernel:
-    """The kernel of ``qp.P``, shared by every program with the same owner and tag."""
+def _warm_start(qp: QuadraticProgram) -> np.ndarray:
+    """The support kept for the program's owner and tag (a fresh one without an owner)."""
     if qp.cache_owner is None:
-        return ActiveSetKernel(np.asarray(qp.P, dtype=float))
-    return prepared_for(qp.cache_owner, qp.cache_tag, qp.P)
-
-
-def prepared_for(owner: object, tag: str, P: np.ndarray) -> ActiveSetKernel:
-    """The kernel of P kept for (owner, tag): P must be the same matrix at every call."""
-    per_owner = _CACHE.setdefault(owner, {})
-    kernel = per_owner.get(tag)
-    if kernel is None:
-        kernel = per_owner[tag] = ActiveSetKernel(np.asarray(P, dtype=float))
-    return kernel
+        return np.zeros(qp.n_vars, dtype=bool)
+    per_owner = _WARM.setdefault(qp.cache_owner, {})
+    passive = per_owner.get(qp.cache_tag)
+    if passive is None or passive.size != qp.n_vars:
+        passive = per_owner[qp.cache_tag] = np.zeros(qp.n_vars, dtype=bool)
+    return passive
 
 
 def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
-    lam = prepared(qp).solve(qp.c)
-    if lam is None:
-        raise SolverError("kernel: no invertible support fits (q is not in the range of P)")
-    return QPSolution(x=lam, y=np.maximum(qp.P @ lam + qp.c, 0.0), status="solved",
-                      backend="kernel")
+    x, w, status = solve_lcp_psd(np.asarray(qp.P, dtype=float), qp.c, _warm_start(qp))
+    if status == NO_SOLUTION:
+        raise NoSolutionError("kernel: the LCP has no solution (a ray x ≥ 0 with Px = 0 and "
+                              "cᵀx < 0 makes its QP unbounded below)")
+    if status != SOLVED:
+        raise SolverError("kernel: the active-set search hit its step bound")
+    return QPSolution(x=x, y=np.maximum(w, 0.0), status="solved", backend="kernel")
 
 
 def solve_many(qp: QuadraticProgram, C: np.ndarray, *, tol: float = 1e-10,
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(X, Y, solved mask) for the rows of C as linear terms, vectorised over rows."""
-    X, done = prepared(qp).solve_batch(C)
-    return X, X @ qp.P + C, done
+    """(X, Y, solved mask) for the rows of C as linear terms."""
+    P = np.ascontiguousarray(qp.P, dtype=float)
+    X, Y, status = lcp_psd_rows(P, np.ascontiguousarray(C, dtype=float), _warm_start(qp),
+                                20 * qp.n_vars + 50)
+    return X, Y, status == SOLVED
