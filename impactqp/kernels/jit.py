@@ -17,3 +17,9 @@ def kernel(function: F) -> F:
     division by zero give inf/NaN (which every certificate then rejects) instead of raising.
     """
     return numba.njit(cache=True, nogil=True, error_model="numpy")(function)
+
+
+def inline_kernel(function: F) -> F:
+    """:func:`kernel` for a helper of a few operations, inlined into every kernel calling it
+    (a call that is not inlined costs as much as the helper's arithmetic)."""
+    return numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")(function)

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from .jit import inline_kernel, kernel
 
 RESIDUALS = ("momentum", "impulse_sign", "law_feasibility", "complementarity",
              "energy_balance", "duality_gap")
@@ -35,13 +35,13 @@ SCALE_RANGE = (1e-60, 1e60)
 """Largest entries of u⁻ whose squares need no rescaling; outside, inputs are divided by it."""
 
 
-@kernel
+@inline_kernel
 def _low(a, b):
     """min(a, b) that keeps a NaN of either."""
     return a if (a < b or a != a) else b
 
 
-@kernel
+@inline_kernel
 def _high(a, b):
     """max(a, b) that keeps a NaN of either."""
     return a if (a > b or a != a) else b
@@ -51,7 +51,7 @@ NEW_FOLD = (np.inf, np.inf, 0.0, 0.0)
 """The neutral fold of the contacts: (min Λᵢsᵢ, min wᵢ/sᵢ, max |Λᵢwᵢ|, Σ |Λᵢwᵢ|)."""
 
 
-@kernel
+@inline_kernel
 def fold_contact(acc, lam, w, s):
     """``acc`` (see :data:`NEW_FOLD`) with one more contact: impulse Λ, w = γ⁺ + Eγ⁻, scale s."""
     p = abs(lam * w)
@@ -67,7 +67,7 @@ def fold_contacts(lam, w, s):
     return acc
 
 
-@kernel
+@inline_kernel
 def finish(V, momentum_norm, acc, eps, moreau, cross, out):
     """The six residuals (order :data:`RESIDUALS`) from V, ‖u⁺ − u⁻ − M⁻¹WΛ‖, the fold of the
     contacts and, for Moreau's law (``moreau``), ε and cross = ⟨z, u⁻ − z⟩."""
@@ -117,7 +117,7 @@ def _quadratic(M, x, y):
     return total
 
 
-@kernel
+@inline_kernel
 def velocity_unit(V2_minus, V2_plus):
     """V = ‖u⁻‖, or for u⁻ = 0 the answer's own size, at least 1 (docs/theory.md §8)."""
     if V2_minus > 0.0:
@@ -166,17 +166,10 @@ def dense_residual_rows(M, Wt, MinvW, s, Um, Up, Lam, E, eps, moreau):
     return out
 
 
-@kernel
-def chain_residuals(um, up, lam, masses, s, left_wall, right_wall, E, eps, moreau, out):
-    """The residuals of one impact of a 1-D chain (docs/theory.md §5, §8) in one O(N) loop.
-
-    Contacts are the gaps between neighbours, with a wall contact first (γ = u₁) and last
-    (γ = −u_N) where there are walls; E is the scalar restitution. With t = u⁺ − u⁻ and L_j
-    the impulse left of ball j, the momentum is Σⱼ rⱼ²/mⱼ with rⱼ = mⱼtⱼ − (L_j − L_{j+1}),
-    and ⟨z, u⁻ − z⟩ = −(⟨t, u⁻⟩ + ‖t‖²/(1+ε))/(1+ε) in the kinetic metric.
-    """
+@inline_kernel
+def _chain_pass(um, up, lam, masses, s, left_wall, right_wall, E, eps, moreau, f, out):
+    """:func:`chain_residuals` with the inputs multiplied by f."""
     n = um.size
-    f = 1.0 / unit_of(um, up, lam)
     lo = 0 if left_wall else 1  # Λ = (L_lo, L_lo+1, …)
     V2m = 0.0
     V2p = 0.0
@@ -214,6 +207,33 @@ def chain_residuals(um, up, lam, masses, s, left_wall, right_wall, E, eps, morea
     V = velocity_unit(V2m, V2p)
     cross = -(mt_u + mt_t / (1.0 + eps)) / (1.0 + eps) if moreau else 0.0
     finish(V, np.sqrt(q), acc, eps, moreau, cross, out)
+
+
+@inline_kernel
+def chain_residuals(um, up, lam, masses, s, left_wall, right_wall, E, eps, moreau, out):
+    """The residuals of one impact of a 1-D chain (docs/theory.md §5, §8) in one O(N) loop.
+
+    Contacts are the gaps between neighbours, with a wall contact first (γ = u₁) and last
+    (γ = −u_N) where there are walls; E is the scalar restitution. With t = u⁺ − u⁻ and L_j
+    the impulse left of ball j, the momentum is Σⱼ rⱼ²/mⱼ with rⱼ = mⱼtⱼ − (L_j − L_{j+1}),
+    and ⟨z, u⁻ − z⟩ = −(⟨t, u⁻⟩ + ‖t‖²/(1+ε))/(1+ε) in the kinetic metric. Inputs are
+    divided by :func:`unit_of` only when max|u⁻ⱼ| is outside :data:`SCALE_RANGE`.
+    """
+    top = 0.0
+    for j in range(um.size):
+        top = max(top, abs(um[j]))
+    f = 1.0 if SCALE_RANGE[0] < top < SCALE_RANGE[1] else 1.0 / unit_of(um, up, lam)
+    _chain_pass(um, up, lam, masses, s, left_wall, right_wall, E, eps, moreau, f, out)
+
+
+@kernel
+def chain_residual_rows(Um, Up, Lam, masses, s, left_wall, right_wall, E, eps, moreau):
+    """:func:`chain_residuals` for every row of (U⁻, U⁺, Λ): a (k, 6) array."""
+    out = np.empty((Um.shape[0], 6))
+    for r in range(Um.shape[0]):
+        chain_residuals(Um[r], Up[r], Lam[r], masses, s, left_wall, right_wall, E, eps, moreau,
+                        out[r])
+    return out
 
 
 @kernel

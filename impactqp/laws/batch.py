@@ -20,11 +20,12 @@ import numpy as np
 from ..base.arrays import as_array, as_count, check_tol
 from ..base.checks import DEFAULT_TOL
 from ..errors import BackendUnsuitableError, CertificateError, ShapeError
+from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
 from ..qp import backends
 from ..qp.certified import FAST_PATHS
 from .base import ImpactLaw
-from .chain_rows import RESIDUALS, ChainRows, suits
+from .chain_rows import ChainRows, suits
 from .moreau import Moreau
 from .pipeline import check_backend, check_law, check_problem, solve
 from .sector import SectorLaw
@@ -175,12 +176,9 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
                 Up[a:b, j] = col
             for i, col in enumerate(lam):
                 Lam[a:b, i] = col
-            general = np.flatnonzero(~rows.residuals(u, up, lam,
-                                                     {key: v[a:b] for key, v in res.items()}))
-            if general.size:  # outside the plain range: the law's own scaled routine
-                for key, v in law.residuals(st, Ua[general], Up[a:b][general],
-                                            Lam[a:b][general]).items():
-                    res[key][a + general] = v
+            table = rows.residuals(Ua, Up[a:b], Lam[a:b])
+            for i, key in enumerate(RESIDUALS):
+                res[key][a:b] = table[:, i]
         else:
             if module is None:
                 Up[a:b], Lam[a:b] = law.closed_form_rows(problem, Ua)
