@@ -112,3 +112,17 @@ def test_compiled_solves_of_every_shape(n, m) -> None:
         ref = iq.solve(p, law, backend="exact" if m <= 14 else "clarabel")
         np.testing.assert_allclose(r.u_plus, ref.u_plus, rtol=1e-8, atol=1e-10)
         assert r.attempts == [COMPILED]
+
+
+def test_the_rest_shortcut_answers_only_when_certified() -> None:
+    """u⁻ = 0 gives u⁺ = 0, Λ = 0 for the laws of the impact; a time-stepping law whose
+    previous velocity approaches (γ_prev = −2, e = 0.5) rejects it and is solved in full."""
+    from impactqp.simulation.step_law import MoreauJeanStep
+
+    rest = iq.ImpactProblem(np.eye(2), [[-1.0], [1.0]], [0.0, 0.0])
+    r = iq.moreau(rest, 0.5)
+    assert r.certificate.ok and not r.u_plus.any() and not r.impulses.any()
+    step = iq.solve(rest, MoreauJeanStep(0.5, [1.0, -1.0]))
+    assert step.certificate.ok
+    np.testing.assert_allclose(step.u_plus, [-0.5, 0.5])  # γ⁺ = −e·γ_prev = 1
+    np.testing.assert_allclose(step.impulses, [0.5])

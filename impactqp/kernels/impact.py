@@ -21,13 +21,56 @@ import numpy as np
 
 from .active_set import SOLVED, lcp_psd
 from .jit import kernel
-from .residuals import dense_residuals
+from .residuals import dense_residuals, matvec
 
 
-def pack(M: np.ndarray, Wt: np.ndarray, Minv_W: np.ndarray, G: np.ndarray,
-         s: np.ndarray) -> np.ndarray:
-    """M (n × n), Wᵀ (m × n), M⁻¹W (n × m), G (m × m) and s (m) in one flat array."""
-    return np.concatenate([np.ravel(a) for a in (M, Wt, Minv_W, G, s)]).astype(float)
+@kernel
+def pack(M, W):
+    """M (n × n), Wᵀ (m × n), M⁻¹W (n × m), G = WᵀM⁻¹W (m × m) and sᵢ = √Gᵢᵢ in one flat
+    array, from M = LLᵀ and B = L⁻¹W: G = BᵀB, M⁻¹W = L⁻ᵀB (docs/theory.md §1). Plain loops:
+    no inverse, no eigen-decomposition, no BLAS call for the small M of one impact.
+    M must be symmetric positive definite (the structure has checked it)."""
+    n, m = W.shape
+    L = np.zeros((n, n))
+    for j in range(n):
+        d = M[j, j]
+        for k in range(j):
+            d -= L[j, k] * L[j, k]
+        L[j, j] = np.sqrt(d)
+        for i in range(j + 1, n):
+            v = M[i, j]
+            for k in range(j):
+                v -= L[i, k] * L[j, k]
+            L[i, j] = v / L[j, j]
+    B = np.empty((n, m))
+    X = np.empty((n, m))
+    for c in range(m):
+        for i in range(n):  # B = L⁻¹W
+            v = W[i, c]
+            for k in range(i):
+                v -= L[i, k] * B[k, c]
+            B[i, c] = v / L[i, i]
+        for i in range(n - 1, -1, -1):  # M⁻¹W = L⁻ᵀB
+            v = B[i, c]
+            for k in range(i + 1, n):
+                v -= L[k, i] * X[k, c]
+            X[i, c] = v / L[i, i]
+    out = np.empty(n * n + 2 * m * n + m * m + m)
+    out[:n * n] = M.ravel()
+    a = n * n
+    for c in range(m):
+        for i in range(n):
+            out[a + c * n + i] = W[i, c]  # Wᵀ, row by row
+            out[a + m * n + i * m + c] = X[i, c]
+    d = a + 2 * m * n
+    for r in range(m):
+        for c in range(m):
+            v = 0.0
+            for i in range(n):
+                v += B[i, r] * B[i, c]
+            out[d + r * m + c] = v
+        out[d + m * m + r] = np.sqrt(out[d + r * m + r])
+    return out
 
 
 @kernel
@@ -47,8 +90,8 @@ def _solve_into(M, Wt, MinvW, G, s, um, E, eps, moreau, tol, passive, up, lam, r
     n, m = um.size, passive.size
     if moreau:
         E = eps * np.eye(m)
-    g = Wt @ um
-    q = g + E @ g
+    g = matvec(Wt, um)
+    q = g + matvec(E, g)
     w = np.empty(m)
     if lcp_psd(G, q, passive, lam, w, 20 * m + 50) != SOLVED:
         return False

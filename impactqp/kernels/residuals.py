@@ -118,6 +118,19 @@ def _quadratic(M, x, y):
 
 
 @inline_kernel
+def matvec(A, x):
+    """Ax by plain loops: for the small operands of one impact a BLAS call costs more (and
+    wakes a second BLAS thread pool where numpy and scipy bring their own)."""
+    out = np.zeros(A.shape[0])
+    for i in range(A.shape[0]):
+        total = 0.0
+        for j in range(A.shape[1]):
+            total += A[i, j] * x[j]
+        out[i] = total
+    return out
+
+
+@inline_kernel
 def velocity_unit(V2_minus, V2_plus):
     """V = ‖u⁻‖, or for u⁻ = 0 the answer's own size, at least 1 (docs/theory.md §8)."""
     if V2_minus > 0.0:
@@ -140,7 +153,7 @@ def dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, out):
             d[i] -= MinvW[i, j] * la[j]
     V = velocity_unit(_quadratic(M, a, a), _quadratic(M, b, b))
     momentum = np.sqrt(_high(_quadratic(M, d, d), 0.0))
-    g = Wt @ a if m else np.zeros(0)
+    g = matvec(Wt, a)
     w = np.empty(m)
     for i in range(m):
         total = 0.0

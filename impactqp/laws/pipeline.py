@@ -78,7 +78,9 @@ def _result(problem: ImpactProblem, law: ImpactLaw, answer: Answer, backend: str
 
 
 def _trivial(problem: ImpactProblem) -> Answer:
-    """No contact, or u⁻ = 0 (then γ⁻ = 0 and Λ = 0 solves every law exactly)."""
+    """No contact, or u⁻ = 0: u⁺ = u⁻ and Λ = 0, which solves every law of docs/theory.md §3
+    exactly (γ⁻ = 0); a law with other data (a time-stepping law's previous velocity) may
+    reject it, and its certificate decides."""
     u = problem.u_minus.copy()
     return Answer(u, np.zeros(problem.n_contacts), u.copy())
 
@@ -136,8 +138,13 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
             return result
     if problem.n_contacts == 0 or not problem.u_minus.any():
         answer = _trivial(problem)
-        return _result(problem, law, answer, "none", law.certificate(problem, answer, tol),
-                       start, attempts=["no contact or u⁻ = 0: u⁺ = u⁻, Λ = 0"])
+        cert = law.certificate(problem, answer, tol)
+        if cert.ok:  # the shortcut answers only when the law's own certificate passes
+            return _result(problem, law, answer, "none", cert, start,
+                           attempts=["no contact or u⁻ = 0: u⁺ = u⁻, Λ = 0"])
+        if problem.n_contacts == 0:
+            raise CertificateError(f"{law.title} without contacts: u⁺ = u⁻ fails its "
+                                   f"certificate, {cert.summary()}")
     if not law.forms:
         return _closed_form(problem, law, backend, tol, start)
 

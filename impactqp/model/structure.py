@@ -206,8 +206,7 @@ class ImpactStructure:
     def kernel_pack(self) -> np.ndarray:
         """M, Wᵀ, M⁻¹W, G and the contact scales packed for the compiled impact solve
         (:func:`impactqp.kernels.impact.pack`; dense problems)."""
-        return pack(self.dense_mass, self.dense_Wt, self.dense_Minv_W, as_dense(self.delassus),
-                    self.contact_scale)
+        return pack(self.dense_mass, np.ascontiguousarray(as_dense(self.W), dtype=float))
 
     @cached_property
     def warm_support(self) -> np.ndarray:
