@@ -164,7 +164,13 @@ def _final_solve(L, idx, k, G, q, x, w, s):
     """The solution on the final support as a function of the support alone (indices in
     order, a fresh factor, one step of iterative refinement), so that the path that found it
     (cold or warm start) leaves no trace; kept only where it stays positive."""
-    idx[:k] = np.sort(idx[:k])
+    for a in range(1, k):  # insertion sort: k is small, and np.sort costs seconds to compile
+        i = idx[a]
+        b = a - 1
+        while b >= 0 and idx[b] > i:
+            idx[b + 1] = idx[b]
+            b -= 1
+        idx[b + 1] = i
     if _refactor(L, idx, k, G, s) < k:
         return
     for a in range(k):
