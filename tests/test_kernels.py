@@ -12,14 +12,9 @@ from scipy.optimize import linprog
 from scipy.optimize import nnls as scipy_nnls
 
 import impactqp as iq
-from impactqp.kernels.active_set import (
-    NO_SOLUTION,
-    SOLVED,
-    lcp_psd_rows,
-    solve_lcp_psd,
-    solve_nnls,
-)
+from impactqp.kernels.active_set import NO_SOLUTION, SOLVED, lcp_psd_rows, solve_lcp_psd
 from impactqp.kernels.impact import solve_impact, solve_impact_rows
+from impactqp.kernels.nnls import solve_nnls
 from impactqp.kernels.residuals import RESIDUALS, chain_residuals, dense_residuals
 from impactqp.model.residuals import restitution_matrix
 
@@ -127,8 +122,8 @@ def test_chain_loop_equals_the_dense_residuals(walls):
         up = p.u_minus + rng.standard_normal(n)
         lam = rng.standard_normal(p.n_contacts)
         a, b = np.empty(6), np.empty(6)
-        chain_residuals(p.u_minus, up, lam, masses, p.structure.contact_scale, walls[0],
-                        walls[1], 0.4, 0.4, True, a)
+        chain_residuals(p.u_minus, up, lam, masses, 1.0 / masses, p.structure.contact_scale,
+                        walls[0], walls[1], 0.4, 0.4, True, a)
         dense_residuals(dense.dense_mass, dense.dense_Wt, dense.dense_Minv_W,
                         dense.contact_scale, p.u_minus, up, lam, 0.4 * np.eye(p.n_contacts),
                         0.4, True, b)

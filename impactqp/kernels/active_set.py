@@ -19,14 +19,13 @@ active-set scheme on this Gram form:
 
 It needs no inverse and no eigen-decomposition; a warm start enters the passive set of an
 earlier solve. NNLS, min ‖Ax − b‖ over x ≥ 0, is the case G = AᵀA, q = −Aᵀb
-(:func:`nnls`), finished by a least-squares solve on the factor itself.
+(:mod:`impactqp.kernels.nnls`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..errors import SolverError
 from .jit import kernel
 
 SOLVED, NO_SOLUTION, ITERATION_LIMIT = 0, 1, 2
@@ -303,36 +302,6 @@ def lcp_psd_rows(G, Q, passive, max_iter):
     return X, W, status
 
 
-@kernel
-def nnls(A, b, max_iter):
-    """min ‖Ax − b‖₂ over x ≥ 0: the active-set search on G = AᵀA, q = −Aᵀb, then the
-    least-squares problem on the final support solved on A itself (no squared condition).
-
-    Returns ``(x, ‖Ax − b‖₂, status)`` with the status codes of :func:`lcp_psd`.
-    """
-    n, m = A.shape
-    G = A.T @ A
-    q = -(A.T @ b)
-    x = np.zeros(m)
-    w = np.zeros(m)
-    passive = np.zeros(m, dtype=np.bool_)
-    status = lcp_psd(G, q, passive, x, w, max_iter)
-    k = 0
-    for j in range(m):
-        k += passive[j]
-    if status == SOLVED and 0 < k <= n:
-        support = np.flatnonzero(passive)
-        sub = np.empty((n, k))
-        for a in range(k):
-            sub[:, a] = A[:, support[a]]
-        xs = np.linalg.lstsq(sub, b.astype(np.float64), -1.0)[0]
-        if (xs > 0.0).all():
-            for a in range(k):
-                x[support[a]] = xs[a]
-    r = A @ x - b
-    return x, np.sqrt(np.sum(r * r)), status
-
-
 def solve_lcp_psd(G: np.ndarray, q: np.ndarray, passive: np.ndarray | None = None,
                   ) -> tuple[np.ndarray, np.ndarray, int]:
     """``(x, w, status)`` of ``0 ≤ x ⟂ w = Gx + q ≥ 0`` by :func:`lcp_psd`, cold or warm.
@@ -348,19 +317,3 @@ def solve_lcp_psd(G: np.ndarray, q: np.ndarray, passive: np.ndarray | None = Non
     x, w = np.zeros(m), np.zeros(m)
     status = lcp_psd(G, q, passive, x, w, 20 * m + 50)
     return x, w, int(status)
-
-
-def solve_nnls(A: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, float]:
-    """``(x, ‖Ax − b‖₂)`` for min ‖Ax − b‖₂ over x ≥ 0 by :func:`nnls`.
-
-    Raises
-    ------
-    SolverError
-        When the search hits its step bound (20m + 50 steps).
-    """
-    A = np.ascontiguousarray(A, dtype=np.float64)
-    x, rnorm, status = nnls(A, np.ascontiguousarray(b, dtype=np.float64), 20 * A.shape[1] + 50)
-    if status != SOLVED:
-        raise SolverError(f"NNLS did not finish: the active-set search on {A.shape[1]} "
-                          "variables hit its step bound")
-    return x, float(rnorm)

@@ -50,6 +50,7 @@ class ChainRows:
     def __init__(self, structure: ImpactStructure, eps: float) -> None:
         chain = structure.chain
         self.masses = np.ascontiguousarray(chain.masses, dtype=float)
+        self.inverse = 1.0 / self.masses
         self.left, self.right = bool(chain.left_wall), bool(chain.right_wall)
         self.scale = np.ascontiguousarray(structure.contact_scale, dtype=float)
         self.eps = float(eps)
@@ -121,5 +122,5 @@ class ChainRows:
         """Moreau's residuals (docs/theory.md §8) of the rows, a (k, 6) array in the order of
         :data:`RESIDUALS`, by the one definition of the chain certificate
         (:func:`impactqp.kernels.residuals.chain_residuals`)."""
-        return chain_residual_rows(U, Up, Lam, self.masses, self.scale, self.left,
-                                   self.right, self.eps, self.eps, True)
+        return chain_residual_rows(U, Up, Lam, self.masses, self.inverse, self.scale,
+                                   self.left, self.right, self.eps, self.eps, True)

@@ -24,7 +24,7 @@ import scipy.sparse as sp
 from ..base.arrays import as_vector, check_tol
 from ..base.checks import DEFAULT_TOL, NamedChecks
 from ..errors import InputError
-from ..kernels.active_set import solve_nnls
+from ..kernels.nnls import solve_nnls
 from ..qp.backends.clarabel_ import run as run_clarabel
 from ..qp.certified import solve_in_forms
 from ..qp.lcp import solve_psd_lcp

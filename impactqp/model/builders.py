@@ -9,7 +9,7 @@ import numpy as np
 
 from ..base.arrays import as_array, as_count, as_flag, as_real
 from ..errors import InputError, SectorLawError
-from ..kernels.active_set import solve_nnls
+from ..kernels.nnls import solve_nnls
 from .chain_structure import ChainStructure, chain_directions
 from .problem import ImpactProblem
 from .structure import ChainInfo

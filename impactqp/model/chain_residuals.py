@@ -47,7 +47,7 @@ def chain_law_residuals(structure: ImpactStructure, u_minus: np.ndarray, u_plus:
     if st.m == 0 or um.shape != (st.n,) or up.shape != um.shape or lam.shape != (st.m,):
         return {k: float(v) for k, v in law_residuals(st, um, up, lam, E, eps=eps).items()}
     out = np.empty(len(RESIDUALS))
-    chain_residuals(um, up, lam, c.masses, st.contact_scale, bool(c.left_wall),
+    chain_residuals(um, up, lam, c.masses, st.inverse_masses, st.contact_scale, bool(c.left_wall),
                     bool(c.right_wall), float(E), 0.0 if eps is None else float(eps),
                     eps is not None, out)
     names = RESIDUALS if eps is not None else RESIDUALS[:4]

@@ -24,7 +24,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..kernels.active_set import solve_nnls
+from ..kernels.nnls import solve_nnls
 from .program import QPSolution, QuadraticProgram
 
 REFINEMENT_STEPS = 8

@@ -12,7 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import BackendUnsuitableError, NoSolutionError, SolverError
-from ...kernels.active_set import NO_SOLUTION, SOLVED, nnls, solve_lcp_psd
+from ...kernels.active_set import NO_SOLUTION, SOLVED, solve_lcp_psd
+from ...kernels.nnls import nnls
 from ..program import QPSolution, QuadraticProgram
 
 MAX_VARIABLES = 400

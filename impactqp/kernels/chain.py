@@ -1,0 +1,123 @@
+"""Moreau's projection on a 1-D chain in O(N): weighted isotonic regression and anchored
+impulses in compiled code (docs/theory.md §3, §5).
+
+For a chain of N balls (masses m, contacts [left wall, gaps 1..N−1, right wall]) the
+M-projection z of u⁻ onto T_C is the weighted isotonic regression of u⁻ (z₁ ≤ … ≤ z_N),
+clipped at 0 on a wall side (both walls: z = 0). :func:`project` computes it by pooling
+adjacent violators on a stack of blocks (each block a run of equal z, its value the
+weighted mean of u⁻ over the run), then the impulses: with dⱼ = mⱼ(zⱼ − u⁻ⱼ) and L_j the
+impulse left of ball j, M(z − u⁻) = WΛ reads L_j − L_{j+1} = dⱼ. Over a block Σ d = 0, so
+the contact before each block start carries none (L = 0 there, an anchor) and L is a running
+sum from the anchor; clipped blocks hang from the first free block start. Running sums are
+compensated (Neumaier), so their rounding does not grow with the length of a block.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import inline_kernel, kernel
+
+
+@inline_kernel
+def _add(total, compensation, x):
+    """Neumaier's compensated sum: (total + x, updated compensation)."""
+    t = total + x
+    if abs(total) >= abs(x):
+        compensation += (total - t) + x
+    else:
+        compensation += (x - t) + total
+    return t, compensation
+
+
+@inline_kernel
+def _pava(m, u, starts, weight, total):
+    """Blocks of the weighted isotonic regression of u: returns their count nb, with
+    ``starts[:nb + 1]`` (a last entry N), block weights and weighted sums."""
+    nb = 0
+    for j in range(u.size):
+        starts[nb] = j
+        weight[nb] = m[j]
+        total[nb] = m[j] * u[j]
+        nb += 1
+        while nb > 1 and total[nb - 2] * weight[nb - 1] > total[nb - 1] * weight[nb - 2]:
+            weight[nb - 2] += weight[nb - 1]
+            total[nb - 2] += total[nb - 1]
+            nb -= 1
+    starts[nb] = u.size
+    return nb
+
+
+@inline_kernel
+def _forward(m, u, z, L, a, b):
+    """L_{j+1} = L_j − dⱼ for j = a … b − 1, from L_a = 0 (anchored at a)."""
+    s, c = 0.0, 0.0
+    L[a] = 0.0
+    for j in range(a, b):
+        s, c = _add(s, c, -m[j] * (z[j] - u[j]))
+        L[j + 1] = s + c
+
+
+@kernel
+def project(m, u, left, right, z, L, starts, weight):
+    """z = prox_{T_C}(u⁻) and the impulses L (N + 1 entries: L_j left of ball j, L_0 and L_N
+    the walls' impulses, 0 where there is no wall) of one chain, into ``z`` and ``L``.
+
+    ``starts`` (N + 1 integers) and ``weight`` (N floats) are scratch for the blocks (a long
+    chain's caller keeps them between solves: fresh pages cost more than the regression);
+    the blocks' weighted sums live in ``L`` until the impulses are written."""
+    n = u.size
+    total = L[:n]
+    nb = _pava(m, u, starts, weight, total)
+    free = 0  # blocks whose mean is at most 0 (a wall clips them or the others)
+    for b in range(nb):
+        mean = total[b] / weight[b]
+        if mean <= 0.0:
+            free = b + 1
+        if left and right:
+            mean = 0.0
+        elif left:
+            mean = max(mean, 0.0)
+        elif right:
+            mean = min(mean, 0.0)
+        for j in range(starts[b], starts[b + 1]):
+            z[j] = mean
+    if left and right:  # z = 0: the least impulses, L = max_j E_j − E_j with E_0 = 0
+        s, c, top = 0.0, 0.0, 0.0
+        L[0] = 0.0
+        for j in range(n):
+            s, c = _add(s, c, m[j] * (z[j] - u[j]))
+            L[j + 1] = s + c
+            top = max(top, L[j + 1])
+        for j in range(n + 1):
+            L[j] = top - L[j]
+        return
+    L[0] = 0.0
+    first = free if left else 0
+    last = free if right else nb
+    for b in range(first, last):  # each free block from its own start
+        _forward(m, u, z, L, starts[b], starts[b + 1])
+    if left:  # the wall and the clipped blocks hang from the first free block start k
+        k = starts[free]
+        s, c = 0.0, 0.0
+        L[k] = 0.0
+        for j in range(k - 1, -1, -1):
+            s, c = _add(s, c, m[j] * (z[j] - u[j]))
+            L[j] = s + c
+    if right:  # the clipped blocks and the wall hang from the first clipped block start
+        _forward(m, u, z, L, starts[free], n)
+    else:
+        L[n] = 0.0
+
+
+@kernel
+def project_rows(m, U, left, right):
+    """:func:`project` for every row of U: (Z (k × N), L (k × (N + 1)))."""
+    k, n = U.shape
+    Z = np.empty((k, n))
+    L = np.empty((k, n + 1))
+    starts = np.empty(n + 1, dtype=np.int64)
+    weight = np.empty(n)
+    for r in range(k):
+        project(m, U[r], left, right, Z[r], L[r], starts, weight)
+    return Z, L

@@ -1,0 +1,58 @@
+"""Non-negative least squares, min ‖Ax − b‖₂ over x ≥ 0 (docs/theory.md §9): the active-set
+search of :mod:`impactqp.kernels.active_set` on G = AᵀA, q = −Aᵀb, with the final support's
+least-squares problem solved on A itself, so the answer does not carry the squared
+condition number of the Gram form."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SolverError
+from .active_set import SOLVED, lcp_psd
+from .jit import kernel
+
+
+@kernel
+def nnls(A, b, max_iter):
+    """min ‖Ax − b‖₂ over x ≥ 0: the active-set search on G = AᵀA, q = −Aᵀb, then the
+    least-squares problem on the final support solved on A itself (no squared condition).
+
+    Returns ``(x, ‖Ax − b‖₂, status)`` with the status codes of :func:`lcp_psd`.
+    """
+    n, m = A.shape
+    G = A.T @ A
+    q = -(A.T @ b)
+    x = np.zeros(m)
+    w = np.zeros(m)
+    passive = np.zeros(m, dtype=np.bool_)
+    status = lcp_psd(G, q, passive, x, w, max_iter)
+    k = 0
+    for j in range(m):
+        k += passive[j]
+    if status == SOLVED and 0 < k <= n:
+        support = np.flatnonzero(passive)
+        sub = np.empty((n, k))
+        for a in range(k):
+            sub[:, a] = A[:, support[a]]
+        xs = np.linalg.lstsq(sub, b.astype(np.float64), -1.0)[0]
+        if (xs > 0.0).all():
+            for a in range(k):
+                x[support[a]] = xs[a]
+    r = A @ x - b
+    return x, np.sqrt(np.sum(r * r)), status
+
+
+def solve_nnls(A: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, float]:
+    """``(x, ‖Ax − b‖₂)`` for min ‖Ax − b‖₂ over x ≥ 0 by :func:`nnls`.
+
+    Raises
+    ------
+    SolverError
+        When the search hits its step bound (20m + 50 steps).
+    """
+    A = np.ascontiguousarray(A, dtype=np.float64)
+    x, rnorm, status = nnls(A, np.ascontiguousarray(b, dtype=np.float64), 20 * A.shape[1] + 50)
+    if status != SOLVED:
+        raise SolverError(f"NNLS did not finish: the active-set search on {A.shape[1]} "
+                          "variables hit its step bound")
+    return x, float(rnorm)
