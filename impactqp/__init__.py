@@ -41,7 +41,7 @@ from .io.save import save_problem
 from .laws.base import Answer, ImpactLaw
 from .laws.batch import BatchResult, moreau_batch, sector_law_batch, solve_batch
 from .laws.catalogue import available_backends
-from .laws.certificate import Certificate
+from .laws.certificate import Certificate, SectorLawCertificate
 from .laws.complementarity import Fremond, Newton
 from .laws.functions import fremond, moreau, newton, reflection_law, sector_law
 from .laws.lzb import LZB, LZBAnswer
@@ -51,7 +51,7 @@ from .laws.moreau import Moreau
 from .laws.pipeline import solve
 from .laws.reflection import ReflectionLaw
 from .laws.result import ImpactResult
-from .laws.sector import SectorLaw, SectorLawCertificate
+from .laws.sector import SectorLaw
 from .model.admissible import AdmissibleSet, Membership
 from .model.builders import chain, newtons_cradle, random_impact
 from .model.classify import Classification, classify

@@ -9,7 +9,6 @@ import pytest
 
 import impactqp as iq
 from impactqp.laws.certificate import certify
-from impactqp.model.chain_residuals import chain_law_residuals
 from impactqp.model.chain_structure import ChainStructure, chain_directions
 from impactqp.model.programs import velocity_program
 from impactqp.model.residuals import law_residuals
@@ -27,11 +26,18 @@ def random_chain(rng: np.random.Generator, n: int, walls, scale: float) -> iq.Im
                     right_wall=walls[1])
 
 
+def dense_twin(p: iq.ImpactProblem) -> iq.ImpactProblem:
+    """The chain's impact as a general dense problem (its residuals take the dense pass)."""
+    return iq.ImpactProblem(np.diag(p.chain.masses), np.asarray(p.W.todense())
+                            if hasattr(p.W, "todense") else p.W, p.u_minus)
+
+
 def close(a: dict, b: dict) -> None:
     """Same keys, same values up to rounding (far below the default tolerance 1e-9)."""
     assert a.keys() == b.keys()
     for k in a:
-        assert abs(a[k] - float(b[k])) <= 1e-9 * abs(float(b[k])) + 1e-12, (k, a[k], b[k])
+        want = float(np.ravel(b[k])[0])
+        assert abs(a[k] - want) <= 1e-9 * abs(want) + 1e-12, (k, a[k], want)
 
 
 @pytest.mark.parametrize("n", [10**5])
@@ -92,11 +98,12 @@ def test_chain_certificate_equals_the_general_one(walls, scale, eps):
         bad_u = r.u_plus + 1e-6 * np.abs(um).max() * rng.standard_normal(n)
         unit = p.velocity_scale / st.contact_scale  # the impulse unit of contact i
         bad_lam = r.impulses + 1e-6 * unit * rng.standard_normal(p.n_contacts)
+        dense = dense_twin(p).structure  # the same impact with M and W formed
         for up, lam in ((r.u_plus, r.impulses), (bad_u, r.impulses), (r.u_plus, bad_lam)):
-            fast = chain_law_residuals(st, um, up, lam, eps, eps=eps)
-            close(fast, law_residuals(st, um, up, lam, eps, eps=eps))
-            close(chain_law_residuals(st, um, up, lam, eps),  # without ε's extra residuals
-                  law_residuals(st, um, up, lam, eps))
+            fast = law_residuals(st, um, up, lam, eps, eps=eps)  # the O(N) chain loop
+            close(fast, law_residuals(dense, um, up, lam, eps, eps=eps))
+            close(law_residuals(st, um, up, lam, eps),  # without ε's extra residuals
+                  law_residuals(dense, um, up, lam, eps))
         assert certify(p, r.u_plus, r.impulses, eps, eps=eps).ok
         assert not certify(p, bad_u, r.impulses, eps, eps=eps).ok
         assert not certify(p, r.u_plus, bad_lam, eps, eps=eps).ok
@@ -122,7 +129,8 @@ def test_chain_certificate_fails_corrupted_long_answers(walls):
     for up, lam in cases:
         fast = certify(p, up, lam, 0.5, eps=0.5)
         assert not fast.ok
-        close(fast.residuals, law_residuals(p.structure, p.u_minus, up, lam, 0.5, eps=0.5))
+        close(fast.residuals, law_residuals(p.structure, p.u_minus[None], up[None], lam[None],
+                                            0.5, eps=0.5))  # rows: the numpy products
 
 
 def test_chain_certificate_non_finite_and_zero_velocity():
@@ -139,7 +147,7 @@ def test_chain_certificate_non_finite_and_zero_velocity():
     assert certify(rest, np.zeros(3), np.zeros(3), 0.5, eps=0.5).ok
     moving = certify(rest, np.array([0.0, 1e-300, 0.0]), np.zeros(3), 0.5, eps=0.5)
     assert not moving.ok
-    close(moving.residuals, law_residuals(rest.structure, rest.u_minus,
+    close(moving.residuals, law_residuals(dense_twin(rest).structure, rest.u_minus,
                                           np.array([0.0, 1e-300, 0.0]), np.zeros(3), 0.5,
                                           eps=0.5))
 

@@ -15,11 +15,11 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
-from ..base.checks import ResidualChecks
 from ..model.problem import ImpactProblem
 from ..model.programs import preferred_forms
 from ..model.structure import ImpactStructure
 from ..qp.program import QPSolution, QuadraticProgram
+from .certificate import Certificate
 
 
 class Answer(NamedTuple):
@@ -43,9 +43,10 @@ class Answer(NamedTuple):
 class ImpactLaw(ABC):
     """Base class of impact laws.
 
-    A subclass sets the class attributes below, implements :meth:`residuals` and
-    :meth:`certificate`, and either :meth:`program` with :meth:`recover` (a law solved through
-    quadratic programs) or :meth:`closed_form` (``forms = ()``).
+    A subclass sets the class attributes below, implements :meth:`residuals` (from which
+    :meth:`certificate` builds the law's :class:`~impactqp.Certificate`), and either
+    :meth:`program` with :meth:`recover` (a law solved through quadratic programs) or
+    :meth:`closed_form` (``forms = ()``).
 
     Attributes
     ----------
@@ -120,10 +121,12 @@ class ImpactLaw(ABC):
         """The law's dimensionless residuals for one impact (1-D arrays, float values) or
         for rows of impacts ((k,) arrays)."""
 
-    @abstractmethod
-    def certificate(self, problem: ImpactProblem, answer: Answer,
-                    tol: float) -> ResidualChecks:
-        """The recomputed certificate of ``answer`` on ``problem``."""
+    def certificate(self, problem: ImpactProblem, answer: Answer, tol: float) -> Certificate:
+        """The recomputed certificate of ``answer`` on ``problem``: the law's
+        :meth:`residuals`, each within ``tol`` (docs/theory.md §8). A law whose checks need
+        more than the structure (an independent evaluation on the problem) overrides it."""
+        return Certificate(self.residuals(problem.structure, problem.u_minus, answer.u_plus,
+                                          answer.impulses), tol)
 
     def __repr__(self) -> str:
         coef = self.coefficients

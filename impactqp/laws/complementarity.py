@@ -19,7 +19,7 @@ from ..model.programs import impulse_program
 from ..model.structure import ImpactStructure
 from ..qp.program import QPSolution, QuadraticProgram
 from .base import Answer, ImpactLaw
-from .certificate import Certificate, certify, law_residuals
+from .certificate import law_residuals
 
 
 def check_restitution(name: str, value: Any, m: int, *, matrix: bool = False) -> np.ndarray:
@@ -70,10 +70,6 @@ class _ComplementarityLaw(ImpactLaw):
                   impulses: np.ndarray) -> dict[str, np.ndarray]:
         return law_residuals(structure, U_minus, U_plus, impulses, self.restitution(structure.m))
 
-    def certificate(self, problem: ImpactProblem, answer: Answer, tol: float) -> Certificate:
-        return certify(problem, answer.u_plus, answer.impulses,
-                       self.restitution(problem.n_contacts),
-                       tol=tol)
 
 
 class Newton(_ComplementarityLaw):

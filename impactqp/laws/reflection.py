@@ -23,8 +23,8 @@ from ..tables.reflection_group import (
 )
 from ..tables.reflection_table import reflection_law_table
 from .base import Answer, ImpactLaw
-from .certificate import as_residual
-from .sector import SectorLawCertificate, sector_residuals
+from .certificate import Certificate
+from .sector import sector_residuals
 
 
 @lru_cache(maxsize=32)
@@ -69,10 +69,9 @@ class ReflectionLaw(ImpactLaw):
                   impulses: np.ndarray) -> dict[str, np.ndarray]:
         return sector_residuals(structure, U_minus, U_plus, impulses)
 
-    def certificate(self, problem: ImpactProblem, answer: Answer,
-                    tol: float) -> SectorLawCertificate:
+    def certificate(self, problem: ImpactProblem, answer: Answer, tol: float) -> Certificate:
         group = check_reflection_problem(problem)
         expected = _reference_gamma(problem, group) if problem.n_contacts else None
         res = sector_residuals(problem.structure, problem.u_minus, answer.u_plus,
                                answer.impulses, expected=expected)
-        return SectorLawCertificate(**{k: as_residual(v) for k, v in res.items()}, tol=tol)
+        return Certificate(res, tol)

@@ -35,7 +35,7 @@ class ImpactResult:
         Impulsive contact forces Λ ≥ 0 with M(u⁺ − u⁻) = WΛ.
     backend : str
         What produced the numbers (e.g. ``"nnls"``, ``"clarabel"``, ``"exact"``).
-    certificate : Certificate or SectorLawCertificate
+    certificate : Certificate
         Recomputed residuals of the law that was solved. A fast path may pass a callable
         that builds it from residuals it has already checked; it is called on first read.
     form : str or None

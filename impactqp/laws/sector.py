@@ -1,17 +1,15 @@
 """The sector law as an impact law on a chain problem: ``u⁺ = sort(u⁻)`` (docs/theory.md §6).
 
-The sector law is not a complementarity law ``0 ≤ Λ ⟂ γ⁺ + Eγ⁻``, so its results carry a
-:class:`SectorLawCertificate` of their own: the impact equation, Λ ≥ 0, γ⁺ ≥ 0, energy
-conservation and agreement of γ⁺ with the closed-form γ-map of docs/theory.md §6.
+The sector law is not a complementarity law ``0 ≤ Λ ⟂ γ⁺ + Eγ⁻``, so its certificate has
+residuals of its own: the impact equation, Λ ≥ 0, γ⁺ ≥ 0, energy conservation and agreement
+of γ⁺ with the closed-form γ-map of docs/theory.md §6.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from ..base.checks import DEFAULT_TOL, ResidualChecks
+from ..base.checks import DEFAULT_TOL
 from ..base.rowwise import row_max, row_min
 from ..errors import SectorLawError
 from ..model.builders import require_chain
@@ -21,51 +19,18 @@ from ..model.structure import ImpactStructure
 from ..tables.coxeter import contact_angles, coxeter_labels
 from ..tables.sector_table import sector_gamma_map, sector_velocity_map
 from .base import Answer, ImpactLaw
-from .certificate import as_residual
+from .certificate import Certificate
 
 MASS_RTOL = 1e-12
 """Relative spread of the ball masses below which they count as equal."""
 
 
-@dataclass(frozen=True)
-class SectorLawCertificate(ResidualChecks):
-    """Recomputed checks of one sector-law result (docs/theory.md §1, §2, §6), dimensionless as in
-    :mod:`impactqp.laws.certificate`.
-
-    Attributes
-    ----------
-    momentum : float
-        ‖u⁺ − u⁻ − M⁻¹WΛ‖ / V: the impact equation M(u⁺ − u⁻) = WΛ.
-    impulse_sign : float
-        Largest violation of Λ ≥ 0 (scaled).
-    kinematic : float
-        Largest violation of γ⁺ ≥ 0 (scaled).
-    energy_balance : float
-        abs(‖u⁺‖² − ‖u⁻‖²) / V²: the sector law conserves kinetic energy.
-    law_residual : float
-        max abs(γ⁺ − S(γ⁻)) / V with S the closed-form sector map of docs/theory.md §6.
-    tol : float
-        Tolerance every residual must meet.
-    """
-
-    momentum: float
-    impulse_sign: float
-    kinematic: float
-    energy_balance: float
-    law_residual: float
-    tol: float
-
-    @property
-    def residuals(self) -> dict[str, float]:
-        return {"momentum": self.momentum, "impulse_sign": self.impulse_sign,
-                "kinematic": self.kinematic, "energy_balance": self.energy_balance,
-                "law_residual": self.law_residual}
-
-
 def sector_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
                      Lam: np.ndarray, expected: np.ndarray | None = None,
                      ) -> dict[str, np.ndarray]:
-    """Residuals of :class:`SectorLawCertificate` for one impact or for rows of impacts.
+    """The sector law's residuals for one impact or for rows of impacts: momentum, Λ ≥ 0,
+    ``kinematic`` (γ⁺ ≥ 0), ``energy_balance`` (|‖u⁺‖² − ‖u⁻‖²| / V²) and ``law_residual``
+    (max |γ⁺ − S(γ⁻)| / V with S the closed-form map of docs/theory.md §6).
 
     ``expected`` is the γ⁺ the law must reproduce (default: the sector map of γ⁻,
     docs/theory.md §6).
@@ -87,10 +52,10 @@ def sector_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np
 
 
 def certify_sector(problem: ImpactProblem, u_plus: np.ndarray, impulses: np.ndarray,
-                   *, tol: float = DEFAULT_TOL) -> SectorLawCertificate:
+                   *, tol: float = DEFAULT_TOL) -> Certificate:
     """Recompute the checks of a sector-law answer (u⁺, Λ) on a chain problem."""
-    res = sector_residuals(problem.structure, problem.u_minus, u_plus, impulses)
-    return SectorLawCertificate(**{k: as_residual(v) for k, v in res.items()}, tol=tol)
+    return Certificate(sector_residuals(problem.structure, problem.u_minus, u_plus, impulses),
+                       tol)
 
 
 
@@ -175,6 +140,3 @@ class SectorLaw(ImpactLaw):
                   impulses: np.ndarray) -> dict[str, np.ndarray]:
         return sector_residuals(structure, U_minus, U_plus, impulses)
 
-    def certificate(self, problem: ImpactProblem, answer: Answer,
-                    tol: float) -> SectorLawCertificate:
-        return certify_sector(problem, answer.u_plus, answer.impulses, tol=tol)

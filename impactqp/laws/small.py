@@ -16,6 +16,7 @@ from functools import partial
 import numpy as np
 
 from ..kernels.impact import solve_impact
+from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
 from ..model.residuals import restitution_matrix
 from .base import ImpactLaw
@@ -77,10 +78,9 @@ def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float,
                         st.warm_support, out):
         return None
     up = out[:n]
-    r = out[n + m:].tolist()
-    extra = (r[4], tol, r[5]) if moreau else (None, tol, None)
+    values = dict(zip(RESIDUALS if moreau else RESIDUALS[:4], out[n + m:].tolist()))
     return ImpactResult(problem, law.name, law.coefficients_for(problem), up, out[n:n + m],
-                        "kernel", partial(Certificate, *r[:4], *extra), form="impulse",
+                        "kernel", partial(Certificate, values, tol), form="impulse",
                         z=partial(law.projection, problem, up) if moreau else None,
                         attempts=["kernel (compiled): certified"], impact_law=law,
                         solve_time=time.perf_counter() - start)

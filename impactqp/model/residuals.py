@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.rowwise import row_max, row_min, row_sum
-from ..kernels.residuals import RESIDUALS, dense_residual_rows, finish_rows
+from ..kernels.residuals import RESIDUALS, chain_residuals, dense_residual_rows, finish_rows
 from .structure import ImpactStructure
 
 
@@ -78,6 +78,8 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
     """
     st = structure
     one = np.ndim(U_minus) == 1
+    if one and st.chain is not None and np.ndim(E) == 0 and st.m:
+        return _chain_residuals(st, U_minus, U_plus, Lam, float(E), eps)
     Um, Up, L = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (U_minus, U_plus, Lam))
     moreau = eps is not None
     e = 0.0 if eps is None else float(eps)
@@ -97,3 +99,19 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
                             st.contact_scale, e, moreau, cross)
     names = RESIDUALS if moreau else RESIDUALS[:4]
     return {name: (float(table[0, i]) if one else table[:, i]) for i, name in enumerate(names)}
+
+
+def _chain_residuals(st: ImpactStructure, u_minus, u_plus, Lam, E: float,
+                     eps: float | None) -> dict[str, float]:
+    """The residuals of one chain impact by the compiled O(N) loop (docs/theory.md §5, §8);
+    inputs that do not have the chain's shapes give NaN (they fail)."""
+    c = st.chain
+    um, up, lam = (np.ascontiguousarray(a, dtype=float) for a in (u_minus, u_plus, Lam))
+    names = RESIDUALS if eps is not None else RESIDUALS[:4]
+    if um.shape != (st.n,) or up.shape != um.shape or lam.shape != (st.m,):
+        return dict.fromkeys(names, float("nan"))
+    out = np.empty(len(RESIDUALS))
+    chain_residuals(um, up, lam, c.masses, st.inverse_masses, st.contact_scale,
+                    bool(c.left_wall), bool(c.right_wall), E, 0.0 if eps is None else float(eps),
+                    eps is not None, out)
+    return {name: float(out[i]) for i, name in enumerate(names)}

@@ -15,11 +15,9 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..base.arrays import as_array
-from ..base.checks import ResidualChecks
 from ..base.rowwise import row_max, row_min
 from ..errors import ShapeError
 from ..laws.base import Answer, ImpactLaw
-from ..laws.certificate import Certificate, as_residual
 from ..model.problem import ImpactProblem
 from ..model.programs import impulse_program, velocity_program
 from ..model.residuals import impact_residuals, normalized_rows
@@ -97,10 +95,3 @@ class MoreauJeanStep(ImpactLaw):
         out["complementarity"] = row_max(np.abs(Lam * w)) / V**2
         return out
 
-    def certificate(self, problem: ImpactProblem, answer: Answer,
-                    tol: float) -> ResidualChecks:
-        r = {k: as_residual(v) for k, v in self.residuals(
-            problem.structure, problem.u_minus, answer.u_plus, answer.impulses).items()}
-        return Certificate(momentum=r["momentum"], impulse_sign=r["impulse_sign"],
-                           law_feasibility=r["law_feasibility"],
-                           complementarity=r["complementarity"], energy_balance=None, tol=tol)
