@@ -72,7 +72,7 @@ from .simulation.simulate import simulate
 from .simulation.step_law import MoreauJeanStep
 from .simulation.system import LinearForce, LinearSystem
 from .simulation.trajectory import Trajectory
-from .tables.certificate import SectorCertificate
+from .tables.certificate import SectorCertificate, TableCertificate
 from .tables.coxeter import continuous_mass_ratios
 from .tables.reflection_table import reflection_law_table
 from .tables.sector_table import SectorCone, SectorTable, sector_law_table
@@ -95,7 +95,7 @@ __all__ = [
     "MassMatrixError", "Membership", "Moreau", "MoreauJeanStep", "Newton", "NoSolutionError",
     "NonConvexLCPError", "NonFiniteError", "NonSymmetricLCPError", "OptionalDependencyError",
     "PhysicalChain", "ProblemFile", "ProblemFileError", "ReflectionLaw", "ResidualChecks",
-    "RestitutionError", "SectorCertificate", "SectorCone", "SectorInputError", "SectorLaw",
+    "RestitutionError", "SectorCertificate", "TableCertificate", "SectorCone", "SectorInputError", "SectorLaw",
     "SectorLawCertificate", "SectorLawError", "SectorTable", "SectorTableTooLarge",
     "ShapeError", "SolverError", "Trajectory", "UnknownBackendError", "available_backends",
     "ball_chain", "bead_chain", "bouncing_ball", "chain", "classify", "compare_chain",

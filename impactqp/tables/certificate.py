@@ -70,7 +70,7 @@ class CheckResult:
 
 
 @dataclass(frozen=True)
-class SectorCertificate:
+class TableCertificate:
     """Exact docs/theory.md §7 certificate of a sector table.
 
     ``maximal_monotone`` is True iff the law is continuous across every pair of
@@ -233,7 +233,11 @@ def table_mass_matrix(table: Any) -> FloatArray:
 
 
 # --------------------------------------------------------------------------- certificate
-def certify_sector_table(table: Any, exact_energy: bool | None = None) -> SectorCertificate:
+SectorCertificate = TableCertificate
+"""Another name of :class:`TableCertificate`, kept for code written before the rename."""
+
+
+def certify_sector_table(table: Any, exact_energy: bool | None = None) -> TableCertificate:
     """Run every docs/theory.md §7 check on ``table`` (a :class:`~impactqp.sector.SectorTable`).
 
     Parameters
@@ -333,5 +337,5 @@ def certify_sector_table(table: Any, exact_energy: bool | None = None) -> Sector
     for c in (kinematic, kinetic, energetic):
         if not c.passed:
             reason += f"; note: {c.name} consistency fails on cone '{c.worst}'"
-    return SectorCertificate(int(table.n_balls), len(cones), len(pairs), tuple(checks),
+    return TableCertificate(int(table.n_balls), len(cones), len(pairs), tuple(checks),
                              kinematic, kinetic, energetic, continuity, non_exp, vel, mm, reason)

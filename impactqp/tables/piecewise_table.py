@@ -12,7 +12,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .certificate import SectorCertificate, certify_sector_table
+from .certificate import TableCertificate, certify_sector_table
 
 FloatArray = NDArray[np.float64]
 
@@ -27,7 +27,7 @@ class PiecewiseLinearTable:
         raise TypeError(f"{type(self).__name__} must define find_cones")
 
     @cached_property
-    def certificate(self) -> SectorCertificate:
+    def certificate(self) -> TableCertificate:
         """The exact docs/theory.md §7 certificate of this table (computed once, on first use)."""
         return certify_sector_table(self)
 

@@ -152,7 +152,7 @@ class SectorTable(PiecewiseLinearTable):
         Delassus matrix and contact directions (docs/theory.md §1).
     n_balls : int
     mass : float
-    certificate : SectorCertificate
+    certificate : TableCertificate
         Exact docs/theory.md §7 certificate, computed on first access.
     """
 

@@ -61,7 +61,7 @@ class LawReport:
         How many u⁻ and pairs were checked (0 for an exact certificate).
     method : str
         ``"sampled"`` or ``"exact"``.
-    certificate : SectorCertificate or None
+    certificate : TableCertificate or None
         The docs/theory.md §7 certificate when ``method == "exact"``.
     """
 
