@@ -143,3 +143,23 @@ def test_toml_writer_round_trips_exactly():
     assert text.startswith('version = 1\nlaw = "sector"\nleft_wall = true\nM = [')
     back = tomllib.loads(text)
     assert back == data and all(isinstance(v, float) for row in back["M"] for v in row)
+
+
+def test_every_law_named_in_files_is_the_registrys() -> None:
+    """Files, the command line and the registry share one table of law names: every name
+    builds its law (with coefficients where it takes them) and solves the cradle."""
+    from impactqp.laws.catalogue import NAMED_LAWS, law_named
+
+    p = iq.newtons_cradle(3)
+    coefficients = {"eps": 0.5, "e": [1.0, 0.5], "E": [[0.5, 0.0], [0.0, 0.5]]}
+    for name, law_class in NAMED_LAWS.items():
+        key = law_class.coefficient_key
+        law = law_named(name, coefficients[key] if key else None)
+        assert type(law) is law_class and iq.solve(p, law).certificate.ok
+        if law_class.needs_coefficients:
+            with pytest.raises(iq.InputError, match="needs its coefficients"):
+                law_named(name)
+    with pytest.raises(iq.InputError, match="must be one of"):
+        law_named("lzb")
+    with pytest.raises(iq.InputError, match="takes no coefficients"):
+        law_named("sector", 0.5)

@@ -13,11 +13,12 @@ from typing import Any
 
 import numpy as np
 
+from ..laws.catalogue import NAMED_LAWS
 from ..laws.result import ImpactResult
 from ..model.admissible import Membership
 from ..model.problem import ImpactProblem
 
-COEFFICIENT_NAMES = {"moreau": "ε", "newton": "e", "fremond": "E"}
+COEFFICIENT_NAMES = {name: law.coefficient_symbol for name, law in NAMED_LAWS.items()}
 CONDITIONS = ("kinetic", "kinematic", "energetic")
 CONDITION_TEXT = {"kinetic": "u⁺ ∈ u⁻ + N", "kinematic": "u⁺ ∈ T_C",
                   "energetic": "‖u⁺‖ ≤ ‖u⁻‖"}

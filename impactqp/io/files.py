@@ -14,7 +14,7 @@ One flat schema, stored as JSON or TOML (chosen by the file suffix)::
     # always
     u_minus  = [1.0, 0.0, 0.0]
     # optional
-    law      = "moreau"                   # "moreau" | "newton" | "fremond" | "sector"
+    law      = "moreau"             # "moreau" | "newton" | "fremond" | "sector" | "reflection"
     eps      = 0.5                        # moreau; "e" for newton, "E" for fremond
     u_plus   = [0.0, 0.0, 1.0]            # a candidate post-impact velocity
 
@@ -41,6 +41,7 @@ import numpy as np
 
 from ..base.arrays import as_vector
 from ..errors import InputError, ProblemFileError
+from ..laws.catalogue import NAMED_LAWS
 from ..laws.complementarity import check_restitution
 from ..laws.moreau import check_eps
 from ..model.builders import chain
@@ -58,8 +59,9 @@ MAX_DENSE_CONTACTS = 1_000
 scipy.sparse matrices, where the caller decides what is affordable."""
 
 VERSION = 1
-LAWS = ("moreau", "newton", "fremond", "sector")
-COEFFICIENT_KEYS = {"moreau": "eps", "newton": "e", "fremond": "E"}
+LAWS = tuple(NAMED_LAWS)
+COEFFICIENT_KEYS = {name: law.coefficient_key for name, law in NAMED_LAWS.items()
+                    if law.coefficient_key}
 GENERAL_KEYS = ("M", "W")
 CHAIN_KEYS = ("masses", "left_wall", "right_wall")
 KNOWN_KEYS = ("version", *GENERAL_KEYS, *CHAIN_KEYS, "u_minus", "law", "eps", "e", "E",
@@ -75,7 +77,8 @@ class ProblemFile:
     ----------
     problem : ImpactProblem
     law : str or None
-        ``"moreau"``, ``"newton"``, ``"fremond"``, ``"sector"`` or None when absent.
+        A name of :data:`impactqp.laws.catalogue.NAMED_LAWS` (``"moreau"``, ``"newton"``,
+        ``"fremond"``, ``"sector"``, ``"reflection"``) or None when absent.
     coefficients : float, ndarray or None
         ε (Moreau), the eᵢ (Newton, an (m,) array) or Frémond's (m, m) matrix E.
     u_plus : ndarray or None

@@ -15,6 +15,7 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
+from ..errors import InputError
 from ..model.problem import ImpactProblem
 from ..model.programs import preferred_forms
 from ..model.structure import ImpactStructure
@@ -61,6 +62,14 @@ class ImpactLaw(ABC):
     always_solvable : bool
         A solution exists for every u⁻ (Moreau's law, the sector law): the pipeline never
         reports "no solution" for such a law.
+    by_name : bool
+        Problem and simulation files and the command line may name the law (its
+        coefficients, if any, under :attr:`coefficient_key`).
+    coefficient_key, coefficient_symbol : str or None
+        How files and the command line spell its coefficients (``"eps"``) and how reports
+        print them (``"ε"``); None for a law without coefficients.
+    needs_coefficients : bool
+        Naming the law requires its coefficients (they have no default).
     """
 
     name: ClassVar[str]
@@ -68,6 +77,34 @@ class ImpactLaw(ABC):
     forms: ClassVar[tuple[str, ...]] = ()
     closed_form_backend: ClassVar[str] = ""
     always_solvable: ClassVar[bool] = False
+    by_name: ClassVar[bool] = False
+    coefficient_key: ClassVar[str | None] = None
+    coefficient_symbol: ClassVar[str | None] = None
+    needs_coefficients: ClassVar[bool] = False
+
+    @classmethod
+    def from_coefficients(cls, coefficients: Any = None) -> ImpactLaw:
+        """The law named in a file or on the command line, with its coefficients (None: the
+        law's defaults, or InputError when :attr:`needs_coefficients`)."""
+        if coefficients is None:
+            if cls.needs_coefficients:
+                raise InputError(f"law {cls.name!r} needs its coefficients "
+                                 f"{cls.coefficient_key!r}")
+            return cls()
+        if cls.coefficient_key is None:
+            raise InputError(f"law {cls.name!r} takes no coefficients")
+        return cls(coefficients)
+
+    def restrict(self, contacts: np.ndarray) -> ImpactLaw:
+        """The law on a subset of the contacts (indices into its own): per-contact
+        coefficients taken at ``contacts``; a law without them is itself."""
+        return self
+
+    def step_restitution(self, contacts: np.ndarray) -> float | np.ndarray | None:
+        """E of the law's Moreau–Jean step form ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k`` on ``contacts``
+        (docs/theory.md §14): one number when every coefficient is equal, None for a law
+        without a step form (it maps the free velocity to u⁺ instead)."""
+        return None
 
     @property
     def coefficients(self) -> Any:

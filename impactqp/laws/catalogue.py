@@ -1,8 +1,13 @@
-"""Which law each registered backend serves: the laws × backends table of the README is
-generated from here (and a test compares the two)."""
+"""The laws impactqp ships: the one table of law names (files, the command line and
+simulations read a law's name through :func:`law_named`), and which law each registered
+backend serves (the laws × backends table of the README is generated from here, and a test
+compares the two)."""
 
 from __future__ import annotations
 
+from typing import Any
+
+from ..errors import InputError
 from ..qp import backends
 from ..qp.certified import FAST_PATHS
 from .base import ImpactLaw
@@ -14,6 +19,25 @@ from .sector import SectorLaw
 
 LAWS: tuple[type[ImpactLaw], ...] = (Moreau, Newton, Fremond, SectorLaw, ReflectionLaw, LZB)
 """The law classes impactqp ships."""
+
+NAMED_LAWS: dict[str, type[ImpactLaw]] = {law.name: law for law in LAWS if law.by_name}
+"""The laws that problem and simulation files and the command line name, by name: the one
+table every reader of a law's name uses."""
+
+
+def law_named(name: object, coefficients: Any = None) -> ImpactLaw:
+    """The law called ``name`` in a file or on the command line, with its coefficients.
+
+    Raises
+    ------
+    InputError
+        An unknown name, missing coefficients of a law that needs them, or coefficients the
+        law refuses (its own errors, e.g. RestitutionError).
+    """
+    law = NAMED_LAWS.get(name) if isinstance(name, str) else None
+    if law is None:
+        raise InputError(f"law must be one of {list(NAMED_LAWS)}, got {name!r}")
+    return law.from_coefficients(coefficients)
 
 
 def laws_served(entry: backends.Backend) -> dict[str, tuple[str, ...]]:

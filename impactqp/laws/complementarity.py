@@ -89,6 +89,10 @@ class Newton(_ComplementarityLaw):
 
     name = "newton"
     title = "the local Newton law"
+    by_name = True
+    coefficient_key = "e"
+    coefficient_symbol = "e"
+    needs_coefficients = True
 
     def __init__(self, e: Any = 1.0) -> None:
         arr = as_array("e", e, allow_nonfinite=True)
@@ -111,6 +115,13 @@ class Newton(_ComplementarityLaw):
         if not self._scalar:
             check_restitution("e", self.e, problem.n_contacts)
 
+    def restrict(self, contacts: np.ndarray) -> Newton:
+        return self if self._scalar else Newton(self.e[contacts])
+
+    def step_restitution(self, contacts: np.ndarray) -> float | np.ndarray:
+        e = self.e if self._scalar else self.e[contacts]
+        return float(e[0]) if np.all(e == e[0]) else e
+
 
 class Fremond(_ComplementarityLaw):
     """Frémond's law with an (m, m) matrix of impact coefficients:
@@ -129,6 +140,10 @@ class Fremond(_ComplementarityLaw):
 
     name = "fremond"
     title = "Frémond's law"
+    by_name = True
+    coefficient_key = "E"
+    coefficient_symbol = "E"
+    needs_coefficients = True
 
     def __init__(self, E: Any) -> None:
         arr = as_array("E", E)
@@ -145,3 +160,9 @@ class Fremond(_ComplementarityLaw):
 
     def check(self, problem: ImpactProblem) -> None:
         check_restitution("E", self.E, problem.n_contacts, matrix=True)
+
+    def restrict(self, contacts: np.ndarray) -> Fremond:
+        return Fremond(self.E[np.ix_(contacts, contacts)])
+
+    def step_restitution(self, contacts: np.ndarray) -> np.ndarray:
+        return self.E[np.ix_(contacts, contacts)]

@@ -58,6 +58,9 @@ class Moreau(ImpactLaw):
     title = "Moreau's law"
     forms = ("velocity", "impulse")
     always_solvable = True
+    by_name = True
+    coefficient_key = "eps"
+    coefficient_symbol = "ε"
 
     def __init__(self, eps: float = 0.0) -> None:
         self.eps = check_eps(eps)
@@ -69,6 +72,9 @@ class Moreau(ImpactLaw):
     def projection(self, problem: ImpactProblem, u_plus: np.ndarray) -> np.ndarray:
         """z = (u⁺ + εu⁻)/(1 + ε) of this law's answer u⁺ (docs/theory.md §3)."""
         return (u_plus + self.eps * problem.u_minus) / (1.0 + self.eps)
+
+    def step_restitution(self, contacts: np.ndarray) -> float:
+        return self.eps
 
     def restitution(self, m: int) -> np.ndarray:
         """The law's E = εI for m contacts (docs/theory.md §3)."""

@@ -53,6 +53,7 @@ class ReflectionLaw(ImpactLaw):
     """
 
     name = "reflection"
+    by_name = True
     title = "the reflection law"
     closed_form_backend = "reflections"
     always_solvable = True

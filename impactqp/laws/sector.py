@@ -122,6 +122,7 @@ class SectorLaw(ImpactLaw):
     """
 
     name = "sector"
+    by_name = True
     title = "the sector law"
     closed_form_backend = "sort"
     always_solvable = True

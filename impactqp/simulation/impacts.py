@@ -13,18 +13,12 @@ from functools import cached_property
 
 import numpy as np
 
-from ..base.arrays import as_dense
 from ..base.checks import DEFAULT_TOL
-from ..errors import CertificateError
-from ..laws.base import Answer, ImpactLaw
-from ..laws.complementarity import Fremond, Newton
-from ..laws.lzb import LZB
-from ..laws.moreau import Moreau
+from ..laws.base import ImpactLaw
 from ..laws.pipeline import solve
 from ..laws.result import ImpactResult
 from ..model.admissible import Membership
 from ..model.problem import ImpactProblem
-from ..qp.lcp import solve_lcp
 from .clusters import Cluster, ClusterCache
 from .step_law import MoreauJeanStep
 
@@ -82,32 +76,6 @@ class ImpactEvent:
                 f"certificate={'ok' if self.certified else 'FAILED'})")
 
 
-def cluster_law(law: ImpactLaw, contacts: np.ndarray) -> ImpactLaw:
-    """``law`` on a subset of the system's contacts: per-contact coefficients restricted
-    (Newton's eᵢ, Frémond's E_ij within the cluster, LZB's stiffness and restitution),
-    other laws unchanged."""
-    if isinstance(law, Newton) and law.e.size > 1:
-        return Newton(law.e[contacts])
-    if isinstance(law, Fremond):
-        return Fremond(law.E[np.ix_(contacts, contacts)])
-    if isinstance(law, LZB):
-        return law.restrict(contacts)
-    return law
-
-
-def step_restitution(law: ImpactLaw, contacts: np.ndarray) -> float | np.ndarray | None:
-    """E of the Moreau–Jean step for a complementarity law on these contacts (one number
-    when all coefficients are equal), or None for any other law."""
-    if isinstance(law, Moreau):
-        return law.eps
-    if isinstance(law, Newton):
-        e = law.e if law.e.size == 1 else law.e[contacts]
-        return float(e[0]) if np.all(e == e[0]) else e
-    if isinstance(law, Fremond):
-        return law.E[np.ix_(contacts, contacts)]
-    return None
-
-
 class ImpactSolver:
     """Solves the impacts of one system with one law, cluster by cluster.
 
@@ -157,29 +125,16 @@ class ImpactSolver:
         """The law for this cluster, or None when nothing happens (Λ = 0)."""
         gamma = cl.structure.Wt_times(u_c)
         if v_prev is not None:
-            E = step_restitution(self.law, cl.contacts)
+            E = self.law.step_restitution(cl.contacts)
             if E is not None:
                 g_prev = cl.structure.Wt_times(v_prev)
                 q = gamma + (E @ g_prev if np.ndim(E) == 2 else E * g_prev)
                 return MoreauJeanStep(E, v_prev) if np.any(q < 0) else None
         if not np.any(gamma < 0):
             return None
-        return cluster_law(self.law, cl.contacts)
+        return self.law.restrict(cl.contacts)
 
     def _solve(self, problem: ImpactProblem, law: ImpactLaw) -> ImpactResult:
-        result = solve(problem, law, self.backend, tol=self.tol)
-        if result.certificate.ok or not isinstance(law, MoreauJeanStep):
-            return result  # other laws map u⁻ = 0 to u⁺ = 0, which the pipeline returns
-        # u⁻ = 0 exactly: the pipeline answers Λ = 0 without asking the law, which is wrong
-        # for the step law when E γ_k < 0; solve its LCP directly and certify it as the law.
-        st = problem.structure
-        G = as_dense(st.delassus)
-        q = law.program(problem, "impulse").c
-        lcp = solve_lcp(G, q, tol=self.tol)
-        answer = Answer(problem.u_minus + st.impulse_velocity(lcp.z), lcp.z)
-        cert = law.certificate(problem, answer, self.tol)
-        if not cert.ok:
-            raise CertificateError(f"{law.title}: certificate failed, {cert.summary()}")
-        return ImpactResult(problem, law.name, law.coefficients_for(problem), answer.u_plus,
-                            answer.impulses, f"lcp:{lcp.backend}", cert, form="impulse",
-                            impact_law=law)
+        """The certified answer of :func:`impactqp.solve` (whose u⁻ = 0 shortcut answers only
+        when the law's own certificate passes, so the step law needs no special case)."""
+        return solve(problem, law, self.backend, tol=self.tol)

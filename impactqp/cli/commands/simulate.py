@@ -35,10 +35,7 @@ import numpy as np
 
 from ...errors import InputError, ProblemFileError
 from ...laws.base import ImpactLaw
-from ...laws.complementarity import Fremond, Newton
-from ...laws.moreau import Moreau
-from ...laws.reflection import ReflectionLaw
-from ...laws.sector import SectorLaw
+from ...laws.catalogue import NAMED_LAWS, law_named
 from ...simulation.builders import bead_chain, bouncing_ball, cradle_system
 from ...simulation.simulate import SCHEMES, simulate
 from ...simulation.system import LinearForce, LinearSystem
@@ -54,7 +51,7 @@ SYSTEMS = {
     "bead_chain": ("n_beads", "mass", "radius", "height", "spacing", "gravity", "velocity"),
     "linear": ("M", "q0", "v0", "force", "stiffness", "H", "b"),
 }
-LAWS = {"moreau": "eps", "newton": "e", "fremond": "E", "sector": None, "reflection": None}
+LAWS = {name: law.coefficient_key for name, law in NAMED_LAWS.items()}
 SIMULATION = ("scheme", "t_end", "h", "theta", "t0", "backend", "record_every", "keep_events",
               "gap_tol", "rest_velocity", "method", "rtol", "atol", "max_events")
 
@@ -176,9 +173,7 @@ def _law(data: Any) -> ImpactLaw:
     if coefficient and coefficient not in table:
         raise ProblemFileError(f"law {name!r} needs its coefficient {coefficient!r}")
     value = _value(f"law.{coefficient}", table[coefficient]) if coefficient else None
-    return {"moreau": lambda: Moreau(value), "newton": lambda: Newton(value),
-            "fremond": lambda: Fremond(value), "sector": SectorLaw,
-            "reflection": ReflectionLaw}[name]()
+    return law_named(name, value)
 
 
 class _Bar:

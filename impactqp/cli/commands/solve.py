@@ -13,7 +13,8 @@ import numpy as np
 
 from ...errors import InputError
 from ...io.files import COEFFICIENT_KEYS, LAWS, ProblemFile, load_problem
-from ...laws.functions import fremond, moreau, newton, sector_law
+from ...laws.catalogue import NAMED_LAWS, law_named
+from ...laws.pipeline import solve
 from ...laws.result import ImpactResult
 from ...model.problem import ImpactProblem
 from ..progress import progress
@@ -41,12 +42,12 @@ def choose_law(args: argparse.Namespace, content: ProblemFile) -> tuple[str, Any
     given = [k for k, v in flags.items() if v is not None]
     wanted = COEFFICIENT_KEYS.get(law)
     if any(k != wanted for k in given):
-        raise InputError(f"--{given[0]} does not apply to law {law!r}; use --eps with moreau, "
-                         "--e with newton, --E with fremond")
+        uses = ", ".join(f"--{key} with {name}" for name, key in COEFFICIENT_KEYS.items())
+        raise InputError(f"--{given[0]} does not apply to law {law!r}; use {uses}")
     if given:
         return law, parse_numbers(f"--{wanted}", flags[wanted])
     coefficients = content.coefficients if law == content.law else None
-    if coefficients is None and law in ("newton", "fremond"):
+    if coefficients is None and NAMED_LAWS[law].needs_coefficients:
         raise InputError(f"law {law!r} needs its coefficients: put {wanted!r} in the file or "
                          f"pass --{wanted}")
     return law, coefficients
@@ -54,15 +55,9 @@ def choose_law(args: argparse.Namespace, content: ProblemFile) -> tuple[str, Any
 
 def solve_law(problem: ImpactProblem, law: str, coefficients: Any,
               backend: str = "auto") -> ImpactResult:
-    """Apply one of the laws of docs/theory.md §3 and docs/theory.md §6 by name."""
-    if law == "moreau":
-        return moreau(problem, eps=0.0 if coefficients is None else coefficients,
-                      backend=backend)
-    if law == "newton":
-        return newton(problem, coefficients, backend=backend)
-    if law == "fremond":
-        return fremond(problem, coefficients, backend=backend)
-    return sector_law(problem)
+    """Apply the law called ``law`` (docs/theory.md §3, §6, §10) through :func:`impactqp.solve`,
+    with exactly its checks (a closed-form law refuses a named backend, as in Python)."""
+    return solve(problem, law_named(law, coefficients), backend)
 
 
 def run(args: argparse.Namespace) -> int:
