@@ -103,7 +103,7 @@ def test_dense_residuals_are_the_table_of_the_theory(moreau):
         E = eps * np.eye(m) if moreau else rng.random((m, m))
         out = np.empty(6)
         dense_residuals(st.dense_mass, st.dense_Wt, st.dense_Minv_W, st.contact_scale,
-                        p.u_minus, up, lam, E, eps, moreau, out)
+                        p.u_minus, up, lam, E, eps, moreau, out, np.empty(2 * p.n_dof + 2 * m))
         want = table_residuals(st.dense_mass, st.dense_Wt.T, p.u_minus, up, lam, E,
                                eps if moreau else None)
         np.testing.assert_allclose(out[:len(want)], want, rtol=1e-9, atol=1e-15)
@@ -126,7 +126,7 @@ def test_chain_loop_equals_the_dense_residuals(walls):
                         walls[0], walls[1], 0.4, 0.4, True, a)
         dense_residuals(dense.dense_mass, dense.dense_Wt, dense.dense_Minv_W,
                         dense.contact_scale, p.u_minus, up, lam, 0.4 * np.eye(p.n_contacts),
-                        0.4, True, b)
+                        0.4, True, b, np.empty(2 * n + 2 * p.n_contacts))
         np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-15)
 
 
@@ -137,7 +137,8 @@ def test_non_finite_input_gives_non_finite_residuals():
         out = np.empty(6)
         up = np.array([0.0, bad, 1.0])
         dense_residuals(st.dense_mass, st.dense_Wt, st.dense_Minv_W, st.contact_scale,
-                        p.u_minus, up, np.zeros(2), 0.5 * np.eye(2), 0.5, True, out)
+                        p.u_minus, up, np.zeros(2), 0.5 * np.eye(2), 0.5, True, out,
+                        np.empty(10))
         assert not (out <= 1e-9).all()
 
 

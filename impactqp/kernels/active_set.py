@@ -40,20 +40,18 @@ DESCENT_TOL = 1e-13
 
 @kernel
 def _append(L, idx, k, G, j):
-    """Append variable j to the factor of G_PP (P = idx[:k]); False if its column is dependent."""
-    row = np.empty(k)
+    """Append variable j to the factor of G_PP (P = idx[:k]); False if its column is dependent.
+    The new row is formed in row k of L, which is not part of the factor until it succeeds."""
     total = 0.0
     for a in range(k):
         s = G[idx[a], j]
         for b in range(a):
-            s -= L[a, b] * row[b]
-        row[a] = s / L[a, a]
-        total += row[a] * row[a]
+            s -= L[a, b] * L[k, b]
+        L[k, a] = s / L[a, a]
+        total += L[k, a] * L[k, a]
     d = G[j, j] - total
     if not d > PIVOT_TOL * G[j, j]:
         return False
-    for a in range(k):
-        L[k, a] = row[a]
     L[k, k] = np.sqrt(d)
     idx[k] = j
     return True
@@ -217,10 +215,16 @@ def lcp_psd(G, q, passive, x, w, max_iter):
         LCP has no feasible point) or :data:`ITERATION_LIMIT`.
     """
     m = q.size
-    L = np.zeros((m, m))
-    idx = np.empty(m, dtype=np.int64)
-    s = np.zeros(m)
-    blocked = np.zeros(m, dtype=np.bool_)
+    return lcp_psd_work(G, q, passive, x, w, max_iter, np.empty((m, m)),
+                        np.empty(m, dtype=np.int64), np.empty(m), np.empty(m, dtype=np.bool_))
+
+
+@kernel
+def lcp_psd_work(G, q, passive, x, w, max_iter, L, idx, s, blocked):
+    """:func:`lcp_psd` with its workspace given: L (m × m), idx (m integers), s (m floats)
+    and blocked (m booleans), so that a loop over many LCPs allocates nothing."""
+    m = q.size
+    blocked[:] = False
     x[:] = 0.0
     qmax = 0.0
     gmax = 0.0

@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .active_set import SOLVED, lcp_psd
+from .active_set import SOLVED, lcp_psd_work
 from .jit import kernel
-from .residuals import dense_residuals, matvec
+from .residuals import dense_residuals
 
 
 @kernel
@@ -85,22 +85,42 @@ def _unpack(packed, n, m):
 
 
 @kernel
-def _solve_into(M, Wt, MinvW, G, s, um, E, eps, moreau, tol, passive, up, lam, res):
+def workspace(n, m):
+    """Scratch for :func:`_solve_into` (floats, the factor L, indices, flags): allocated once
+    per call of the kernels below, however many impacts they solve."""
+    return (np.empty(2 * n + 5 * m), np.empty((m, m)), np.empty(m, dtype=np.int64),
+            np.empty(m, dtype=np.bool_))
+
+
+@kernel
+def _solve_into(M, Wt, MinvW, G, s, um, E, eps, moreau, tol, passive, up, lam, res, work):
     """Solve and certify one impact into (u⁺, Λ, residuals); True when certified."""
     n, m = um.size, passive.size
-    if moreau:
-        E = eps * np.eye(m)
-    g = matvec(Wt, um)
-    q = g + matvec(E, g)
-    w = np.empty(m)
-    if lcp_psd(G, q, passive, lam, w, 20 * m + 50) != SOLVED:
+    floats, L, idx, blocked = work
+    q = floats[:m]
+    w = floats[m:2 * m]
+    sv = floats[2 * m:3 * m]
+    for i in range(m):  # γ⁻, then q = (I + E)γ⁻
+        total = 0.0
+        for j in range(n):
+            total += Wt[i, j] * um[j]
+        sv[i] = total
+    for i in range(m):
+        total = sv[i]
+        if moreau:
+            total += eps * sv[i]
+        else:
+            for j in range(m):
+                total += E[i, j] * sv[j]
+        q[i] = total
+    if lcp_psd_work(G, q, passive, lam, w, 20 * m + 50, L, idx, sv, blocked) != SOLVED:
         return False
     for i in range(n):
         total = um[i]
         for j in range(m):
             total += MinvW[i, j] * lam[j]
         up[i] = total
-    dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, res)
+    dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, res, floats[3 * m:])
     count = 6 if moreau else 4
     for i in range(count):
         if not res[i] <= tol:  # NaN fails
@@ -141,7 +161,7 @@ def solve_impact(packed, um, E, eps, moreau, tol, passive, out):
     n, m = um.size, passive.size
     M, Wt, MinvW, G, s = _unpack(packed, n, m)
     return _solve_into(M, Wt, MinvW, G, s, um, E, eps, moreau, tol, passive, out[:n],
-                       out[n:n + m], out[n + m:n + m + 6])
+                       out[n:n + m], out[n + m:n + m + 6], workspace(n, m))
 
 
 @kernel
@@ -157,7 +177,8 @@ def solve_impact_rows(packed, Um, E, eps, moreau, tol, passive):
     Lam = np.empty((k, m))
     Res = np.empty((k, 6))
     ok = np.empty(k, dtype=np.bool_)
+    work = workspace(n, m)
     for r in range(k):
         ok[r] = _solve_into(M, Wt, MinvW, G, s, Um[r], E, eps, moreau, tol, passive, Up[r],
-                            Lam[r], Res[r])
+                            Lam[r], Res[r], work)
     return Up, Lam, Res, ok

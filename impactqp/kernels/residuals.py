@@ -105,31 +105,6 @@ def unit_of(um, up, lam):
     return c if c > 0.0 else 1.0
 
 
-@kernel
-def _quadratic(M, x, y):
-    """xᵀMy."""
-    total = 0.0
-    for i in range(x.size):
-        row = 0.0
-        for j in range(y.size):
-            row += M[i, j] * y[j]
-        total += x[i] * row
-    return total
-
-
-@inline_kernel
-def matvec(A, x):
-    """Ax by plain loops: for the small operands of one impact a BLAS call costs more (and
-    wakes a second BLAS thread pool where numpy and scipy bring their own)."""
-    out = np.zeros(A.shape[0])
-    for i in range(A.shape[0]):
-        total = 0.0
-        for j in range(A.shape[1]):
-            total += A[i, j] * x[j]
-        out[i] = total
-    return out
-
-
 @inline_kernel
 def velocity_unit(V2_minus, V2_plus):
     """V = ‖u⁻‖, or for u⁻ = 0 the answer's own size, at least 1 (docs/theory.md §8)."""
@@ -138,35 +113,62 @@ def velocity_unit(V2_minus, V2_plus):
     return _high(np.sqrt(_high(V2_plus, 0.0)), 1.0)
 
 
+@inline_kernel
+def _scaled_quadratic(M, x, y, f):
+    """(fx)ᵀM(fy), scaled before the products so that nothing leaves the float range."""
+    total = 0.0
+    for i in range(x.size):
+        row = 0.0
+        for j in range(y.size):
+            row += M[i, j] * (y[j] * f)
+        total += (x[i] * f) * row
+    return total
+
+
 @kernel
-def dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, out):
+def dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, out, work):
     """The residuals of one impact with dense M (n × n), Wᵀ (m × n), M⁻¹W (n × m), the
-    contact scales s and the law's E (m × m) into ``out`` (order :data:`RESIDUALS`)."""
+    contact scales s and the law's E (m × m; for Moreau's law, ``moreau``, E = εI is used and
+    E may be empty) into ``out`` (order :data:`RESIDUALS`); ``work`` is scratch of at least
+    2n + 2m floats (a loop over impacts allocates nothing)."""
     n, m = um.size, lam.size
-    c = unit_of(um, up, lam)
-    a = um / c
-    b = up / c
-    la = lam / c
-    d = b - a
-    for i in range(n):
+    f = 1.0 / unit_of(um, up, lam)
+    d = work[:n]
+    g = work[n:n + m]
+    w = work[n + m:n + 2 * m]
+    z = work[n + 2 * m:2 * n + 2 * m]
+    for i in range(n):  # u⁺ − u⁻ − M⁻¹WΛ
+        total = (up[i] - um[i]) * f
         for j in range(m):
-            d[i] -= MinvW[i, j] * la[j]
-    V = velocity_unit(_quadratic(M, a, a), _quadratic(M, b, b))
-    momentum = np.sqrt(_high(_quadratic(M, d, d), 0.0))
-    g = matvec(Wt, a)
-    w = np.empty(m)
-    for i in range(m):
-        total = 0.0
+            total -= MinvW[i, j] * (lam[j] * f)
+        d[i] = total
+    V = velocity_unit(_scaled_quadratic(M, um, um, f), _scaled_quadratic(M, up, up, f))
+    momentum = np.sqrt(_high(_scaled_quadratic(M, d, d, 1.0), 0.0))
+    for i in range(m):  # γ⁻ and γ⁺
+        gm = 0.0
+        gp = 0.0
         for j in range(n):
-            total += Wt[i, j] * b[j]
-        for j in range(m):
-            total += E[i, j] * g[j]
-        w[i] = total
-    acc = fold_contacts(la, w, s)
+            gm += Wt[i, j] * (um[j] * f)
+            gp += Wt[i, j] * (up[j] * f)
+        g[i] = gm
+        w[i] = gp
+    acc = NEW_FOLD
+    for i in range(m):  # w = γ⁺ + Eγ⁻
+        if moreau:
+            w[i] += eps * g[i]
+        else:
+            for j in range(m):
+                w[i] += E[i, j] * g[j]
+        acc = fold_contact(acc, lam[i] * f, w[i], s[i])
     cross = 0.0
-    if moreau:
-        z = (b + eps * a) / (1.0 + eps)
-        cross = _quadratic(M, z, a - z)
+    if moreau:  # ⟨z, u⁻ − z⟩ with z = (u⁺ + εu⁻)/(1 + ε)
+        for i in range(n):
+            z[i] = (up[i] + eps * um[i]) * f / (1.0 + eps)
+        for i in range(n):
+            row = 0.0
+            for j in range(n):
+                row += M[i, j] * (um[j] * f - z[j])
+            cross += z[i] * row
     finish(V, momentum, acc, eps, moreau, cross, out)
 
 
@@ -174,8 +176,9 @@ def dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, out):
 def dense_residual_rows(M, Wt, MinvW, s, Um, Up, Lam, E, eps, moreau):
     """:func:`dense_residuals` for every row of (U⁻, U⁺, Λ): a (k, 6) array."""
     out = np.empty((Um.shape[0], 6))
+    work = np.empty(2 * Um.shape[1] + 2 * Lam.shape[1])
     for r in range(Um.shape[0]):
-        dense_residuals(M, Wt, MinvW, s, Um[r], Up[r], Lam[r], E, eps, moreau, out[r])
+        dense_residuals(M, Wt, MinvW, s, Um[r], Up[r], Lam[r], E, eps, moreau, out[r], work)
     return out
 
 
