@@ -112,6 +112,8 @@ def test_corrupted_chain_row_is_resolved(monkeypatch):
 
 
 def test_corrupted_kernel_row_is_resolved(monkeypatch):
+    """The kernel backend's rows (a chain longer than the compiled path takes, Newton's law)
+    are checked by the law's certificate: a wrong impulse claimed solved is solved again."""
     from impactqp.qp.backends import kernel
     solve_many = kernel.solve_many
 
@@ -121,12 +123,32 @@ def test_corrupted_kernel_row_is_resolved(monkeypatch):
         return X, Y, done
 
     monkeypatch.setattr(kernel, "solve_many", corrupt)
-    p = iq.newtons_cradle(3)
-    U = np.random.default_rng(1).standard_normal((10, 3))
-    b = iq.moreau_batch(p, U, 0.0, backend="kernel")
+    p = iq.newtons_cradle(12)
+    U = np.random.default_rng(1).standard_normal((10, 12))
+    b = iq.solve_batch(p, iq.Newton(0.5), U, backend="kernel")
     assert b.backend == "kernel" and b.resolved == 1 and b.ok.all()
-    r = iq.moreau(p.with_u_minus(U[0]), 0.0)
+    r = iq.newton(p.with_u_minus(U[0]), 0.5)
     assert p.norm(b.u_plus[0] - r.u_plus) <= 1e-12 * p.norm(U[0])
+
+
+def test_corrupted_compiled_rows_are_resolved():
+    """Dense batches run the compiled impact row by row; with its operators corrupted (M⁻¹W
+    halved) every row misses its own certificate and is solved again on the general path."""
+    p = iq.random_impact(5, 3, seed=4)
+    st = p.structure
+    U = np.random.default_rng(2).standard_normal((12, 5))
+    clean = iq.moreau_batch(p, U, 0.3)
+    assert clean.backend == "kernel" and clean.resolved == 0 and clean.ok.all()
+    packed = st.kernel_pack.copy()
+    start = st.n * st.n + st.m * st.n
+    packed[start:start + st.n * st.m] *= 0.5
+    st.__dict__["kernel_pack"] = packed
+    try:
+        b = iq.moreau_batch(p, U, 0.3)
+    finally:
+        del st.__dict__["kernel_pack"]
+    assert b.resolved == 12 and b.ok.all()
+    np.testing.assert_allclose(b.u_plus, clean.u_plus, rtol=1e-9, atol=1e-12)
 
 
 def test_failing_closed_form_row_is_rejected(monkeypatch):

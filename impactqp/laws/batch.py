@@ -1,12 +1,14 @@
 """Many impacts of one problem structure at once (k pre-impact velocities, rows of a matrix),
 through the same law objects as single impacts.
 
-Closed-form laws run on all rows at once; program laws run vectorised on a fast-path backend
-that solves many linear terms at once (isotonic regression for chains, the prepared
-active-set kernel for small dense impacts); rows they cannot settle, and every row of other
-structures, go through :func:`impactqp.solve`. Every row's certificate is recomputed by the
-law; a row that fails it is solved again on its own, which raises if no backend certifies
-it, so a returned batch is certified row by row.
+The route is the one :func:`impactqp.solve` takes (:mod:`impactqp.laws.planner`): dense
+impacts of the complementarity laws run the compiled impact row by row, certificate
+included; Moreau's law on a short chain runs column by column; closed-form laws run on all
+rows at once; other program laws run on a fast-path backend that solves many linear terms
+at once (isotonic regression for chains, the active-set search); rows they cannot settle,
+and every row of other structures, go through :func:`impactqp.solve`. Every row's
+certificate is recomputed by the law; a row that fails it is solved again on its own, which
+raises if no backend certifies it, so a returned batch is certified row by row.
 """
 
 from __future__ import annotations
@@ -17,17 +19,20 @@ from typing import Any
 
 import numpy as np
 
-from ..base.arrays import as_array, as_count, check_tol
+from ..base.arrays import as_array, as_count
 from ..base.checks import DEFAULT_TOL
 from ..errors import BackendUnsuitableError, CertificateError, ShapeError
+from ..kernels.impact import solve_impact_rows
 from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
 from ..qp import backends
 from ..qp.certified import FAST_PATHS
+from . import small
 from .base import ImpactLaw
 from .chain_rows import ChainRows, suits
 from .moreau import Moreau
-from .pipeline import check_backend, check_law, check_problem, solve
+from .pipeline import solve
+from .planner import check_problem, route, validate
 from .sector import SectorLaw
 
 
@@ -161,11 +166,18 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
     """``work(a, b)`` for :func:`_in_chunks`: solve rows a..b into Up, Lam, write their
     residuals into ``res`` and return the indices of the rows that are not certified."""
     st, k = problem.structure, U.shape[0]
+    module = None
     if fast == "chain":
         rows = ChainRows(st, law.eps)
-        res.update({key: np.empty(k) for key in RESIDUALS})
-    else:
-        module = None if fast is None else backends.load(backends.REGISTRY[fast[0]])
+    elif fast == "compiled":
+        moreau = type(law) is Moreau
+        compiled = (st.kernel_pack, small.restitution_for(law, st.m),
+                    law.eps if moreau else 0.0, moreau)
+    elif fast is not None:
+        module = backends.load(backends.REGISTRY[fast[0]])
+    if fast in ("chain", "compiled"):
+        names = RESIDUALS if fast == "chain" or compiled[3] else RESIDUALS[:4]
+        res.update({key: np.empty(k) for key in names})
 
     def work(a: int, b: int) -> np.ndarray:
         Ua, done = U[a:b], None
@@ -178,6 +190,13 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
                 Lam[a:b, i] = col
             table = rows.residuals(Ua, Up[a:b], Lam[a:b])
             for i, key in enumerate(RESIDUALS):
+                res[key][a:b] = table[:, i]
+        elif fast == "compiled":  # each chunk warm-starts from its own cold support
+            packed, E, eps, moreau = compiled
+            Up[a:b], Lam[a:b], table, done = solve_impact_rows(
+                packed, np.ascontiguousarray(Ua), E, eps, moreau, tol,
+                np.zeros(st.m, dtype=bool))
+            for i, key in enumerate(res):
                 res[key][a:b] = table[:, i]
         else:
             if module is None:
@@ -231,19 +250,17 @@ def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: s
     CertificateError
         A closed-form law's row fails its certificate, or no backend certifies a row.
     """
-    check_problem(problem)
-    check_law(law)
+    tol = validate(problem, law, backend, "auto", tol)
     U = as_rows(problem, U_minus)
-    tol = check_tol(tol)
     n_jobs = as_count("n_jobs", n_jobs, minimum=1)
-    if law.forms or backend != law.closed_form_backend:
-        check_backend(backend)
-    law.check(problem)
     st = problem.structure
     k = U.shape[0]
+    way = route(problem, law, backend)
     if backend in ("auto", "isotonic") and suits(problem, law):
         fast, used = "chain", "isotonic"
-    elif law.forms:
+    elif way == "compiled":
+        fast, used = "compiled", "kernel"
+    elif way == "programs":
         fast = _fast_path(problem, law, backend)
         used = backend if fast is None else fast[0]
     else:

@@ -8,7 +8,8 @@ from ..base.checks import DEFAULT_TOL
 from ..model.problem import ImpactProblem
 from .complementarity import Fremond, Newton
 from .moreau import Moreau
-from .pipeline import check_problem, solve
+from .pipeline import solve
+from .planner import check_problem
 from .reflection import ReflectionLaw
 from .result import ImpactResult
 from .sector import SectorLaw

@@ -10,62 +10,22 @@ from __future__ import annotations
 
 import time
 from functools import partial
-from typing import Any
 
 import numpy as np
 
-from ..base.arrays import check_tol
 from ..base.checks import DEFAULT_TOL
 from ..errors import (
     BackendUnsuitableError,
     CertificateError,
-    InputError,
     NoSolutionError,
 )
 from ..model.problem import ImpactProblem
-from ..qp import backends
-from ..qp.backends import FORMS
 from ..qp.certified import solve_in_forms
 from ..qp.program import QPSolution
 from . import small
 from .base import Answer, ImpactLaw
+from .planner import route, validate
 from .result import ImpactResult
-
-FORM_CHOICES = ("auto",) + FORMS
-
-
-def check_problem(problem: Any) -> ImpactProblem:
-    """``problem`` itself, or InputError when it is not an ImpactProblem."""
-    if not isinstance(problem, ImpactProblem):
-        raise InputError(f"problem must be an ImpactProblem (built by iq.ImpactProblem, "
-                         f"iq.chain, iq.newtons_cradle, ...), got {type(problem).__name__}")
-    return problem
-
-
-def check_law(law: Any) -> ImpactLaw:
-    """``law`` itself, or InputError when it is not an impact law object."""
-    if ImpactLaw not in type(law).__mro__:  # isinstance, without the ABC machinery
-        raise InputError(f"law must be an impact law object such as iq.Moreau(0.5), "
-                         f"iq.Newton(e), iq.Fremond(E) or iq.SectorLaw(), got "
-                         f"{type(law).__name__}")
-    return law
-
-
-def check_backend(backend: Any) -> str:
-    """``backend`` when it is ``"auto"`` or a registered name, else UnknownBackendError."""
-    if backend != "auto":
-        backends.parse_backend(backend)
-    return backend
-
-
-def check_form(law: ImpactLaw, form: Any) -> str:
-    """``form`` when it is "auto" or a form ``law`` has, else InputError."""
-    if form not in FORM_CHOICES:
-        raise InputError(f"form must be one of {FORM_CHOICES}, got {form!r}")
-    if form != "auto" and form not in law.forms:
-        has = ", ".join(law.forms) if law.forms else "none: it is evaluated in closed form"
-        raise InputError(f"{law.title} has no {form} form (forms: {has})")
-    return form
 
 
 def _result(problem: ImpactProblem, law: ImpactLaw, answer: Answer, backend: str, cert,
@@ -125,14 +85,9 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         No backend produced an answer that passes the certificate.
     """
     start = time.perf_counter()
-    check_problem(problem)
-    check_law(law)
-    if law.forms or backend != law.closed_form_backend:
-        check_backend(backend)
-    check_form(law, form)
-    tol = check_tol(tol)
-    law.check(problem)
-    if small.applies(problem, law, backend, form):  # declines when u⁻ = 0
+    tol = validate(problem, law, backend, form, tol)
+    way = route(problem, law, backend, form)
+    if way == "compiled":
         result = small.solve_small(problem, law, tol, start)
         if result is not None:
             return result
@@ -145,7 +100,7 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         if problem.n_contacts == 0:
             raise CertificateError(f"{law.title} without contacts: u⁺ = u⁻ fails its "
                                    f"certificate, {cert.summary()}")
-    if not law.forms:
+    if way == "closed_form":
         return _closed_form(problem, law, backend, tol, start)
 
     forms = (form,) if form != "auto" else law.preferred_forms(problem)

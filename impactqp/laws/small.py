@@ -46,7 +46,7 @@ _MOREAU_E = np.zeros((0, 0))
 """What the kernel takes as E for Moreau's law (it forms εI itself)."""
 
 
-def _restitution(law: ImpactLaw, m: int) -> np.ndarray:
+def restitution_for(law: ImpactLaw, m: int) -> np.ndarray:
     """The law's E as the kernel takes it, formed once per law object and contact count."""
     if type(law) is Moreau:
         return _MOREAU_E
@@ -74,8 +74,8 @@ def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float,
     eps = law.eps if moreau else 0.0
     n, m = st.n, st.m
     out = np.empty(n + m + 6)
-    if not solve_impact(st.kernel_pack, problem.u_minus, _restitution(law, m), eps, moreau, tol,
-                        st.warm_support, out):
+    if not solve_impact(st.kernel_pack, problem.u_minus, restitution_for(law, m), eps, moreau,
+                        tol, st.warm_support, out):
         return None
     up = out[:n]
     values = dict(zip(RESIDUALS if moreau else RESIDUALS[:4], out[n + m:].tolist()))

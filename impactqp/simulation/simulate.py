@@ -11,7 +11,7 @@ from ..base.arrays import as_count, as_flag, as_real, check_tol
 from ..base.checks import DEFAULT_TOL
 from ..errors import InputError
 from ..laws.base import ImpactLaw
-from ..laws.pipeline import check_backend, check_law
+from ..laws.planner import check_backend, check_law
 from ..model.problem import ImpactProblem
 from .event_driven import event_driven
 from .system import LinearSystem

@@ -15,7 +15,8 @@ from ..base.checks import DEFAULT_TOL
 from ..errors import InputError, SectorLawError
 from ..laws.lzb import DEFAULT_RTOL, LZB
 from ..laws.moreau import Moreau
-from ..laws.pipeline import check_law, check_problem, solve
+from ..laws.pipeline import solve
+from ..laws.planner import check_law, check_problem
 from ..laws.result import ImpactResult
 from ..laws.sector import SectorLaw
 from ..model.admissible import Membership
