@@ -10,14 +10,17 @@ in by subclassing :class:`ImpactLaw`.
 
 from __future__ import annotations
 
-from abc import ABC, abstractmethod
+from abc import ABC
 from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
+from ..base.arrays import as_vector
 from ..errors import InputError
+from ..model.admissible import best_impulses
 from ..model.problem import ImpactProblem
 from ..model.programs import preferred_forms
+from ..model.residuals import impact_residuals, normalized_rows
 from ..model.structure import ImpactStructure
 from ..qp.program import QPSolution, QuadraticProgram
 from .certificate import Certificate
@@ -44,10 +47,12 @@ class Answer(NamedTuple):
 class ImpactLaw(ABC):
     """Base class of impact laws.
 
-    A subclass sets the class attributes below, implements :meth:`residuals` (from which
-    :meth:`certificate` builds the law's :class:`~impactqp.Certificate`), and either
-    :meth:`program` with :meth:`recover` (a law solved through quadratic programs) or
-    :meth:`closed_form` (``forms = ()``).
+    A subclass sets the class attributes below and either :meth:`program` with
+    :meth:`recover` (a law solved through quadratic programs) or :meth:`closed_form`
+    (``forms = ()``; returning u⁺ alone is enough, the impulses are recovered). Its
+    :meth:`residuals` (by default momentum and Λ ≥ 0) make the law's
+    :class:`~impactqp.Certificate`; batches run a closed form row by row unless
+    :meth:`closed_form_rows` does better.
 
     Attributes
     ----------
@@ -74,8 +79,16 @@ class ImpactLaw(ABC):
 
     name: ClassVar[str]
     title: ClassVar[str]
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """A law class that names neither itself nor its title is called by its class name."""
+        super().__init_subclass__(**kwargs)
+        if "name" not in cls.__dict__ and not hasattr(cls, "name"):
+            cls.name = cls.__name__.lower()
+        if "title" not in cls.__dict__ and not hasattr(cls, "title"):
+            cls.title = cls.__name__
     forms: ClassVar[tuple[str, ...]] = ()
-    closed_form_backend: ClassVar[str] = ""
+    closed_form_backend: ClassVar[str] = "closed form"
     always_solvable: ClassVar[bool] = False
     by_name: ClassVar[bool] = False
     coefficient_key: ClassVar[str | None] = None
@@ -131,9 +144,36 @@ class ImpactLaw(ABC):
         """u⁺, Λ (and z) from a solution of :meth:`program`."""
         raise NotImplementedError(f"{self.title} emits no {form} program")
 
-    def closed_form(self, problem: ImpactProblem) -> Answer:
-        """The answer of a closed-form law (``forms == ()``)."""
+    def closed_form(self, problem: ImpactProblem) -> Answer | Any:
+        """The answer of a closed-form law (``forms == ()``): an :class:`Answer`, a pair
+        (u⁺, Λ), or u⁺ alone, whose impulses :meth:`answer_of` then recovers."""
         raise NotImplementedError(f"{self.title} is solved through programs")
+
+    def answer_of(self, problem: ImpactProblem, output: Any) -> Any:
+        """What :meth:`closed_form` returned, as an :class:`Answer` of finite real arrays
+        (an answer type of the law's own, such as the LZB answer, keeps its type).
+
+        u⁺ alone gets the impulses Λ ≥ 0 closest to M(u⁺ − u⁻) = WΛ (exact NNLS, the
+        kinetic test of docs/theory.md §2); if no Λ ≥ 0 produces the jump, the momentum
+        residual of the certificate says so and the answer is not returned.
+
+        Raises
+        ------
+        InputError
+            Output that is not one or two real arrays of the problem's sizes (complex,
+            NaN, strings, wrong shapes; the message names what was wrong).
+        """
+        if hasattr(output, "u_plus") and hasattr(output, "impulses"):  # an Answer or kin
+            u_plus = as_vector(f"{self.title}: u⁺", output.u_plus, problem.n_dof)
+            impulses = as_vector(f"{self.title}: Λ", output.impulses, problem.n_contacts)
+            return output._replace(u_plus=u_plus, impulses=impulses)
+        if isinstance(output, tuple) and len(output) == 2:
+            u_plus = as_vector(f"{self.title}: u⁺", output[0], problem.n_dof)
+            impulses = as_vector(f"{self.title}: Λ", output[1], problem.n_contacts)
+        else:
+            u_plus = as_vector(f"{self.title}: u⁺", output, problem.n_dof)
+            impulses = best_impulses(problem, u_plus - problem.u_minus)[0]
+        return Answer(u_plus, impulses, None)
 
     def linear_terms(self, problem: ImpactProblem, U_minus: np.ndarray,
                      form: str) -> np.ndarray:
@@ -148,15 +188,23 @@ class ImpactLaw(ABC):
 
     def closed_form_rows(self, problem: ImpactProblem,
                          U_minus: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(U⁺, Λ) of a closed-form law for every row of U_minus."""
-        raise NotImplementedError(f"{self.title} does not evaluate many impacts at once; "
-                                  "define closed_form_rows to use it in a batch")
+        """(U⁺, Λ) of a closed-form law for every row of U_minus; by default row by row
+        through :meth:`closed_form` (a law that can do better overrides it)."""
+        k, n, m = U_minus.shape[0], problem.n_dof, problem.n_contacts
+        U_plus, impulses = np.empty((k, n)), np.empty((k, m))
+        for i, u in enumerate(U_minus):
+            row = problem.with_u_minus(u)
+            U_plus[i], impulses[i] = self.answer_of(row, self.closed_form(row))[:2]
+        return U_plus, impulses
 
-    @abstractmethod
     def residuals(self, structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
                   impulses: np.ndarray) -> dict[str, np.ndarray]:
         """The law's dimensionless residuals for one impact (1-D arrays, float values) or
-        for rows of impacts ((k,) arrays)."""
+        for rows of impacts ((k,) arrays). By default those every impact law shares: the
+        momentum ‖u⁺ − u⁻ − M⁻¹WΛ‖/V and the sign of Λ (docs/theory.md §8); whether u⁺ is
+        admissible, energy included, is the separate verdict ``result.admissible``."""
+        U_minus, U_plus, impulses = normalized_rows(U_minus, U_plus, impulses)
+        return impact_residuals(structure, U_minus, U_plus, impulses)[1]
 
     def certificate(self, problem: ImpactProblem, answer: Answer, tol: float) -> Certificate:
         """The recomputed certificate of ``answer`` on ``problem``: the law's

@@ -127,7 +127,7 @@ def _closed_form(problem: ImpactProblem, law: ImpactLaw, backend: str, tol: floa
     if backend not in ("auto", law.closed_form_backend):
         raise BackendUnsuitableError(f"{law.title} is evaluated in closed form; pass "
                                      f"backend='auto', not {backend!r}")
-    answer = law.closed_form(problem)
+    answer = law.answer_of(problem, law.closed_form(problem))
     cert = law.certificate(problem, answer, tol)
     if not cert.ok:
         raise CertificateError(f"{law.title}: certificate failed, {cert.summary()}")

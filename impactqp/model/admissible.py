@@ -85,7 +85,7 @@ def best_impulses(problem: Any, du: np.ndarray) -> tuple[np.ndarray, float]:
     kinetic condition). ``du`` is divided by its largest entry first and the answer scaled
     back, so the NNLS sees numbers of order one at any velocity scale.
 
-    Dense: ‖M⁻¹WΛ − du‖_M = ‖BΛ − Lᵀdu‖ with M = LLᵀ, B = L⁻¹W, scipy's exact NNLS.
+    Dense: ‖M⁻¹WΛ − du‖_M = ‖BΛ − Lᵀdu‖ with M = LLᵀ, B = L⁻¹W, the compiled exact NNLS.
     Sparse: the NNLS normal equations, an LCP with the Delassus matrix, by a sparse direct
     solve when that already gives Λ ≥ 0 and by a certified QP backend otherwise.
     """
