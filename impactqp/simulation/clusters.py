@@ -19,6 +19,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..base.arrays import Matrix
+from ..laws.small import SHORT_CHAIN
 from ..model.builders import chain_directions
 from ..model.structure import ChainInfo, ImpactStructure
 
@@ -156,12 +157,15 @@ class ClusterCache:
     def _build(self, dofs: slice | np.ndarray, contacts: np.ndarray,
                key: object) -> ImpactStructure:
         if isinstance(dofs, slice):
-            # a run of a chain is a chain (sparse: its Delassus matrix costs O(k))
+            # a run of a chain is a chain: dense while the compiled path takes it, sparse
+            # beyond (its Delassus matrix then costs O(k))
             masses = self.diagonal[dofs].copy()
             left, right = key[2], key[3]
-            H = chain_directions(masses.size, left_wall=left, right_wall=right, sparse=True)
+            sparse = contacts.size > SHORT_CHAIN
+            H = chain_directions(masses.size, left_wall=left, right_wall=right, sparse=sparse)
             info = ChainInfo(masses=masses, left_wall=left, right_wall=right)
-            return ImpactStructure(sp.diags(masses, format="csc"), H, chain=info)
+            M = sp.diags(masses, format="csc") if sparse else np.diag(masses)
+            return ImpactStructure(M, H, chain=info)
         H = self.H[dofs, :][:, contacts]
         M = self.metric[dofs][:, dofs]
         if not self.sparse:

@@ -1,8 +1,11 @@
 """Event-driven integration with any impact law (docs/theory.md §14).
 
-Smooth phases are integrated by scipy's :func:`~scipy.integrate.solve_ivp` (DOP853 by
-default) with event location: a free contact closing (its gap falls through 0) or a held
-contact ceasing to push (its force λ falls through −threshold) ends the phase. At an event:
+Smooth phases under a constant force are flown in closed form (constant acceleration, the
+first closing gap a root of a quadratic); others are integrated by scipy's
+:func:`~scipy.integrate.solve_ivp` (DOP853 by default) with event location, a maximum step
+from the system's own period and a search for gaps that dip below zero within one step. A
+free contact closing (its gap falls through 0) or a held contact ceasing to push (its force λ
+falls through −threshold) ends the phase. At an event:
 
 1. closed contacts are those with gᵢ ≤ ``gap_tol``; each cluster of them with an approaching
    contact (γ⁻ᵢ < 0) is an impact problem (M, H_closed, u⁻), solved with the law through
@@ -18,16 +21,21 @@ contact ceasing to push (its force λ falls through −threshold) ends the phase
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any, NamedTuple
 
 import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
+from ..base.arrays import as_dense
 from ..base.checks import DEFAULT_TOL
 from ..errors import InputError, SolverError
 from ..laws.base import ImpactLaw
 from .clusters import ClusterCache
 from .impacts import ImpactEvent, ImpactSolver
-from .smooth import Phase, check_solved, contact_accelerations
+from .smooth import Phase, check_solved, contact_accelerations, first_closing
 from .system import LinearSystem
 from .trajectory import Trajectory
 
@@ -88,7 +96,8 @@ def event_driven(system: LinearSystem, law: ImpactLaw, t_end: float, h: float | 
     rest_velocity : float
         A closed contact separating slower than this (velocity units) is settled.
     method, rtol, atol : str, float, float
-        :func:`scipy.integrate.solve_ivp` settings of the smooth phases.
+        :func:`scipy.integrate.solve_ivp` settings of the smooth phases (unused under a
+        constant force, whose phases are exact).
     max_events : int
         Events after which integration stops with an error.
     keep_events : bool
@@ -118,6 +127,7 @@ def event_driven(system: LinearSystem, law: ImpactLaw, t_end: float, h: float | 
     lift_threshold = RELATIVE_THRESHOLD * force_scale
     acc_tol = 1e-3 * lift_threshold * system.structure.delassus_diagonal \
         if system.n_contacts else 0.0
+    max_step = _max_step(system)
     g = system.gaps(system.q0)
     if np.any(g < -gap_tol):
         worst = int(np.argmin(g))
@@ -155,18 +165,25 @@ def event_driven(system: LinearSystem, law: ImpactLaw, t_end: float, h: float | 
         phase = Phase(system, held, structures)
         watched = np.flatnonzero(~held)
         near = g[watched] <= gap_tol
-        closing = phase.closing_event(watched, near, g[watched])
-        liftoff = phase.liftoff_event(lift_threshold)
-        first = _first_step(gamma_new[watched][near], Hta[watched][near], t_end - t)
         t_eval = np.append(grid[(grid > t) & (grid < t_end)], t_end)
-        for _ in range(6):
-            sol = solve_ivp(phase.rhs, (t, t_end), np.concatenate([q, v]), method=method,
-                            t_eval=t_eval, events=[closing, liftoff], rtol=rtol, atol=atol,
-                            first_step=first)
-            check_solved(sol.status, sol.message, t)
-            if not _spurious(sol, system, t, gap_tol):
-                break
-            first = min(first or 1e-6 * (t_end - t), t_end - t) / 100.0
+        if system.constant_force is not None:  # constant acceleration: the flight is exact
+            a = phase.acceleration(t, q, v)[0]
+            tau = first_closing(g[watched], gamma_new[watched],
+                                system.contact_velocities(a)[watched], near)
+            sol = _exact_flight(t, q, v, a, t_eval, t + tau if t + tau <= t_end else None)
+        else:
+            closing = phase.closing_event(watched, near, g[watched])
+            liftoff = phase.liftoff_event(lift_threshold)
+            first = _first_step(gamma_new[watched][near], Hta[watched][near], t_end - t)
+            for _ in range(6):
+                sol = solve_ivp(phase.rhs, (t, t_end), np.concatenate([q, v]), method=method,
+                                t_eval=t_eval, events=[closing, liftoff], rtol=rtol, atol=atol,
+                                first_step=first, max_step=max_step, dense_output=True)
+                check_solved(sol.status, sol.message, t)
+                if not _spurious(sol, system, t, gap_tol):
+                    break
+                first = min(first or 1e-6 * (t_end - t), t_end - t) / 100.0
+            sol = _grazing(sol, system, watched, np.where(near, g[watched], 0.0))
         if len(sol.t):  # t_eval points before the event (solve_ivp gives [] for none)
             for k in range(len(sol.t)):
                 rec.add(sol.t[k], sol.y[:n, k], sol.y[n:, k])
@@ -191,6 +208,88 @@ def event_driven(system: LinearSystem, law: ImpactLaw, t_end: float, h: float | 
                 "gap_tol": gap_tol, "rest_velocity": rest_velocity, "method": method,
                 "rtol": rtol, "atol": atol, "events": count, "keep_events": keep_events}
     return Trajectory(system, law, "event-driven", T, Q, V, L, events, settings)
+
+
+class _Flight(NamedTuple):
+    """A phase flown in closed form, read like the result of ``solve_ivp`` with one
+    terminal event."""
+
+    t: np.ndarray
+    y: np.ndarray
+    status: int
+    t_events: list[np.ndarray]
+    y_events: list[np.ndarray]
+
+
+def _exact_flight(t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, t_eval: np.ndarray,
+                  t_event: float | None) -> _Flight:
+    """States q + vτ + ½aτ², v + aτ at the output times before ``t_event`` (all of them when
+    no contact closes) and at the event itself (docs/theory.md §14)."""
+    times = t_eval if t_event is None else t_eval[t_eval < t_event]
+    tau = times - t
+    y = np.concatenate([q[:, None] + v[:, None] * tau + (0.5 * a)[:, None] * tau**2,
+                        v[:, None] + a[:, None] * tau])
+    if t_event is None:
+        return _Flight(times, y, 0, [np.zeros(0)], [np.zeros((0, 2 * q.size))])
+    tau = t_event - t
+    y_event = np.concatenate([q + v * tau + (0.5 * tau**2) * a, v + tau * a])
+    return _Flight(times, y, 1, [np.array([t_event])], [y_event[None, :]])
+
+
+def _max_step(system: LinearSystem) -> float:
+    """An eighth of the shortest period of a linear force's oscillations, 2π/ω_max with
+    ω²_max the largest eigenvalue of (K, M), so that a gap has at most one minimum between two
+    accepted steps (docs/theory.md §14); unbounded for other forces."""
+    K = system.linear_force.stiffness if system.linear_force is not None else None
+    if K is None:
+        return np.inf
+    K = K.toarray() if sp.issparse(K) else np.asarray(K)
+    if not K.any():
+        return np.inf
+    w2 = float(sla.eigh(K, as_dense(system.M), eigvals_only=True)[-1])
+    return np.inf if w2 <= 0.0 else 2.0 * np.pi / np.sqrt(w2) / 8.0
+
+
+def _grazing(sol: Any, system: LinearSystem, watched: np.ndarray, offset: np.ndarray) -> Any:
+    """``sol`` ended at the first watched contact whose gap gᵢ − offsetᵢ (offset: the gap at
+    the start for contacts near closed, as in :meth:`Phase.closing_event`) dips below zero
+    and back between two accepted steps: a grazing impact that the sign test at the steps
+    does not see.
+
+    On a step where the gap is positive at both ends while γᵢ turns from negative to
+    positive, its minimum is where γᵢ = 0 on the solver's dense output; if the gap is
+    negative there, the contact closed at the root of the gap before it (docs/theory.md §14).
+    """
+    if watched.size == 0 or sol.sol is None:
+        return sol
+    n = system.n_dof
+    ts = sol.sol.ts
+    Y = sol.sol(ts)
+    G = system.gaps(Y[:n].T)[:, watched] - offset
+    Gam = system.contact_velocities(Y[n:].T)[:, watched]
+    dips = (G[:-1] > 0) & (G[1:] > 0) & (Gam[:-1] < 0) & (Gam[1:] > 0)
+    def speed(s: float, h: np.ndarray, b: float) -> float:
+        return float(h @ sol.sol(s)[n:])
+
+    def gap(s: float, h: np.ndarray, b: float) -> float:
+        return float(h @ sol.sol(s)[:n] + b)
+
+    found = None
+    for j, i in zip(*np.nonzero(dips)):  # steps in time order
+        if found is not None and ts[j] >= found:
+            break
+        h = system.H[:, watched[i]]
+        h = h.toarray().ravel() if sp.issparse(h) else np.asarray(h).ravel()
+        b = system.b[watched[i]] - offset[i]
+        t_min = brentq(speed, ts[j], ts[j + 1], args=(h, b))
+        if gap(t_min, h, b) < 0:
+            t_in = brentq(gap, ts[j], t_min, args=(h, b))
+            found = t_in if found is None else min(found, t_in)
+    if found is None:
+        return sol
+    keep = sol.t < found
+    return _Flight(sol.t[keep], sol.y[:, keep], 1, [np.array([found])],
+                   [sol.sol(found)[None, :]])
 
 
 def _event_time(sol) -> float:

@@ -138,6 +138,30 @@ class Phase:
         return _terminal(liftoff)
 
 
+def first_closing(g: np.ndarray, gamma: np.ndarray, alpha: np.ndarray,
+                  near: np.ndarray) -> float:
+    """The first τ > 0 at which a gap gᵢ(τ) = gᵢ + γᵢτ + ½αᵢτ² falls through zero, ∞ if none
+    does (docs/theory.md §14, phases under a constant force).
+
+    A gap that is ``near`` closed at the start is watched as gᵢ(τ) − gᵢ(0) (as the closing
+    event of :class:`Phase`): it closes at τ = −2γᵢ/αᵢ when it separates and decelerates, at
+    once when it approaches.
+    Otherwise the falling root, where γᵢ + αᵢτ = −√D with D = γᵢ² − 2αᵢgᵢ, is taken in the form
+    without cancellation: 2gᵢ/(−γᵢ + √D) when γᵢ < 0, (−γᵢ − √D)/αᵢ when γᵢ ≥ 0 (then only
+    αᵢ < 0 brings the gap back).
+    """
+    tau = np.where(near & (gamma < 0), 0.0, np.inf)  # closing at once (a law left γ⁺ < 0)
+    back = near & (gamma > 0) & (alpha < 0)
+    tau[back] = -2.0 * gamma[back] / alpha[back]
+    far = ~near
+    D = gamma * gamma - 2.0 * alpha * np.where(far, g, 0.0)
+    approaching = far & (gamma < 0) & (D >= 0)
+    tau[approaching] = 2.0 * g[approaching] / (-gamma[approaching] + np.sqrt(D[approaching]))
+    returning = far & (gamma >= 0) & (alpha < 0)
+    tau[returning] = (-gamma[returning] - np.sqrt(D[returning])) / alpha[returning]
+    return float(np.min(tau, initial=np.inf))
+
+
 def _terminal(fn: Callable[[float, np.ndarray], float]) -> Callable[[float, np.ndarray], float]:
     fn.terminal = True
     fn.direction = -1.0
