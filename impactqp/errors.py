@@ -48,6 +48,11 @@ class NonSymmetricLCPError(NonConvexLCPError):
     """An LCP whose matrix is not symmetric."""
 
 
+class OutOfRangeError(InputError):
+    """An answer whose magnitude floats cannot represent (it would overflow to infinity or
+    vanish below the smallest float); the message gives its scale."""
+
+
 class ProblemFileError(InputError):
     """A problem file that cannot be read: syntax, unknown keys, types, shapes or size."""
 

@@ -16,7 +16,13 @@ import numpy as np
 
 from ..base.arrays import as_array, check_tol
 from ..base.checks import DEFAULT_TOL, NamedChecks, ResidualChecks
-from ..errors import NonConvexLCPError, NonSymmetricLCPError, NoSolutionError, ShapeError
+from ..errors import (
+    NonConvexLCPError,
+    NonSymmetricLCPError,
+    NoSolutionError,
+    OutOfRangeError,
+    ShapeError,
+)
 from . import backends
 from .certified import solve_in_forms
 from .program import QPSolution, QuadraticProgram
@@ -70,7 +76,7 @@ class LCPResult:
 
 
 def _residuals(G: Any, q: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, dict]:
-    """w = Gz + q and the residuals, for an LCP already normalized (max |Gᵢⱼ| = 1, ‖q‖ = 1)."""
+    """w = Gz + q and the residuals, for an LCP already normalized (max |Gᵢⱼ| = 1, max |qᵢ| = 1)."""
     w = np.asarray(G @ z).ravel() + q
     scale = 1.0 + np.linalg.norm(q)
     zs = max(np.abs(z).max(initial=0.0), 1.0)
@@ -119,8 +125,9 @@ def solve_lcp(G: Any, q: Any, backend: str = "auto", *, tol: float = DEFAULT_TOL
 
     .. math:: \\min_{z \\ge 0} \\tfrac12 z^T G z + q^T z
 
-    The problem is normalized (G by its largest entry, q by its norm) before it is solved
-    and certified, so the answer does not depend on the units of G and q.
+    The problem is normalized (G and q each by its largest entry) before it is solved and
+    certified, so the answer does not depend on the units of G and q, down to the smallest
+    and up to the largest floats.
 
     Parameters
     ----------
@@ -146,6 +153,8 @@ def solve_lcp(G: Any, q: Any, backend: str = "auto", *, tol: float = DEFAULT_TOL
         Unknown backend, or one that cannot take this LCP.
     NoSolutionError
         The LCP is infeasible.
+    OutOfRangeError
+        The solution's scale max|q|/max|G| is beyond what floats represent.
     CertificateError
         No backend reached ``tol``.
     """
@@ -162,8 +171,8 @@ def solve_psd_lcp(G: Any, q: np.ndarray, backend: str = "auto", *,
     known to be symmetric positive semidefinite, such as a Delassus matrix."""
     start = time.perf_counter()
     g_scale = float(abs(G).max()) if G.shape[0] else 0.0
-    q_scale = float(np.linalg.norm(q))
-    if q.size == 0 or q_scale == 0.0 or np.all(q >= 0):
+    q_scale = float(np.abs(q).max(initial=0.0))  # max |qᵢ|: a norm would overflow first
+    if q_scale == 0.0 or np.all(q >= 0):
         # z = 0 solves it exactly (w = q ≥ 0)
         z = np.zeros(q.size)
         _, res = _residuals(G, q / max(q_scale, 1.0), z)
@@ -171,6 +180,10 @@ def solve_psd_lcp(G: Any, q: np.ndarray, backend: str = "auto", *,
                          time.perf_counter() - start)
     if g_scale == 0.0:
         raise NoSolutionError("G = 0 and q has a negative entry: the LCP has no solution")
+    z_scale = q_scale / g_scale
+    if not np.isfinite(z_scale) or z_scale == 0.0:
+        raise OutOfRangeError(f"the solution z scales as max|q|/max|G| = {q_scale:.3g}/"
+                              f"{g_scale:.3g}, which floats cannot represent; rescale G or q")
     Gn, qn = G / g_scale, q / q_scale
     qp = QuadraticProgram(P=Gn, c=qn)
 
@@ -181,6 +194,11 @@ def solve_psd_lcp(G: Any, q: np.ndarray, backend: str = "auto", *,
 
     out = solve_in_forms([("impulse", lambda: qp, finish)], backend)
     z, w, res = out.answer
-    return LCPResult(z=z * (q_scale / g_scale), w=w * q_scale, error=res["natural_map"],
+    with np.errstate(over="ignore"):
+        z, w = z * z_scale, w * q_scale
+    if not (np.isfinite(z).all() and np.isfinite(w).all()):
+        raise OutOfRangeError(f"the solution z (scale {z_scale:.3g}) or w = Gz + q (scale "
+                              f"{q_scale:.3g}) overflows floats; rescale G or q")
+    return LCPResult(z=z, w=w, error=res["natural_map"],
                      residuals=res, backend=out.backend, tol=tol, attempts=out.attempts,
                      solve_time=time.perf_counter() - start)
