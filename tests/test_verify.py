@@ -163,7 +163,7 @@ def test_law_errors_are_counted_not_raised() -> None:
 
 
 def test_bad_input() -> None:
-    with pytest.raises(iq.ShapeError, match="u_plus of shape"):
+    with pytest.raises(iq.ShapeError, match="u⁺ must have shape"):
         iq.verify_law(lambda q: np.zeros(2), CRADLE, samples=5)
     with pytest.raises(iq.InputError, match="callable"):
         iq.verify_law(42, CRADLE)
@@ -177,3 +177,28 @@ def test_bad_input() -> None:
         fremond_matrix(0, 0, 2, family="lower")
     with pytest.raises(iq.InputError, match="1-D"):
         iq.fremond_admissibility_map(CRADLE, [[0, 1]], [0])
+
+
+def test_a_laws_own_exception_is_reported_with_its_type_and_message():
+    p = iq.newtons_cradle(3)
+
+    def fragile(problem):
+        if problem.u_minus[0] > 0.5:
+            raise ZeroDivisionError("the spring broke")
+        return iq.sector_law(problem).u_plus
+
+    report = iq.verify_law(fragile, p, samples=64, seed=1)
+    assert report.violations["law_error"] > 0 and not report.ok
+    ce = report.counterexamples["law_error"]
+    assert ce.error == "ZeroDivisionError: the spring broke"
+    assert ce.u_minus[0] > 0.5 and np.isnan(ce.u_plus).all()
+    assert "ZeroDivisionError: the spring broke" in report.summary()
+
+
+def test_a_law_answering_nan_is_a_law_error_and_complex_output_is_refused():
+    p = iq.newtons_cradle(3)
+    report = iq.verify_law(lambda q: np.full(3, np.nan), p, samples=8)
+    assert report.violations["law_error"] == 8
+    assert report.counterexamples["law_error"].error.startswith("NonFiniteError")
+    with pytest.raises(iq.InputError, match="complex"):
+        iq.verify_law(lambda q: iq.sector_law(q).u_plus + 1e-3j, p, samples=8)

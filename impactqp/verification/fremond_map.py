@@ -92,7 +92,7 @@ def fremond_admissibility_map(problem: ImpactProblem, a_values: Any, b_values: A
         verdicts = []
         for a, b in (cells[k] for k in span):
             E = fremond_matrix(a, b, m, family)
-            _, res = admissibility_residuals(lambda q, E=E: fremond(q, E), problem, u_minus)
+            _, res, _ = admissibility_residuals(lambda q, E=E: fremond(q, E), problem, u_minus)
             verdicts.append(bool(np.all(res <= tol)))  # NaN (the law failed): not in S
         return verdicts
 

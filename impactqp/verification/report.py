@@ -34,12 +34,16 @@ class Counterexample:
         ``"law_error"`` (or ``"continuity"`` for an exact certificate).
     amount : float
         By how much the condition is violated (dimensionless; ``inf`` for a law error).
+    error : str or None
+        For ``"law_error"``: the law's exception as ``"Type: message"`` (or why its answer
+        was refused).
     """
 
     u_minus: np.ndarray
     u_plus: np.ndarray
     condition: str
     amount: float
+    error: str | None = None
 
 
 @dataclass(frozen=True)
@@ -87,6 +91,8 @@ class LawReport:
         line = f"{'ok' if self.ok else 'VIOLATED'} ({size}): {counts}"
         if self.worst is not None:
             line += f"; worst {self.worst.condition} by {self.worst.amount:.3g}"
+            if self.worst.error:
+                line += f" ({self.worst.error})"
         return line
 
 

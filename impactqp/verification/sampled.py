@@ -19,8 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from ..base.arrays import as_count, as_dense, as_flag, check_tol
-from ..errors import ImpactError, InputError, ShapeError
+from ..base.arrays import as_count, as_dense, as_flag, as_vector, check_tol
+from ..errors import InputError, NonFiniteError
 from ..laws.base import ImpactLaw
 from ..laws.functions import moreau
 from ..laws.pipeline import solve
@@ -68,33 +68,40 @@ def _solve_with(law: ImpactLaw, problem: ImpactProblem) -> ImpactResult:
 
 
 def run_law(law: Law, problem: ImpactProblem) -> np.ndarray:
-    """u⁺ of ``law`` on ``problem``: from an ImpactResult or an array of shape (n,)."""
+    """u⁺ of ``law`` on ``problem``: from an ImpactResult or an (n,) array of real numbers,
+    read by the one input converter (complex, strings or a wrong shape are refused by name;
+    a non-finite u⁺ raises NonFiniteError)."""
     out = law(problem)
-    u = out.u_plus if isinstance(out, ImpactResult) else np.asarray(out, dtype=float)
-    if u.shape != (problem.n_dof,):
-        raise ShapeError(f"the law must return an ImpactResult or u_plus of shape "
-                         f"({problem.n_dof},), got {u.shape}")
-    return u
+    u = out.u_plus if isinstance(out, ImpactResult) else out
+    return as_vector("the law's u⁺", u, problem.n_dof)
 
 
-def admissibility_residuals(law: Law, problem: ImpactProblem,
-                            u_minus: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Run ``law`` from every row of ``u_minus``; return u⁺ (k × n) and the residuals
-    (k × 3: kinematic, kinetic, energetic) of the exact test u⁺ ∈ S. A law that raises an
-    ImpactError gets u⁺ = NaN and residuals NaN."""
+def admissibility_residuals(law: Law, problem: ImpactProblem, u_minus: np.ndarray,
+                            ) -> tuple[np.ndarray, np.ndarray, list[str | None]]:
+    """Run ``law`` from every row of ``u_minus``; return u⁺ (k × n), the residuals (k × 3:
+    kinematic, kinetic, energetic) of the exact test u⁺ ∈ S, and per row the error the law
+    raised (``"Type: message"``) or None. A row where the law raised, or answered a
+    non-finite u⁺, gets u⁺ = NaN and residuals NaN; output that is no real vector of the
+    right length (complex, strings, a wrong shape) is a broken law and raises."""
     u_plus = np.full_like(u_minus, np.nan)
     res = np.full((len(u_minus), 3), np.nan)
+    errors: list[str | None] = [None] * len(u_minus)
     for i, u in enumerate(u_minus):
         q = problem.with_u_minus(u)
         try:
-            u_plus[i] = run_law(law, q)
-        except ShapeError:
-            raise
-        except ImpactError:
+            out = law(q)
+        except Exception as exc:  # the law's own failure at this u⁻: reported, not hidden
+            errors[i] = f"{type(exc).__name__}: {exc}"
+            continue
+        try:
+            u_plus[i] = as_vector("the law's u⁺", out.u_plus if isinstance(out, ImpactResult)
+                                  else out, problem.n_dof)
+        except NonFiniteError as exc:
+            errors[i] = f"{type(exc).__name__}: {exc}"
             continue
         m = q.admissible_set().contains(u_plus[i])
         res[i] = m.kinematic, m.kinetic, m.energetic
-    return u_plus, res
+    return u_plus, res, errors
 
 
 def _pair_expansion(M: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
@@ -165,8 +172,10 @@ def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 10
     InputError
         If ``law`` is neither callable nor a piecewise-linear table, ``problem`` is not an
         :class:`~impactqp.ImpactProblem`, or ``samples`` is not an integer ≥ 2.
-    ShapeError
-        If the law returns u⁺ of the wrong shape.
+    ShapeError, InputError
+        If the law returns u⁺ of the wrong shape, complex or not numbers at all (a law that
+        raises, or answers NaN, at some u⁻ is counted as ``law_error`` instead, its
+        exception's type and message on the counterexample).
     """
     if isinstance(law, PiecewiseLinearTable) or (hasattr(law, "cones") and hasattr(law, "G")):
         return certify_table_report(law, tol=tol)
@@ -192,6 +201,7 @@ def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 10
                        progress=progress)
     u_plus = np.concatenate([part[0] for part in parts])
     res = np.concatenate([part[1] for part in parts])
+    errors = [e for part in parts for e in part[2]]
     st = problem.structure
     expansion, pairs = _pair_expansion(as_dense(st.M), u_minus, u_plus)
 
@@ -210,7 +220,8 @@ def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 10
                                                 "non_expansive", float(expansion.max()))
     if violations["law_error"]:
         i = int(np.flatnonzero(failed)[0])
-        found["law_error"] = Counterexample(u_minus[i], u_plus[i], "law_error", float("inf"))
+        found["law_error"] = Counterexample(u_minus[i], u_plus[i], "law_error", float("inf"),
+                                            error=errors[i])
     return LawReport(ok=not any(violations.values()), violations=violations,
                      counterexamples=found, samples=int(samples), pairs=len(pairs),
                      method="sampled")
