@@ -38,6 +38,7 @@ import json
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -169,9 +170,10 @@ class SiconosServer:
     """This file serving Siconos runs in ``python``; one process for a whole comparison."""
 
     def __init__(self, python: str) -> None:
+        self.errors = tempfile.TemporaryFile("w+")  # a pipe left unread could fill and block
         self.proc = subprocess.Popen([python, str(Path(__file__).resolve()), "--siconos-serve"],
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, text=True)
+                                     stderr=self.errors, text=True)
 
     def run(self, system: str, n: int, steps: int) -> tuple[float, dict[str, list[float]]]:
         """Seconds and state of one Siconos run (raises RuntimeError when it fails)."""
@@ -183,14 +185,19 @@ class SiconosServer:
                 if "error" in answer:
                     raise RuntimeError(f"siconos: {answer['error']}")
                 return answer.pop("seconds"), answer
+        self.proc.wait(timeout=60)  # its output ended: it is exiting
+        self.errors.seek(0)
+        message = self.errors.read().strip()[-300:]
         self.close()
-        raise RuntimeError(f"siconos server died: {self.proc.stderr.read().strip()[-300:]}")
+        raise RuntimeError(f"siconos server died: {message}")
 
     def close(self) -> None:
         """End the server (it exits at the end of its input)."""
         if self.proc.poll() is None:
             self.proc.stdin.close()
             self.proc.wait(timeout=60)
+        self.proc.stdout.close()
+        self.errors.close()
 
     def __enter__(self) -> SiconosServer:
         return self

@@ -150,6 +150,12 @@ def test_simulations_without_siconos_are_skipped_not_failed(monkeypatch):
                and NO_SICONOS in r["message"] for r in peer)
     assert mine[0]["size"] == 40 and mine[1]["size"] == 2  # ball: steps; others: balls
     assert dynamics.run_simulations("smoke", NO_SICONOS) == []
+    # a server in a Python without siconos answers each run with the error, never hangs
+    from benchmarks.simulation import SiconosServer
+
+    with SiconosServer(sys.executable) as server, pytest.raises(RuntimeError,
+                                                                match="No module named"):
+        server.run("ball", 1, 10)
 
 
 @pytest.mark.skipif(not _siconos_here(), reason="python3-siconos not installed")
