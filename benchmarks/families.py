@@ -143,6 +143,12 @@ def _discs(size: int, seed: int) -> Case:
     return Case("discs", p.n_contacts, seed, "sparse", p)
 
 
+def _random_chain(size: int, seed: int) -> Case:
+    """Equal balls, u⁻ standard normal: every contact may be active, blocks of any length."""
+    u = np.random.default_rng(seed).standard_normal(size)
+    return Case("chain-random", size, seed, "chain", iq.chain(np.ones(size), u))
+
+
 def _batch(size: int, seed: int) -> Case:
     rng = np.random.default_rng(seed)
     U = rng.standard_normal((size, 3))
@@ -153,9 +159,13 @@ def _batch(size: int, seed: int) -> Case:
 BUILDERS: dict[str, Callable[[int, int], Case]] = {
     "cradle": _cradle, "random": _random, "redundant": _redundant,
     "mass-ratio": _mass_ratio, "discs": _discs, "batch": _batch,
+    "chain-random": _random_chain,
 }
-SIZE_LABEL = {"cradle": "N", "random": "m", "redundant": "m", "mass-ratio": "r",
-              "discs": "m", "batch": "k", "sweep": "cells"}
+#: families of whole runs (benchmarks/dynamics.py): reported, not plotted
+RUN_FAMILIES = {"sim-ball": "steps", "sim-cradle": "N", "sim-column": "N", "event-ball": "T",
+                "lzb": "N", "startup": "cases"}
+SIZE_LABEL = {"cradle": "N", "chain-random": "N", "random": "m", "redundant": "m",
+              "mass-ratio": "r", "discs": "m", "batch": "k", "sweep": "cells", **RUN_FAMILIES}
 #: seeded instances per size (only the random families vary with the seed)
 INSTANCES = {"random": 3, "redundant": 3}
 
@@ -166,7 +176,8 @@ SUITES: dict[str, dict[str, list[int]]] = {
     "full": {"cradle": [3, 10, 100, 1000, 10_000, 100_000, 1_000_000],
              "random": [2, 4, 5, 10, 20, 50], "redundant": [6, 12, 30, 50],
              "mass-ratio": [10, 1000, 1_000_000], "discs": [100, 1000, 10_000],
-             "batch": [10_000, 100_000, 1_000_000, 10_000_000]},
+             "batch": [10_000, 100_000, 1_000_000, 10_000_000],
+             "chain-random": [1_000_000]},
 }
 
 

@@ -46,16 +46,21 @@ def output_size(raw: Any) -> float | None:
     return sum(a.nbytes for a in arrays) / 2**20
 
 
-def record(case: Case, method: str, group: str, *, status: str, message: str = "",
-           times: list[float] | None = None, error: float | None = None,
-           peak_mb: float | None = None, note: str = "",
-           output_mb: float | None = None) -> dict[str, Any]:
-    """One tidy row: a method on one case instance."""
-    return {"family": case.family, "size": case.size, "instance": case.instance,
+def row(family: str, size: float, method: str, group: str, *, status: str,
+        message: str = "", times: list[float] | None = None, error: float | None = None,
+        peak_mb: float | None = None, note: str = "", output_mb: float | None = None,
+        reference: str = "", instance: int = 0) -> dict[str, Any]:
+    """One tidy row of the reports: a method on one instance of ``family`` at ``size``."""
+    return {"family": family, "size": size, "instance": instance,
             "method": method, "group": group, "status": status, "message": message[:300],
             "times": list(times or []), "error": error, "peak_mb": peak_mb,
-            "output_mb": output_mb,
-            "reference": case.ref_label, "note": note}
+            "output_mb": output_mb, "reference": reference, "note": note}
+
+
+def record(case: Case, method: str, group: str, **fields: Any) -> dict[str, Any]:
+    """One tidy row: a method on one case instance (fields as in :func:`row`)."""
+    return row(case.family, case.size, method, group, instance=case.instance,
+               reference=case.ref_label, **fields)
 
 
 @contextlib.contextmanager

@@ -209,6 +209,13 @@ def _iq_cold(case: Case) -> tuple[Solve, Finish]:
     return (lambda: iq.moreau(iq.chain(masses, u), e)), (lambda r: r.u_plus)
 
 
+def _iq_fresh(case: Case) -> tuple[Solve, Finish]:
+    """Build ``ImpactProblem(M, W, u⁻)`` from the arrays, then solve (nothing cached)."""
+    st, e = case.problem.structure, case.eps
+    M, W, u = np.array(st.M), np.array(st.W), case.problem.u_minus.copy()
+    return (lambda: iq.moreau(iq.ImpactProblem(M, W, u), e)), (lambda r: r.u_plus)
+
+
 # --- batches ---------------------------------------------------------------------------------
 def _moreau_batch(case: Case) -> tuple[Solve, Finish]:
     return (lambda: iq.moreau_batch(case.problem, case.U, case.eps)), (lambda r: r.u_plus)
@@ -241,6 +248,8 @@ METHODS: list[Method] = [
     Method("raw:qpsolvers:highs", "raw", _raw_qpsolvers("highs"), max_size=1000),
     Method("iq:cold", "impactqp", _iq_cold, kinds=("chain",), fits=_free_chain,
            note="builds the chain problem (validation, structure), then solves"),
+    Method("iq:fresh", "impactqp", _iq_fresh, kinds=("dense",), fits=_dense_up_to(KERNEL_MAX),
+           note="builds ImpactProblem(M, W, u⁻) from arrays, then solves"),
     Method("raw:isotonic_regression", "raw", _raw_isotonic, kinds=("chain",),
            fits=_free_chain, note="scipy.optimize.isotonic_regression alone, no certificate"),
     Method("iq:moreau_batch", "batch", _moreau_batch, kinds=("batch",)),

@@ -14,7 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .families import SIZE_LABEL  # noqa: E402
+from .families import RUN_FAMILIES, SIZE_LABEL  # noqa: E402
 
 COLUMNS = ["family", "size", "method", "group", "instances", "ran", "ok", "success_rate",
            "median_s", "p90_s", "max_error", "peak_mb", "output_mb", "status", "message",
@@ -97,27 +97,37 @@ def targets(rows: list[dict]) -> list[tuple[str, str, str]]:
             if a and b:
                 beside.append(f"m = {m}: {a['median_s'] / b['median_s']:.1f}× "
                               f"({fmt_time(a['median_s'])} vs {fmt_time(b['median_s'])})")
-        out.append(("3-ball cradle: iq.moreau ≤ 2× Siconos Lemke (incl. construction)",
+        out.append(("3-ball cradle: iq.moreau ≤ 1.5× Siconos Lemke (incl. construction)",
                     f"{ratio:.1f}× ({fmt_time(iq3['median_s'])} vs "
                     f"{fmt_time(lemke['median_s'])})"
                     + (f"; random impacts {'; '.join(beside)}" if beside else ""),
-                    "met" if ratio <= 2 else f"MISSED by {ratio / 2:.1f}×"))
-    floor = _median(rows, "cradle", 1_000_000, "raw:isotonic_regression")
-    for method, limit, what in (("iq:auto", 3, "warm"), ("iq:cold", 10, "cold build + solve")):
-        r = _median(rows, "cradle", 1_000_000, method)
+                    _at_most(ratio, 1.5)))
+    lemke10 = _median(rows, "random", 10, "siconos:lemke")
+    for method, limit, what in (("iq:auto", 3, "repeat solve"),
+                                ("iq:fresh", 20, "built fresh + solved")):
+        r = _median(rows, "random", 10, method)
+        if r and lemke10:
+            ratio = r["median_s"] / lemke10["median_s"]
+            out.append((f"random dense m = 10, {what}: ≤ {limit}× Siconos Lemke",
+                        f"{ratio:.1f}× ({fmt_time(r['median_s'])} vs "
+                        f"{fmt_time(lemke10['median_s'])})", _at_most(ratio, limit)))
+    for family, method, limit, what in (
+            ("cradle", "iq:auto", 3, "warm"), ("chain-random", "iq:auto", 3, "random u⁻, warm"),
+            ("cradle", "iq:cold", 10, "cold build + solve")):
+        r = _median(rows, family, 1_000_000, method)
+        floor = _median(rows, family, 1_000_000, "raw:isotonic_regression")
         if r and floor:
             ratio = r["median_s"] / floor["median_s"]
             out.append((f"chain N=10⁶, {what}: ≤ {limit}× isotonic_regression",
                         f"{ratio:.1f}× ({fmt_time(r['median_s'])} vs "
-                        f"{fmt_time(floor['median_s'])})",
-                        "met" if ratio <= limit else f"MISSED by {ratio / limit:.1f}×"))
+                        f"{fmt_time(floor['median_s'])})", _at_most(ratio, limit)))
     for method in ("iq:moreau_batch", "iq:sector_law_batch"):
         b = _median(rows, "batch", None, method)
         if b:
             rate = b["size"] / b["median_s"]
-            goal = 5e6 if method == "iq:moreau_batch" and b["size"] >= 10**7 else 1e6
-            out.append((f"batch {method}: ≥ {goal:.0e} three-ball impacts/s, one thread "
-                        f"(k = {b['size']:g})", f"{rate:.3g} impacts/s",
+            goal = 1e7 if method == "iq:moreau_batch" and b["size"] >= 10**7 else 1e6
+            out.append((f"batch {method}: ≥ {goal:.0e} three-ball impacts/s, certified, one "
+                        f"thread (k = {b['size']:g})", f"{rate:.3g} impacts/s",
                         "met" if rate >= goal else f"MISSED by {goal / rate:.1f}×"))
             if b.get("peak_mb") is not None and b.get("output_mb") is not None \
                     and b["size"] >= 10**6:  # below, fixed costs dominate a per-impact figure
@@ -148,16 +158,103 @@ def targets(rows: list[dict]) -> list[tuple[str, str, str]]:
                             f"{ratio:.2f}× ({fmt_time(r['median_s'])} vs "
                             f"{fmt_time(raw['median_s'])})",
                             "met" if ratio <= 1.3 else f"MISSED by {ratio / 1.3:.1f}×"))
+    out += _run_targets(rows)
     return out
 
 
-WHY_MISSED = {
-    "3-ball cradle": (
+def _at_most(ratio: float, limit: float) -> str:
+    return "met" if ratio <= limit else f"MISSED by {ratio / limit:.1f}×"
+
+
+#: simulations against Siconos: (family, size, what, largest ratio impactqp / Siconos,
+#: largest trajectory difference for the verdict or None)
+SIM_TARGETS = (("sim-ball", 2000, "Siconos' BouncingBallTS, 2000 steps, same trajectory "
+                "(≤ 1e-12)", 1.0, 1e-12),
+               ("sim-cradle", 5, "5-ball cradle on pendulums, Moreau–Jean, 1000 steps", 1.0,
+                None),
+               ("sim-column", 100, "100-bead column, 1000 steps", 0.3, None))
+#: per impact: (family, size, what, most seconds per impact)
+IMPACT_TARGETS = (("event-ball", 10, "event-driven bouncing ball, T = 10 s", 0.5e-3),
+                  ("lzb", 10, "LZB 10-ball steel chain", 2e-3),
+                  ("lzb", 100, "LZB 100-ball steel chain", 30e-3))
+
+
+def _run_targets(rows: list[dict]) -> list[tuple[str, str, str]]:
+    """Targets of the runs of benchmarks/dynamics.py: simulations beside Siconos, per-impact
+    times, the first calls of a fresh process."""
+    out: list[tuple[str, str, str]] = []
+    for family, size, what, limit, agree in SIM_TARGETS:
+        mine = _median(rows, family, size, "iq:simulate")
+        peer = _median(rows, family, size, "siconos:MoreauJeanOSI")
+        if not (mine and peer):
+            continue
+        ratio = mine["median_s"] / peer["median_s"]
+        diff = mine["max_error"]
+        verdict = _at_most(ratio, limit)
+        if agree is not None and (diff is None or diff > agree):
+            verdict = ("MISSED" if verdict == "met" else verdict) + " (trajectories differ)"
+        shown = "—" if diff is None else f"{diff:.1e}"
+        out.append((f"{what}: ≤ {limit:g}× Siconos MoreauJeanOSI",
+                    f"{ratio:.2f}× ({fmt_time(mine['median_s'])} vs "
+                    f"{fmt_time(peer['median_s'])} per run), max |Δq|, |Δv| = {shown}",
+                    verdict))
+    for family, size, what, limit in IMPACT_TARGETS:
+        r = _median(rows, family, size, "iq:event-driven" if family == "event-ball"
+                    else "iq:lzb")
+        if r:
+            out.append((f"{what}: ≤ {fmt_time(limit)} per impact",
+                        f"{fmt_time(r['median_s'])} per impact ({r['reference']})",
+                        _at_most(r["median_s"] / limit, 1.0)))
+    first = _median(rows, "startup", None, "iq:first calls")
+    if first:
+        out.append(("first calls in a fresh process, numba cache filled: ≤ 1 s extra",
+                    f"{fmt_time(first['median_s'])} extra ({first['reference']})",
+                    _at_most(first["median_s"], 1.0)))
+    return out
+
+
+WHY_3_BALL = (
         "a single impact through iq.moreau validates its input, runs the structure's compiled "
         "float program (kernel supports and all six residuals of the certificate spelled out) "
-        "and builds a result object (~5 µs), where Siconos' Lemke is one call into C that "
-        "returns bare arrays (~3 µs); on a loaded machine the ratio moves around 2. Many "
-        "impacts belong in the batch API (< 0.1 µs per impact)."),
+        "and builds a result object (~6 µs), where Siconos' Lemke is one call into C that "
+        "returns bare arrays (~2.4 µs). Many impacts belong in the batch API (< 0.1 µs per "
+        "impact).")
+#: per target (its text before the first colon): why it is missed, shown when it is
+WHY_MISSED = {
+    "Siconos' BouncingBallTS, 2000 steps, same trajectory (≤ 1e-12)": (
+        "iq.simulate's Moreau–Jean loop is Python: a step costs ~26 µs on average (small "
+        "numpy operations for the predicted gaps, the free velocity, the update and the "
+        "record; the 345 impact steps add the certified step law), where Siconos' step is C++ "
+        "(~3 µs). The compiled Moreau–Jean under way is what this benchmark waits for."),
+    "5-ball cradle on pendulums, Moreau–Jean, 1000 steps": (
+        "the same per-step Python overhead of iq.simulate (~24 µs a step); Siconos' C++ step "
+        "costs ~15 µs for five bodies and four interactions."),
+    "100-bead column, 1000 steps": (
+        "impactqp's Python step loop and the certified solve of each cluster of closed "
+        "contacts per step."),
+    "random dense m = 10, repeat solve": WHY_3_BALL,
+    "random dense m = 10, built fresh + solved": (
+        "ImpactProblem(M, W, u⁻) validates its arrays and builds its structure before the "
+        "solve (most of the time: the same solve on a built problem is ~6× faster); Siconos' "
+        "LCP gets the Delassus matrix ready-made."),
+    "event-driven bouncing ball, T = 10 s": (
+        "each impact (1 DOF, 1 contact, Newton) goes through the general certified program "
+        "path — a QP solve through qpsolvers, then the active-set polish assembling "
+        "scipy.sparse blocks — ~2.4 ms, not the compiled small-impact path; the flight "
+        "between impacts (scipy solve_ivp, DOP853, event location) adds ~0.8 ms."),
+    "LZB 10-ball steel chain": (
+        "the LZB impulse integration is scipy's solve_ivp with Python rate functions: ~4500 "
+        "evaluations of ~20 µs for 10 balls. The compiled LZB under way is the remedy."),
+    "LZB 100-ball steel chain": (
+        "as for 10 balls, with ~10× more balls and rate evaluations: scipy's solve_ivp on "
+        "Python rate functions. The compiled LZB under way is the remedy."),
+    "first calls in a fresh process, numba cache filled": (
+        "the first calls load numba's cached kernels and fill impactqp's caches (see the "
+        "per-case first-call times in the measured column)."),
+    "chain N=10⁶, random u⁻, warm": (
+        "as for the warm cradle below: impulses and the certificate's passes over five "
+        "arrays of 8 MB, on top of isotonic_regression's one pass."),
+    "3-ball cradle": WHY_3_BALL,
     "chain N=10⁶, warm": (
         "isotonic_regression is one pass in C; impactqp adds the impulses (one pairwise "
         "prefix sum and the anchors, ~2–3 ms: np.cumsum alone takes ~3 ms here) and a "
@@ -267,7 +364,8 @@ def plot(rows: list[dict], path: Path) -> None:
     every method has its own colour and marker, ticks only at the measured sizes."""
     from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 
-    fams = [f for f in SIZE_LABEL if any(r["family"] == f for r in rows)]
+    fams = [f for f in SIZE_LABEL if f not in RUN_FAMILIES and any(r["family"] == f
+                                                                   for r in rows)]
     if not fams:
         fig = plt.figure(figsize=(6, 1.5))
         fig.text(0.5, 0.5, "no measurements", ha="center", va="center")

@@ -11,6 +11,7 @@ from typing import Any
 from tqdm import tqdm
 
 from . import families, peers, report
+from .dynamics import run_per_impact, run_simulations, run_startup
 from .families import Case
 from .measure import measure, quiet_stdout
 from .methods import METHODS, Method
@@ -78,6 +79,10 @@ def run_suite(suite: str, out_dir: Path | str, *, methods: Sequence[Method] | No
     bar.update()
     bar.set_postfix_str(f"sweeps on 1 and {n_jobs} processes", refresh=False)
     records += run_sweeps(suite, n_jobs)
+    bar.set_postfix_str("simulations, per-impact timings, start-up", refresh=False)
+    records += run_simulations(suite, siconos_python)
+    records += run_per_impact(suite)
+    records += run_startup(suite)
     bar.close()
     meta = {"suite": suite, "seconds": round(time.perf_counter() - started, 1),
             "timing_budget_s": budget, "max_repeats": max_repeats,

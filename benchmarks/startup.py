@@ -46,12 +46,19 @@ print(json.dumps(out))
 """
 
 
-def probe(cache: str) -> dict[str, float]:
-    """Seconds of one fresh process (import, first and second call of each case)."""
-    env = {**os.environ, "NUMBA_CACHE_DIR": cache}
-    done = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True,
+def probe(cache: str | None = None, python: str = sys.executable) -> dict[str, float]:
+    """Seconds of one fresh process (import, first and second call of each case); numba's
+    cache in the folder ``cache``, or where the environment puts it when None."""
+    env = dict(os.environ) if cache is None else {**os.environ, "NUMBA_CACHE_DIR": cache}
+    done = subprocess.run([python, "-c", PROBE], env=env, capture_output=True,
                           text=True, check=True, timeout=600)
     return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def first_call_extra(runs: dict[str, float]) -> float:
+    """Seconds the first calls of a probe cost beyond the same calls warm."""
+    return sum(runs[name] - runs[name + " (warm call)"] for name in runs
+               if name + " (warm call)" in runs)
 
 
 def main(argv: list[str] | None = None) -> int:

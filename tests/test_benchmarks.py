@@ -120,3 +120,139 @@ def test_sweep_worker_count_is_an_option(capsys):
     (line,) = [t for t in targets(rows) if t[0].startswith("sweep")]
     assert "3 local processes" in line[0] and line[2] == "identical"
     assert run_sweeps("smoke") == []
+
+
+# --- runs: simulations beside Siconos, per-impact timings, start-up ----------------------------
+TINY_SIMULATIONS = {"quick": ([("ball", 1, 40), ("cradle", 2, 30), ("column", 2, 30)], 1)}
+NO_SICONOS = "/nonexistent/python3"
+
+
+def _siconos_here() -> bool:
+    from benchmarks.simulation import SICONOS_PYTHON, siconos_available
+
+    return siconos_available(SICONOS_PYTHON)[0] is not None
+
+
+def test_simulations_without_siconos_are_skipped_not_failed(monkeypatch):
+    from benchmarks import dynamics
+
+    monkeypatch.setattr(dynamics, "SIMULATIONS", TINY_SIMULATIONS)
+    rows = dynamics.run_simulations("quick", NO_SICONOS)
+    if _siconos_here() and any(r["group"] == "peer" and r["status"] == "ok" for r in rows):
+        pytest.skip("siconos imports in this Python itself")
+    assert [r["family"] for r in rows] == ["sim-ball", "sim-ball", "sim-cradle", "sim-cradle",
+                                           "sim-column", "sim-column"]
+    mine = [r for r in rows if r["method"] == "iq:simulate"]
+    peer = [r for r in rows if r["method"] == "siconos:MoreauJeanOSI"]
+    assert all(r["status"] == "ok" and len(r["times"]) == 1 and r["error"] is None
+               for r in mine)
+    assert all(r["status"] == "skipped" and "siconos not importable" in r["message"]
+               and NO_SICONOS in r["message"] for r in peer)
+    assert mine[0]["size"] == 40 and mine[1]["size"] == 2  # ball: steps; others: balls
+    assert dynamics.run_simulations("smoke", NO_SICONOS) == []
+    # a server in a Python without siconos answers each run with the error, never hangs
+    from benchmarks.simulation import SiconosServer
+
+    with SiconosServer(sys.executable) as server, pytest.raises(RuntimeError,
+                                                                match="No module named"):
+        server.run("ball", 1, 10)
+
+
+@pytest.mark.skipif(not _siconos_here(), reason="python3-siconos not installed")
+def test_simulations_reproduce_siconos_interleaved(monkeypatch, tmp_path):
+    from benchmarks import dynamics, report, simulation
+
+    monkeypatch.setattr(dynamics, "SIMULATIONS", TINY_SIMULATIONS)
+    rows = dynamics.run_simulations("quick")
+    assert len(rows) == 6 and all(r["status"] == "ok" and r["times"] for r in rows), rows
+    # the same steps in both codes: trajectories equal to round-off (impacts included: the
+    # ball lands after ~90 steps only, so check the bead column's, which start at once)
+    assert all(r["error"] <= 1e-12 for r in rows)
+    with simulation.SiconosServer(simulation.SICONOS_PYTHON) as server:
+        _, theirs = server.run("ball", 1, 120)  # past the first impact (step 91)
+        with pytest.raises(RuntimeError, match="siconos"):
+            server.run("column", 0, 10)  # no bead: Siconos fails, the server goes on
+    _, mine = simulation.impactqp_run("ball", 1, 120)
+    assert len(theirs["q"]) == 121 and simulation.agreement(mine, theirs) <= 1e-12
+    assert theirs["v"][92] > 0 > theirs["v"][90]  # it bounced
+    theirs["q"][-1] += 1e-6
+    assert simulation.agreement(mine, theirs) == pytest.approx(1e-6, rel=1e-6)
+    records = report.write_all(rows, tmp_path, {"suite": "t", "seconds": 0,
+                                                "timing_budget_s": 0, "max_repeats": 1,
+                                                "accurate_below": 1e-6})
+    assert (tmp_path / "plot.png").stat().st_size > 0  # run families are not plotted
+    assert "## sim-column" in (tmp_path / "summary.md").read_text() and records
+
+
+def test_per_impact_rows(monkeypatch):
+    from benchmarks import dynamics
+
+    monkeypatch.setattr(dynamics, "PER_IMPACT", {"quick": (1.0, [3], (2, 0.0))})
+    ball, lzb = dynamics.run_per_impact("quick")
+    seconds, impacts = dynamics.event_ball_run(1.0)
+    assert impacts == 1  # first landing at √(2/g) ≈ 0.45 s, the next at ≈ 1.3 s
+    assert ball["family"] == "event-ball" and ball["size"] == 1.0 and ball["status"] == "ok"
+    assert len(ball["times"]) == 1 and "1 certified impacts" in ball["reference"]
+    assert lzb["family"] == "lzb" and lzb["size"] == 3 and lzb["status"] == "ok"
+    assert len(lzb["times"]) == 1 and lzb["times"][0] > 0
+    assert dynamics.run_per_impact("smoke") == []
+    assert dynamics.run_startup("quick") == []
+
+
+def test_fresh_problem_method_builds_and_is_exact(smoke):
+    _, records = smoke
+    fresh = [r for r in records if r["method"] == "iq:fresh"]
+    ran = [r for r in fresh if r["status"] != "skipped"]
+    assert ran and all(r["family"] == "random" for r in ran)
+    assert all(r["status"] == "ok" and r["error"] <= 1e-9 for r in ran)
+    assert all(r["status"] == "skipped" for r in fresh if r["family"] != "random")
+
+
+def _agg(family, size, method, median, error=None, reference=""):
+    return {"family": family, "size": size, "method": method, "group": "impactqp",
+            "median_s": median, "max_error": error, "reference": reference,
+            "status": "ok", "success_rate": 1, "ok": 1, "ran": 1, "note": "", "message": ""}
+
+
+def test_targets_of_the_runs():
+    from benchmarks.report import WHY_MISSED, summary_markdown, targets
+    from benchmarks.startup import first_call_extra
+
+    rows = [
+        _agg("sim-ball", 2000, "iq:simulate", 2e-3, 1e-14),
+        _agg("sim-ball", 2000, "siconos:MoreauJeanOSI", 1e-3, 1e-14),
+        _agg("sim-cradle", 5, "iq:simulate", 1e-3, 1e-9),
+        _agg("sim-cradle", 5, "siconos:MoreauJeanOSI", 2e-3, 1e-9),
+        _agg("sim-column", 100, "iq:simulate", 0.5, 1e-14),
+        _agg("sim-column", 100, "siconos:MoreauJeanOSI", 1.0, 1e-14),
+        _agg("event-ball", 10, "iq:event-driven", 1e-4, reference="168 impacts"),
+        _agg("lzb", 10, "iq:lzb", 1e-3), _agg("lzb", 100, "iq:lzb", 0.1),
+        _agg("random", 10, "iq:auto", 2e-5), _agg("random", 10, "iq:fresh", 1e-4),
+        _agg("random", 10, "siconos:lemke", 1e-5),
+        _agg("startup", 4, "iq:first calls", 0.4, reference="import 300 ms"),
+    ]
+    found = {t.split(":")[0]: (m, v) for t, m, v in targets(rows)}
+    assert found["Siconos' BouncingBallTS, 2000 steps, same trajectory (≤ 1e-12)"][1] \
+        == "MISSED by 2.0×"
+    assert found["5-ball cradle on pendulums, Moreau–Jean, 1000 steps"][1] == "met"
+    assert found["100-bead column, 1000 steps"][1] == "MISSED by 1.7×"
+    assert found["event-driven bouncing ball, T = 10 s"] == (
+        "100 µs per impact (168 impacts)", "met")
+    assert found["LZB 10-ball steel chain"][1] == "met"
+    assert found["LZB 100-ball steel chain"][1] == "MISSED by 3.3×"
+    assert found["random dense m = 10, repeat solve"][1] == "met"
+    assert found["random dense m = 10, built fresh + solved"][1] == "met"
+    assert found["first calls in a fresh process, numba cache filled"][1] == "met"
+    rows[1]["median_s"] = 1.0  # faster than Siconos, but no longer the same trajectory
+    rows[0]["max_error"] = 1e-9
+    found = {t.split(":")[0]: v for t, _, v in targets(rows)}
+    assert found["Siconos' BouncingBallTS, 2000 steps, same trajectory (≤ 1e-12)"] \
+        == "MISSED (trajectories differ)"
+    # every target that can be missed says why in the summary
+    for key in ("100-bead column, 1000 steps", "LZB 100-ball steel chain"):
+        assert key in WHY_MISSED
+    text = summary_markdown(rows, {"suite": "t", "seconds": 0, "timing_budget_s": 0,
+                                   "max_repeats": 1, "accurate_below": 1e-6})
+    assert "*LZB 100-ball steel chain*" in text and "*100-bead column, 1000 steps*" in text
+    assert first_call_extra({"import": 1.0, "a": 0.5, "a (warm call)": 0.1, "b": 0.2,
+                             "b (warm call)": 0.2}) == pytest.approx(0.4)
