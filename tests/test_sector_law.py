@@ -188,3 +188,40 @@ def test_sector_law_command(capsys: pytest.CaptureFixture[str]) -> None:
     assert "maximal monotone: True" in out and "FAIL" not in out
     assert cli.main(["sector-law", "--balls", "9"]) == 2
     assert "sector_gamma_map" in capsys.readouterr().err
+
+
+def test_a_chain_is_recognized_from_its_matrices_however_it_was_built():
+    from impactqp.model.builders import chain_directions, recognize_chain
+
+    rng = np.random.default_rng(5)
+    for left, right in ((False, False), (True, False), (False, True)):
+        built = iq.chain(np.ones(4), rng.standard_normal(4), left_wall=left, right_wall=right)
+        plain = iq.ImpactProblem(np.eye(4), chain_directions(4, left_wall=left,
+                                                             right_wall=right),
+                                 built.u_minus)
+        info = recognize_chain(plain)
+        assert info is not None and (info.left_wall, info.right_wall) == (left, right)
+        if not (left or right):
+            a, b = iq.sector_law(built), iq.sector_law(plain)
+            np.testing.assert_array_equal(a.u_plus, b.u_plus)
+            np.testing.assert_allclose(a.impulses, b.impulses, atol=1e-15)
+    W = chain_directions(4)
+    assert recognize_chain(iq.ImpactProblem(np.eye(4), W[:, ::-1], np.ones(4))) is None
+    assert recognize_chain(iq.ImpactProblem(np.eye(4), 2 * W, np.ones(4))) is None
+    M = np.eye(4)
+    M[0, 1] = M[1, 0] = 0.1
+    assert recognize_chain(iq.ImpactProblem(M, W, np.ones(4))) is None
+    with pytest.raises(iq.SectorLawError, match="1-D chains"):
+        iq.sector_law(iq.ImpactProblem(np.eye(4), W[:, ::-1], np.ones(4)))
+
+
+@pytest.mark.parametrize("law", [iq.SectorLaw(), iq.ReflectionLaw()])
+@pytest.mark.parametrize("scheme", ["event-driven", "moreau-jean"])
+def test_chain_laws_simulate_a_system_whose_gaps_are_a_chain(law, scheme):
+    from impactqp.model.builders import chain_directions
+
+    system = iq.LinearSystem(np.eye(3), [0.0, 0.3, 0.6], [1.0, 0.0, 0.0], None,
+                             chain_directions(3), [-0.3, -0.3])
+    tr = iq.simulate(system, law, 1.0, scheme=scheme, h=1e-3)
+    assert len(tr.events) == 1 and all(e.certified for e in tr.events)
+    np.testing.assert_allclose(tr.v[-1], [0.0, 0.0, 1.0], atol=1e-12)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from ..laws.functions import moreau
 from ..model.builders import newtons_cradle
 from ..model.classify import classify
@@ -22,6 +23,9 @@ def cradle_rows(n_balls: int = 3, v: float = 1.0, backend: str = "auto") -> list
     real cradle (the last ball leaves at v), each with its classification and verdict.
     """
     p = newtons_cradle(n_balls=n_balls, v=v)
+    if not v > 0:
+        raise InputError(f"v must be positive: ball 1 moves at v towards the resting balls "
+                         f"(v = {v:g} makes no impact to solve and classify)")
     S = p.admissible_set()
     rows = []
     for eps in (0.0, 1.0):

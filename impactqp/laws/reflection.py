@@ -13,6 +13,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..model.builders import require_chain
 from ..model.problem import ImpactProblem
 from ..model.structure import ImpactStructure
 from ..tables.reflection_group import (
@@ -35,7 +36,7 @@ def _table(masses: tuple[float, ...], left_wall: bool, right_wall: bool):
 def _reference_gamma(problem: ImpactProblem, group: ReflectionGroup) -> np.ndarray:
     """γ⁺ by an independent route: the table map when the group is small, else the
     opposite collision order."""
-    info = problem.chain
+    info = require_chain(problem, "reflection law")
     if group.order <= MAX_TABLE_ORDER:
         table = _table(tuple(info.masses.tolist()), info.left_wall, info.right_wall)
         return table.apply(problem.gamma_minus)

@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..base.arrays import as_array, as_count, as_flag, as_real
 from ..errors import InputError, SectorLawError
@@ -14,7 +15,8 @@ from .chain_structure import ChainStructure, chain_directions
 from .problem import ImpactProblem
 from .structure import ChainInfo
 
-__all__ = ["chain", "chain_directions", "newtons_cradle", "random_impact", "require_chain"]
+__all__ = ["chain", "chain_directions", "newtons_cradle", "random_impact", "recognize_chain",
+           "require_chain"]
 
 
 def chain(masses: Any, u_minus: Any, *, left_wall: bool = False, right_wall: bool = False,
@@ -153,11 +155,37 @@ def random_impact(n_dof: int, n_contacts: int, *, seed: int | np.random.Generato
     return ImpactProblem(M, W, u)
 
 
+def recognize_chain(problem: ImpactProblem) -> ChainInfo | None:
+    """The ChainInfo of a problem that is a 1-D chain by its M and W however it was built
+    (docs/theory.md §5): M diagonal and W exactly the chain's columns for some walls; None
+    otherwise."""
+    if problem.chain is not None:
+        return problem.chain
+    st = problem.structure
+    n, m = st.n, st.m
+    M = sp.csr_matrix(st.M)
+    masses = M.diagonal()
+    if (M - sp.diags(masses)).count_nonzero() or not np.all(masses > 0):
+        return None
+    W = sp.csc_matrix(st.W)
+    for left in (False, True):
+        right = m - (n - 1) - left
+        if right in (0, 1) and n >= 1 and \
+                not (W - chain_directions(n, left_wall=left, right_wall=bool(right),
+                                          sparse=True)).count_nonzero():
+            return ChainInfo(masses=np.array(masses, dtype=float), left_wall=left,
+                             right_wall=bool(right))
+    return None
+
+
 def require_chain(problem: ImpactProblem, law: str) -> ChainInfo:
-    """The ChainInfo of ``problem``, or an error saying that ``law`` needs a 1-D chain."""
+    """The ChainInfo of ``problem`` (built as a chain, or recognized as one from its M and
+    W), or an error saying that ``law`` needs a 1-D chain."""
     if not isinstance(problem, ImpactProblem):
         raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
-    if problem.chain is None:
-        raise SectorLawError(f"the {law} is defined for 1-D chains of balls; build the "
-                             "problem with impactqp.chain or impactqp.newtons_cradle")
-    return problem.chain
+    info = recognize_chain(problem)
+    if info is None:
+        raise SectorLawError(f"the {law} is defined for 1-D chains of balls: M diagonal and W "
+                             "the chain's contact directions [left wall e₁, neighbour gaps "
+                             "e_{i+1} − e_i, right wall −e_N] (impactqp.chain builds one)")
+    return info

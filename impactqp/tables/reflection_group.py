@@ -131,7 +131,7 @@ def _vec(u: np.ndarray) -> str:
 def _no_law_message(problem: ImpactProblem, angles: np.ndarray, bad: list[int]) -> str:
     """Why no continuous law exists: the first bad angle, the nearest π/k, the mass that
     would reach it, and two collision orders that disagree."""
-    info = problem.chain
+    info = require_chain(problem, "reflection law")
     ext = extended_masses(info.masses, info.left_wall, info.right_wall)
     i = bad[0]
     deg = math.degrees(angles[i])

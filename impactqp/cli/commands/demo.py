@@ -8,8 +8,9 @@ import argparse
 def run(args: argparse.Namespace) -> int:
     from ..demo import cradle_rows, format_rows
 
+    rows = cradle_rows(n_balls=args.balls, v=args.v, backend=args.backend)
     print(f"Newton's cradle, {args.balls} balls, ball 1 released at v = {args.v:g} (unit masses)")
-    print(format_rows(cradle_rows(n_balls=args.balls, v=args.v, backend=args.backend)))
+    print(format_rows(rows))
     return 0
 
 
