@@ -155,3 +155,30 @@ def test_certificate_bounds_velocity_error_on_large_mass_ratios():
     r = iq.moreau(p, 1.0, backend="qpsolvers:piqp")
     err = p.norm(r.u_plus - exact.u_plus) / p.norm(u)
     assert err <= r.certificate.velocity_error_bound
+
+
+def test_plain_qpsolvers_takes_the_best_installed_solver():
+    import qpsolvers
+
+    from impactqp.qp.backends.qpsolvers_ import PREFERRED_DENSE
+
+    p = iq.newtons_cradle(3)
+    r = iq.solve(p, iq.Moreau(1.0), backend="qpsolvers")
+    best = next(s for s in PREFERRED_DENSE if s in qpsolvers.available_solvers)
+    assert r.backend.startswith(f"qpsolvers:{best}") and r.certificate.ok
+    np.testing.assert_allclose(r.u_plus, [-1 / 3, 2 / 3, 2 / 3], atol=1e-12)
+    listed = {b["name"] for b in iq.available_backends() if b["installed"]}
+    for name in listed:  # every listed backend is accepted by its bare name
+        try:
+            iq.solve(p, iq.Moreau(1.0), backend=name)
+        except iq.BackendUnsuitableError:
+            pass  # it serves other programs (the message says which)
+
+
+@pytest.mark.parametrize("backend, n, words", [("cvxpy", 20_000, "dense n × n"),
+                                               ("osqp", 60_000, "converges too slowly")])
+def test_large_programs_are_refused_by_size_before_anything_is_allocated(backend, n, words):
+    p = iq.chain(np.ones(n), np.r_[1.0, np.zeros(n - 1)])
+    with pytest.raises(iq.BackendUnsuitableError, match=words):
+        iq.moreau(p, 0.0, backend=backend)
+    assert iq.moreau(p, 0.0).certificate.ok  # auto answers it

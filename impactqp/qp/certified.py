@@ -91,7 +91,8 @@ def _auto_order(qp: QuadraticProgram, form: str) -> list[str]:
     small = qp.n_constraints <= 10
     if small:
         names.append("exact")
-    names += ["clarabel", "osqp"]
+    names += [name for name in ("clarabel", "osqp")
+              if backends.unsuitable(backends.REGISTRY[name], qp, form) is None]
     if not small and qp.n_constraints <= MAX_CONSTRAINTS:
         names.append("exact")
     return names

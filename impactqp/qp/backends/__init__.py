@@ -44,7 +44,7 @@ class Backend:
         Answers are exact active-set solutions (never polished).
     serves : str
         One line on what it takes (sizes, structure).
-    sub_solver : {"none", "optional", "required"}
+    sub_solver : {"none", "optional"}
         Whether ``"name:SOLVER"`` is accepted.
     scale_free : bool
         Its answer does not depend on the units of the program (relative tolerances only),
@@ -84,8 +84,9 @@ REGISTRY: dict[str, Backend] = {b.name: b for b in (
             sub_solver="optional"),
     Backend("qpsolvers", "qpsolvers_", "qpsolvers", "qpsolvers (pip install 'impactqp[solvers]' "
             "adds daqp, piqp, ecos, quadprog)", FORMS, False,
-            "any solver installed for qpsolvers ('qpsolvers:NAME', e.g. daqp, piqp, highs)",
-            sub_solver="required"),
+            "any solver installed for qpsolvers ('qpsolvers:NAME', e.g. daqp, piqp, highs; "
+            "'qpsolvers' alone: the best installed one for the program)",
+            sub_solver="optional"),
 )}
 
 QP_BACKENDS = tuple(REGISTRY)
@@ -132,9 +133,6 @@ def parse_backend(name: object) -> tuple[Backend, str | None]:
     sub = sub.strip() or None
     if sub and entry.sub_solver == "none":
         raise UnknownBackendError(f"backend {family!r} takes no sub-solver, got {name!r}")
-    if not sub and entry.sub_solver == "required":
-        raise UnknownBackendError(f"backend {family!r} needs a solver name, e.g. "
-                                  f"'{family}:daqp'")
     return entry, sub
 
 

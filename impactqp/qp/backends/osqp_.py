@@ -13,6 +13,18 @@ import scipy.sparse as sp
 from ...errors import SolverError
 from ..program import QPSolution, QuadraticProgram
 
+MAX_VARIABLES = 50_000
+"""Most variables OSQP is given: its first-order iterations reach impactqp's tolerance on a
+chain of 3·10⁴ balls in 0.8 s but take ~40 s at 10⁵ (measured)."""
+
+
+def unsuitable(qp: QuadraticProgram) -> str | None:
+    if qp.n_vars > MAX_VARIABLES:
+        return (f"'osqp' converges too slowly to impactqp's tolerance on {qp.n_vars} variables "
+                f"(at most {MAX_VARIABLES}: ~40 s measured at 10⁵); use 'clarabel', "
+                "'qpsolvers:piqp' or 'auto'")
+    return None
+
 
 def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
     P = sp.triu(sp.csc_matrix(qp.P), format="csc")
