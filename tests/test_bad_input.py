@@ -99,7 +99,7 @@ def test_tolerance(tol: object) -> None:
         refuses(lambda: CRADLE.admissible_set().contains([0, 0, 1.0], tol=tol), "tol")
 
 
-@pytest.mark.parametrize("backend", ["nope", None, 3, ["auto"], "qpsolvers", "exact:x"])
+@pytest.mark.parametrize("backend", ["nope", None, 3, ["auto"], "qpsolvers:nope", "exact:x"])
 def test_backend(backend: object) -> None:
     refuses(lambda: iq.moreau(CRADLE, 0.5, backend), "backend")
     refuses(lambda: iq.solve_lcp(np.eye(2), [-1.0, 0.0], backend), "backend")

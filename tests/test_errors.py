@@ -64,7 +64,7 @@ def test_fremond_matrix_shape_and_newton_length():
 
 def test_backend_names():
     p = iq.newtons_cradle()
-    for name in ["gurobi", "cvxpy:NOPE", "qpsolvers:nope", "qpsolvers", "exact:x", 3]:
+    for name in ["gurobi", "cvxpy:NOPE", "qpsolvers:nope", "exact:x", 3]:
         with pytest.raises(iq.UnknownBackendError):
             iq.moreau(p, 0.5, backend=name)
     with pytest.raises(iq.InputError, match="form"):

@@ -7,6 +7,7 @@ import os
 import sys
 from importlib.metadata import PackageNotFoundError, version
 
+from ..base.log import verbosity
 from ..errors import ImpactError
 from .commands import demo, plot, sector, simulate, solve, verify
 
@@ -14,13 +15,16 @@ COMMANDS = [demo, solve, verify, plot, sector, simulate]
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="impactqp",
+    parser = argparse.ArgumentParser(prog="impactqp", allow_abbrev=False,
                                      description="Rigid-body impacts as convex programs.")
     try:
         installed = version("impactqp")
     except PackageNotFoundError:
         installed = "0+unknown"
     parser.add_argument("--version", action="version", version=f"impactqp {installed}")
+    parser.add_argument("-v", "--verbose", action="count", default=0,
+                        help="log refusals and fallbacks on stderr (-vv: every backend "
+                             "attempt and certificate)")
     sub = parser.add_subparsers(dest="command", required=True)
     for command in COMMANDS:
         command.register(sub)
@@ -71,7 +75,8 @@ def main(argv: list[str] | None = None) -> int:
     argv = join_negative_values(list(sys.argv[1:] if argv is None else argv))
     args = build_parser().parse_args(argv)
     try:
-        return int(args.func(args))
+        with verbosity(min(args.verbose, 2)):
+            return int(args.func(args))
     except ImpactError as exc:
         return _fail(str(exc))
     except OSError as exc:  # unwritable --out, vanished files

@@ -8,12 +8,14 @@ enough to return.
 
 from __future__ import annotations
 
+import logging
 import time
 from functools import partial
 
 import numpy as np
 
 from ..base.checks import DEFAULT_TOL
+from ..base.log import verbosity
 from ..errors import (
     BackendUnsuitableError,
     CertificateError,
@@ -26,6 +28,8 @@ from . import small
 from .base import Answer, ImpactLaw
 from .planner import route, validate
 from .result import ImpactResult
+
+LOG = logging.getLogger(__name__)
 
 
 def _result(problem: ImpactProblem, law: ImpactLaw, answer: Answer, backend: str, cert,
@@ -46,7 +50,8 @@ def _trivial(problem: ImpactProblem) -> Answer:
 
 
 def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
-          form: str = "auto", tol: float = DEFAULT_TOL) -> ImpactResult:
+          form: str = "auto", tol: float = DEFAULT_TOL,
+          verbose: bool | int = False) -> ImpactResult:
     """Solve one impact with any impact law and return a certified result.
 
     Parameters
@@ -63,6 +68,10 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         Which program to solve, for laws that have several (they give the same u⁺).
     tol : float
         Tolerance of the recomputed certificate, in (0, 1).
+    verbose : bool or {0, 1, 2}
+        Print impactqp's log of this solve on stderr: True or 1 refusals and fallbacks, 2
+        also every backend attempt and certificate (the ``"impactqp"`` logger, see
+        :mod:`impactqp.base.log`).
 
     Returns
     -------
@@ -84,6 +93,9 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
     CertificateError
         No backend produced an answer that passes the certificate.
     """
+    if verbose:
+        with verbosity(verbose):
+            return solve(problem, law, backend, form=form, tol=tol)
     start = time.perf_counter()
     tol = validate(problem, law, backend, form, tol)
     way = route(problem, law, backend, form)
@@ -91,6 +103,8 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         result = small.solve_small(problem, law, tol, start)
         if result is not None:
             return result
+        LOG.info("%s: the compiled path declined (certificate not met), trying the general "
+                 "path", law.title)
     if problem.n_contacts == 0 or not problem.u_minus.any():
         answer = _trivial(problem)
         cert = law.certificate(problem, answer, tol)
@@ -131,5 +145,7 @@ def _closed_form(problem: ImpactProblem, law: ImpactLaw, backend: str, tol: floa
     cert = law.certificate(problem, answer, tol)
     if not cert.ok:
         raise CertificateError(f"{law.title}: certificate failed, {cert.summary()}")
+    if LOG.isEnabledFor(logging.DEBUG):
+        LOG.debug("%s in closed form: certificate %s", law.title, cert.summary())
     return _result(problem, law, answer, law.closed_form_backend, cert, start,
                    attempts=[f"{law.closed_form_backend}: certified"])

@@ -11,6 +11,7 @@ layer knows nothing of impacts: the certificate is whatever ``finish`` returns.
 
 from __future__ import annotations
 
+import logging
 import math
 import weakref
 from collections.abc import Callable, Sequence
@@ -35,6 +36,20 @@ from .program import QPSolution, QuadraticProgram
 from .scaling import Scaling, normalize
 
 Finish = Callable[[QPSolution], tuple[Any, ResidualChecks]]
+
+LOG = logging.getLogger(__name__)
+
+
+def _verdict(cert: ResidualChecks) -> None:
+    """The certificate's residuals at DEBUG (formatted only when someone listens)."""
+    if LOG.isEnabledFor(logging.DEBUG):
+        LOG.debug("certificate %s", cert.summary())
+
+
+def _note(log: list[str], message: str, level: int = logging.DEBUG) -> None:
+    """Record one attempt in the result's ``attempts`` and in the ``impactqp`` log."""
+    log.append(message)
+    LOG.log(level, message)
 
 FAST_PATHS = ("kernel", "isotonic")
 """Exact special-structure backends that ``"auto"`` tries before any general one."""
@@ -142,12 +157,13 @@ def solve_in_forms(stages: Sequence[Stage], backend: str) -> Outcome:
             candidates = plan(form, build(), finish, backend)
         except BackendUnsuitableError as exc:
             unsuitable.append(str(exc))
+            LOG.info("%s form refused by %s: %s", form, backend, exc)
             continue
         try:
             out = solve_certified(candidates, named=backend != "auto")
         except CertificateError as exc:
             failures.append(str(exc))
-            log.append(f"{form} form: {exc}")
+            _note(log, f"{form} form: {exc}", logging.INFO)
             continue
         return Outcome(out.answer, out.checks, out.backend, out.form, log + out.attempts)
     if failures:
@@ -187,7 +203,7 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
         except UnknownBackendError:
             if named:
                 raise
-            log.append(f"{cand.backend}: not installed")
+            _note(log, f"{cand.backend}: not installed", logging.INFO)
             continue
         unit, scaling = (cand.program, Scaling(1.0, 1.0)) if entry.scale_free \
             else normalize(cand.program)
@@ -197,11 +213,11 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
             except (BackendUnsuitableError, UnknownBackendError) as exc:
                 if named:
                     raise
-                log.append(f"{cand.backend}: unsuitable ({exc})")
+                _note(log, f"{cand.backend}: unsuitable ({exc})", logging.INFO)
                 break
             except (SolverError, NoSolutionError, FloatingPointError, ValueError,
                     np.linalg.LinAlgError) as exc:
-                log.append(f"{cand.backend} ({cand.form}): {exc}")
+                _note(log, f"{cand.backend} ({cand.form}): {exc}")
                 if entry.exact:
                     break
                 continue
@@ -216,14 +232,16 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
                 if polished is not None:
                     answer_p, cert_p = cand.finish(scaling.solution(polished))
                     if _better(cert_p, cert):
-                        log.append(f"{sol.backend}+polish ({cand.form}): certified")
+                        _note(log, f"{sol.backend}+polish ({cand.form}): certified")
+                        _verdict(cert_p)
                         return Outcome(answer_p, cert_p, f"{sol.backend}+polish", cand.form,
                                        log)
             if cert.ok:
-                log.append(f"{sol.backend} ({cand.form}): certified")
+                _note(log, f"{sol.backend} ({cand.form}): certified")
+                _verdict(cert)
                 return Outcome(answer, cert, sol.backend, cand.form, log)
             name, value = cert.worst
-            log.append(f"{cand.backend} ({cand.form}, tol {attempt_tol:.0e}): certificate "
+            _note(log, f"{cand.backend} ({cand.form}, tol {attempt_tol:.0e}): certificate "
                        f"failed, {name} = {value:.1e}")
     impulse = [c.program for c in candidates if c.program.nonnegative]
     if impulse and not lcp_feasible(normalize(impulse[0])[0]):

@@ -16,6 +16,7 @@ result is kept only when the caller's certificate accepts it.
 
 from __future__ import annotations
 
+import logging
 import warnings
 from collections.abc import Callable
 
@@ -26,6 +27,8 @@ import scipy.sparse.linalg as spla
 
 from ..kernels.nnls import solve_nnls
 from .program import QPSolution, QuadraticProgram
+
+LOG = logging.getLogger(__name__)
 
 REFINEMENT_STEPS = 8
 
@@ -175,6 +178,8 @@ def polish(qp: QuadraticProgram, sol: QPSolution) -> QPSolution | None:
         add = inactive[s[inactive] < -tiny]
         if drop.size == 0 and add.size == 0:
             break
+        LOG.debug("polish: active set of %d rows changes (%d leave, %d join)", active.size,
+                  drop.size, add.size)
         active = np.union1d(np.setdiff1d(active, drop), add)
     if best is None:
         return None

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..base.arrays import as_count, as_dense, as_flag, as_vector, check_tol
+from ..base.log import verbosity
 from ..errors import InputError, NonFiniteError
 from ..laws.base import ImpactLaw
 from ..laws.functions import moreau
@@ -126,7 +127,7 @@ def _pair_expansion(M: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
 def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 1000,
                seed: int = 0, consistent_only: bool = True, *,
                tol: float = DEFAULT_TOL, n_jobs: int = 1, client: Any = None,
-               progress: bool | None = None) -> LawReport:
+               progress: bool | None = None, verbose: bool | int = False) -> LawReport:
     """Check an impact law against S (docs/theory.md §2) and for non-expansiveness
     (docs/theory.md §6).
 
@@ -160,6 +161,8 @@ def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 10
         Run on this Dask cluster instead (the ``dask`` extra), at least 10⁴ impacts a task.
     progress : bool or None
         Progress bar on stderr (None: only on a terminal).
+    verbose : bool or {0, 1, 2}
+        impactqp's log on stderr while it runs (as :func:`impactqp.solve`).
 
     Returns
     -------
@@ -177,6 +180,10 @@ def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 10
         raises, or answers NaN, at some u⁻ is counted as ``law_error`` instead, its
         exception's type and message on the counterexample).
     """
+    if verbose:
+        with verbosity(verbose):
+            return verify_law(law, problem, samples, seed, consistent_only, tol=tol,
+                              n_jobs=n_jobs, client=client, progress=progress)
     if isinstance(law, PiecewiseLinearTable) or (hasattr(law, "cones") and hasattr(law, "G")):
         return certify_table_report(law, tol=tol)
     if isinstance(law, ImpactLaw):

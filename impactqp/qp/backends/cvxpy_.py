@@ -59,7 +59,8 @@ def _compiled(qp: QuadraticProgram, solver: str | None):
 
 def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
     if solver is not None and solver.upper() not in cp.installed_solvers():
-        raise UnknownBackendError(f"cvxpy solver {solver!r} is not installed; installed: "
+        raise UnknownBackendError(f"backend 'cvxpy:{solver}': that solver is not installed "
+                                  "for cvxpy; installed: "
                                   f"{', '.join(cp.installed_solvers())}")
     name = solver.upper() if solver else DEFAULT_SOLVER
     prob, x, c, con = _compiled(qp, name)

@@ -33,7 +33,7 @@ def best_solver(qp: QuadraticProgram) -> str:
     for name in order:
         if name in qpsolvers.available_solvers:
             return name
-    raise UnknownBackendError(f"qpsolvers has none of {', '.join(order)} installed "
+    raise UnknownBackendError(f"backend 'qpsolvers': none of {', '.join(order)} is installed "
                               "(pip install 'impactqp[solvers]' adds daqp, piqp, ecos, quadprog)")
 
 
@@ -41,7 +41,8 @@ def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None
     if solver is None:
         solver = best_solver(qp)
     if solver not in qpsolvers.available_solvers:
-        raise UnknownBackendError(f"qpsolvers solver {solver!r} is not installed; installed: "
+        raise UnknownBackendError(f"backend 'qpsolvers:{solver}': that solver is not "
+                                  "installed; installed: "
                                   f"{', '.join(qpsolvers.available_solvers)} "
                                   "(pip install 'impactqp[solvers]' adds more)")
     sparse_ok = solver in qpsolvers.sparse_solvers
