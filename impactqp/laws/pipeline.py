@@ -24,7 +24,7 @@ from ..errors import (
 from ..model.problem import ImpactProblem
 from ..qp.certified import solve_in_forms
 from ..qp.program import QPSolution
-from . import small
+from . import parallel, small
 from .base import Answer, ImpactLaw
 from .planner import route, validate
 from .result import ImpactResult
@@ -98,6 +98,9 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
             return solve(problem, law, backend, form=form, tol=tol)
     start = time.perf_counter()
     tol = validate(problem, law, backend, form, tol)
+    groups = parallel.collapsible(problem, law)
+    if groups is not None:
+        return _collapsed(problem, law, groups, backend, form, tol, start)
     way = route(problem, law, backend, form)
     if way == "compiled":
         result = small.solve_small(problem, law, tol, start)
@@ -134,6 +137,24 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         raise
     return _result(problem, law, out.answer, out.backend, out.checks, start, form=out.form,
                    attempts=out.attempts)
+
+
+def _collapsed(problem: ImpactProblem, law: ImpactLaw, groups: parallel.Groups, backend: str,
+               form: str, tol: float, start: float) -> ImpactResult:
+    """The impact with its parallel contacts collapsed (:mod:`.parallel`), its impulses split
+    back and certified on the original problem."""
+    reduced = solve(ImpactProblem.from_structure(groups.reduced, problem.u_minus),
+                    parallel.reduced_law(law, groups), backend, form=form, tol=tol)
+    answer = parallel.expand(Answer(reduced.u_plus, reduced.impulses, reduced.z), groups)
+    cert = law.certificate(problem, answer, tol)
+    if not cert.ok:
+        raise CertificateError(f"{law.title}: the answer of the collapsed impact fails the "
+                               f"certificate of the original one, {cert.summary()}")
+    note = (f"{problem.n_contacts} contacts in {groups.representative.size} groups of "
+            "parallel ones: solved collapsed, impulses split back")
+    LOG.info(note)
+    return _result(problem, law, answer, reduced.backend, cert, start, form=reduced.form,
+                   attempts=[note, *reduced.attempts])
 
 
 def _closed_form(problem: ImpactProblem, law: ImpactLaw, backend: str, tol: float,

@@ -66,6 +66,18 @@ def restitution_matrix(E, m: int) -> np.ndarray:
     return np.diag(E) if E.ndim == 1 else np.ascontiguousarray(E)
 
 
+DENSE_CONTACTS = 2000
+"""Most contacts whose residuals the dense kernel computes (it takes E as an (m, m) matrix);
+more go through numpy products that apply a scalar or per-contact E without forming it."""
+
+_EMPTY = np.zeros((0, 0))
+
+
+def _restitute(E: np.ndarray, gamma: np.ndarray) -> np.ndarray:
+    """Eγ for every row of γ: εγ, eᵢγᵢ or the matrix product, without forming εI or diag(e)."""
+    return E * gamma if E.ndim < 2 else gamma @ E.T
+
+
 def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
                   Lam: np.ndarray, E, *, eps: float | None = None) -> dict[str, np.ndarray]:
     """Residuals of the certificate for one impact (1-D arrays) or k impacts (rows).
@@ -83,8 +95,10 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
     Um, Up, L = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (U_minus, U_plus, Lam))
     moreau = eps is not None
     e = 0.0 if eps is None else float(eps)
-    Em = restitution_matrix(E, st.m)
-    if not st.sparse and st.chain is None:
+    E = np.asarray(E, dtype=float)
+    if not st.sparse and st.chain is None and st.m <= DENSE_CONTACTS:
+        # the kernel forms εI itself for Moreau's law (an empty E), any other E as a matrix
+        Em = _EMPTY if moreau else restitution_matrix(E, st.m)
         table = dense_residual_rows(st.dense_mass, st.dense_Wt, st.dense_Minv_W,
                                     st.contact_scale, Um, Up, L, Em, e, moreau)
     else:
@@ -92,7 +106,8 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
             Um, Up, L = normalized_rows(Um, Up, L)
             V, _ = impact_residuals(st, Um, Up, L)
             norms = kinetic_norms(st, Up - Um - st.impulse_velocity(L))
-            W = st.Wt_times(Up) + st.Wt_times(Um) @ Em.T if st.m else np.zeros_like(L)
+            W = st.Wt_times(Up) + _restitute(E, st.Wt_times(Um)) if st.m else \
+                np.zeros_like(L)
             z = (Up + e * Um) / (1.0 + e)
             cross = row_sum(st.mass_rows(z) * (Um - z)) if moreau else np.zeros(V.size)
         table = finish_rows(V, norms, np.ascontiguousarray(L), np.ascontiguousarray(W),
