@@ -69,6 +69,11 @@ class SolverError(ImpactError):
     """A backend failed or returned an answer that does not pass its certificate."""
 
 
+class NonFiniteStateError(SolverError):
+    """A simulation's state became NaN or infinite (a force that turns non-finite, motion
+    beyond the float range); the message gives the time."""
+
+
 class NoSolutionError(ImpactError):
     """The impact law has no solution for this input (e.g. an unbounded LCP)."""
 

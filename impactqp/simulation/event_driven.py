@@ -227,12 +227,14 @@ def _exact_flight(t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, t_eval:
     no contact closes) and at the event itself (docs/theory.md §14)."""
     times = t_eval if t_event is None else t_eval[t_eval < t_event]
     tau = times - t
-    y = np.concatenate([q[:, None] + v[:, None] * tau + (0.5 * a)[:, None] * tau**2,
-                        v[:, None] + a[:, None] * tau])
+    with np.errstate(over="ignore", invalid="ignore"):  # a state that overflows is refused
+        # (0.5a·τ)·τ: a body at rest (a = 0, v = 0) stays put for any τ, even τ² = ∞
+        y = np.concatenate([q[:, None] + v[:, None] * tau + (0.5 * a)[:, None] * tau * tau,
+                            v[:, None] + a[:, None] * tau])
     if t_event is None:
         return _Flight(times, y, 0, [np.zeros(0)], [np.zeros((0, 2 * q.size))])
     tau = t_event - t
-    y_event = np.concatenate([q + v * tau + (0.5 * tau**2) * a, v + tau * a])
+    y_event = np.concatenate([q + v * tau + (0.5 * a * tau) * tau, v + tau * a])
     return _Flight(times, y, 1, [np.array([t_event])], [y_event[None, :]])
 
 

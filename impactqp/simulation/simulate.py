@@ -9,7 +9,7 @@ import numpy as np
 
 from ..base.arrays import as_count, as_flag, as_real, check_tol
 from ..base.checks import DEFAULT_TOL
-from ..errors import InputError
+from ..errors import InputError, NonFiniteStateError
 from ..laws.base import ImpactLaw
 from ..laws.planner import check_backend, check_law
 from ..model.problem import ImpactProblem
@@ -19,6 +19,8 @@ from .time_stepping import moreau_jean
 from .trajectory import Trajectory
 
 SCHEMES = ("moreau-jean", "event-driven")
+MAX_STEPS = 1e8
+"""Most time steps (Moreau–Jean) or output points (event-driven) a run may take."""
 METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
 _POSITIVE = ("gap_tol", "rest_velocity", "rtol", "atol")
 OPTIONS = {
@@ -94,7 +96,10 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
     ------
     InputError
         Bad arguments (naming them); a law that does not fit the system's contacts (e.g.
-        ``SectorLawError`` for the sector law on a chain with a wall).
+        ``SectorLawError`` for the sector law on a chain with a wall); more than 10⁸ steps
+        (or output points) for ``h`` and ``t_end``.
+    NonFiniteStateError
+        A recorded state is NaN or infinite (the message gives the first such time).
     SolverError, CertificateError, NoSolutionError
         From the integrator or from an impact no backend could certify.
     """
@@ -110,6 +115,12 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
     if not t_end > t0:
         raise InputError(f"t_end must be after t0 = {t0!r}, got {t_end!r}")
     h = (t_end - t0) / 1000.0 if h is None else as_real("h", h, positive=True)
+    steps = (t_end - t0) / h
+    if not steps <= MAX_STEPS:  # also catches an overflowing t_end − t0
+        what = "steps" if scheme == "moreau-jean" else "output points"
+        raise InputError(f"h = {h:.6g} is too small for t_end − t0 = {t_end - t0:.6g}: "
+                         f"{steps:.3g} {what}, at most {MAX_STEPS:.0e}; raise h or shorten "
+                         "the run")
     theta = as_real("theta", theta, low=0.0, high=1.0)
     if law.forms or backend != law.closed_form_backend:
         check_backend(backend)
@@ -118,7 +129,20 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
         raise InputError(f"progress must be a callable, got {type(progress).__name__}")
     opts = _options(scheme, options)
     if scheme == "moreau-jean":
-        return moreau_jean(system, law, t_end, h, theta, t0=t0, backend=backend, tol=tol,
-                           progress=progress, **opts)
-    return event_driven(system, law, t_end, h, t0=t0, backend=backend, tol=tol,
-                        progress=progress, **opts)
+        trajectory = moreau_jean(system, law, t_end, h, theta, t0=t0, backend=backend,
+                                 tol=tol, progress=progress, **opts)
+    else:
+        trajectory = event_driven(system, law, t_end, h, t0=t0, backend=backend, tol=tol,
+                                  progress=progress, **opts)
+    check_finite_states(trajectory.t, trajectory.q, trajectory.v)
+    return trajectory
+
+
+def check_finite_states(T: np.ndarray, Q: np.ndarray, V: np.ndarray) -> None:
+    """Raise NonFiniteStateError, with the first time, when a recorded state is not finite."""
+    bad = ~(np.isfinite(Q).all(axis=1) & np.isfinite(V).all(axis=1))
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise NonFiniteStateError(f"the state is not finite at t = {T[i]:.12g} (q or v NaN or "
+                                  "infinite): a force that turns non-finite, or motion beyond "
+                                  "the float range")

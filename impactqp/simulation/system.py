@@ -17,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import Matrix, as_matrix, as_vector
-from ..errors import InputError, MassMatrixError, ShapeError
+from ..errors import InputError, MassMatrixError, NonFiniteStateError, ShapeError
 from ..model.builders import chain_directions
 from ..model.structure import ChainInfo, ImpactStructure
 
@@ -179,8 +179,18 @@ class LinearSystem:
         return np.asarray(self.Ht @ np.asarray(v).T).T
 
     def force_at(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """The external force as a float vector."""
-        return np.asarray(self.force(t, q, v), dtype=float)
+        """The external force as a float vector.
+
+        Raises
+        ------
+        NonFiniteStateError
+            When the force (or the state it is evaluated at) is not finite, with the time.
+        """
+        f = np.asarray(self.force(t, q, v), dtype=float)
+        if not np.isfinite(f).all():
+            raise NonFiniteStateError(f"the force is not finite at t = {t:.12g} (q or v NaN or "
+                                      "infinite, or the force function returned NaN/inf)")
+        return f
 
     def kinetic_energy(self, v: np.ndarray) -> np.ndarray | float:
         """T = ½vᵀMv of a velocity or of every row of a (k, n) array."""
