@@ -398,3 +398,30 @@ def test_figures(tmp_path, event_ball):
     assert gif.read_bytes()[:6] == b"GIF89a"
     with pytest.raises(InputError, match="gif"):
         animate_cradle(cradle, tmp_path / "c.png")
+
+
+def test_a_trajectory_draws_itself(tmp_path, event_ball):
+    pytest.importorskip("matplotlib")
+    from matplotlib.animation import FuncAnimation
+    from matplotlib.figure import Figure
+
+    fig = event_ball.plot()  # positions, not written
+    assert isinstance(fig, Figure) and not list(tmp_path.iterdir())
+    line = fig.axes[0].get_lines()[-1]
+    np.testing.assert_array_equal(line.get_ydata(), event_ball.q[:, 0])
+    energy = event_ball.plot("energy", tmp_path / "e.pdf", title="ball")
+    assert (tmp_path / "e.pdf").read_bytes()[:4] == b"%PDF"
+    assert energy.axes[0].get_title() == "ball"
+    np.testing.assert_allclose(energy.axes[0].get_lines()[-1].get_ydata(),
+                               event_ball.total_energy)
+    cradle = simulate(cradle_system(3), SectorLaw(), 1.0, scheme="event-driven", h=0.05)
+    movie = cradle.animate(frames=3)
+    assert isinstance(movie, FuncAnimation)
+    cradle.animate(tmp_path / "c.gif", frames=3, fps=3)
+    assert (tmp_path / "c.gif").read_bytes()[:6] == b"GIF89a"
+    with pytest.raises(InputError, match="kind"):
+        cradle.plot("speeds")
+    with pytest.raises(InputError, match="dofs"):
+        cradle.plot(dofs=[7])
+    with pytest.raises(InputError, match="suffix|end in"):
+        cradle.plot(path=tmp_path / "q.txt")

@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from ..base.figure import DPI, figure_format
 from ..errors import InputError, OptionalDependencyError
 from ..verification.compare import LawComparison
-from .plots import DPI, figure_format
 
 NO_DATES = {"png": {"Software": None}, "svg": {"Date": None},
             "pdf": {"CreationDate": None, "ModDate": None}}

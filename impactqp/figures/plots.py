@@ -21,66 +21,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import InputError, OptionalDependencyError
+from ..base.figure import figure_format, new_figure, save_figure
 from ..model.builders import newtons_cradle
 from ..model.problem import ImpactProblem
 from ..tables.sector_table import sector_velocity_map
 from .geometry2d import PlanePicture, Wedge, plane_picture, sector_picture
 
-FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
-DPI = 100
-
-#: metadata keys that would make the output differ from run to run
-_NO_DATES = {"png": {"Software": None}, "svg": {"Date": None},
-             "pdf": {"CreationDate": None, "ModDate": None}}
-
 COLORS = {"reaction": ("#d6e6f4", "tab:blue"), "tangent": "tab:orange", "S": "#74c476",
           "candidate": "crimson"}
 """Fill and edge colours of the regions of :func:`draw_plane`."""
-
-
-def new_figure(width: float = 6.4, height: float | None = None) -> Any:
-    """A pyplot-free matplotlib Figure (square unless ``height`` is given), or a clear error
-    naming the extra to install."""
-    try:
-        from matplotlib.figure import Figure
-    except ImportError:
-        raise OptionalDependencyError("figures need matplotlib: pip install 'impactqp[plot]'") \
-            from None
-    return Figure(figsize=(width, width if height is None else height), dpi=DPI,
-                  layout="constrained")
-
-
-def figure_format(path: str | Path) -> str:
-    """The figure format of an output path, from its suffix.
-
-    Parameters
-    ----------
-    path : str or Path
-        Output file.
-
-    Returns
-    -------
-    str
-        ``"png"``, ``"svg"`` or ``"pdf"``.
-
-    Raises
-    ------
-    InputError
-        For any other suffix.
-    """
-    fmt = FORMATS.get(Path(path).suffix.lower())
-    if fmt is None:
-        raise InputError(f"figure file must end in one of {sorted(FORMATS)}, got "
-                         f"{Path(path).name!r}")
-    return fmt
-
-
-def save_figure(fig: Any, path: str | Path) -> Path:
-    """Write ``fig`` in the format of the suffix of ``path``, without time stamps."""
-    fmt = figure_format(path)
-    fig.savefig(path, format=fmt, metadata=_NO_DATES[fmt])
-    return Path(path)
 
 
 def _edges(polygon: np.ndarray, half_width: float) -> np.ndarray:

@@ -118,6 +118,41 @@ class Trajectory:
                 f"events={len(self.events)})")
 
     # --- saving --------------------------------------------------------------------------
+    def plot(self, kind: str = "positions", path: str | Path | None = None, *,
+             title: str = "", dofs: Any = None) -> Any:
+        """Draw the positions qᵢ(t) (``kind="positions"``) or the energies T, V, T + V
+        (``"energy"``) over time, and write the figure when given ``path`` (.png, .svg,
+        .pdf). Needs the ``plot`` extra (matplotlib).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+
+        See Also
+        --------
+        impactqp.simulation.pictures.plot : the parameters in full.
+        """
+        from . import pictures
+
+        return pictures.plot(self, kind, path, title=title, dofs=dofs)
+
+    def animate(self, path: str | Path | None = None, **options: Any) -> Any:
+        """Animate the balls of a pendulum run (:func:`impactqp.cradle_system`), written when
+        given ``path`` (.gif or .mp4); ``options`` are ``length``, ``radius``, ``frames``,
+        ``fps`` and ``size``. Needs the ``plot`` extra (matplotlib).
+
+        Returns
+        -------
+        matplotlib.animation.FuncAnimation
+
+        See Also
+        --------
+        impactqp.simulation.pictures.animate : the parameters in full.
+        """
+        from . import pictures
+
+        return pictures.animate(self, path, **options)
+
     def event_arrays(self) -> dict[str, np.ndarray]:
         """The events as flat arrays (ragged fields as values plus offsets)."""
         ev = self.events
