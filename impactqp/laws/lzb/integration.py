@@ -13,7 +13,7 @@ the crossings of the energy level between the two parametrizations. The impact i
 every contact is open: no stored energy and γᵢ ≥ 0.
 
 Adaptive integration uses DOP853 at tolerance ``rtol`` in the dimensionless variables of
-:mod:`impactqp.laws.lzb_dynamics`; a fixed ``step`` uses RK45 steps of that length in the
+:mod:`impactqp.laws.lzb.dynamics`; a fixed ``step`` uses RK45 steps of that length in the
 primary impulse (error control off), the low-energy pieces against time staying adaptive.
 """
 
@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..errors import CertificateError
-from .lzb_dynamics import LZBDynamics
+from ...errors import CertificateError
+from .dynamics import LZBDynamics
 
 ENERGY_LEVEL = 1e-6
 """Below this dimensionless energy in every contact (the start, the end, a restart) the

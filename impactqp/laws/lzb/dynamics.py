@@ -7,7 +7,7 @@ the energy stored during compression). The state during the impact is, per conta
 accumulated impulse Pᵢ, the stored potential energy Eᵢ and the energy Dᵢ dissipated so far;
 the contact velocities follow from γ = γ⁻ + GP. This module holds the rates of that state,
 once against time and once against the impulse of the primary contact, on which
-:mod:`impactqp.laws.lzb_integration` builds the integration.
+:mod:`impactqp.laws.lzb.integration` builds the integration.
 
 Everything here is dimensionless: velocities against V = max |γ⁻ᵢ|, the Delassus matrix
 against g = max Gᵢᵢ, impulses against Π = V/g, energies against VΠ, so that every state
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..base.arrays import Matrix, as_dense
+from ...base.arrays import Matrix, as_dense
 
 TINY = 1e-30
 """Floor of the primary contact's dimensionless force: its energy is zero only at the event

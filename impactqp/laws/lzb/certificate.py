@@ -8,10 +8,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..base.checks import ResidualChecks
-from ..model.residuals import impact_residuals, kinetic_norms, normalized_rows
-from ..model.structure import ImpactStructure
-from .lzb_integration import LZBRecord
+from ...base.checks import ResidualChecks
+from ...model.residuals import impact_residuals, kinetic_norms, normalized_rows
+from ...model.structure import ImpactStructure
+from .integration import LZBRecord
 
 
 @dataclass(frozen=True)

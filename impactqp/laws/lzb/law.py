@@ -5,7 +5,7 @@ and an energetic restitution coefficient per contact (docs/theory.md §13).
 Unlike the rigid laws of docs/theory.md §3 and §6 the outcome depends on the contacts'
 stiffnesses and exponents: the model disperses the striker's energy along a chain as real
 chains of beads do. It is a closed-form law for the solve pipeline (``forms = ()``, backend
-``"lzb"``): its "solver" is the integration of :mod:`impactqp.laws.lzb_integration`, and its
+``"lzb"``): its "solver" is the integration of :mod:`impactqp.laws.lzb.integration`, and its
 certificate is recomputed from u⁺, Λ and the final state of that integration.
 """
 
@@ -15,16 +15,16 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..base.arrays import as_array, as_real, as_vector
-from ..base.checks import DEFAULT_TOL
-from ..errors import InputError, RestitutionError, ShapeError
-from ..model.problem import ImpactProblem
-from ..model.structure import ImpactStructure
-from .base import ImpactLaw
-from .certificate import as_residual
-from .lzb_certificate import LZBCertificate, lzb_residuals
-from .lzb_dynamics import LZBDynamics
-from .lzb_integration import LZBRecord, integrate
+from ...base.arrays import as_array, as_real, as_vector
+from ...base.checks import DEFAULT_TOL
+from ...errors import InputError, RestitutionError, ShapeError
+from ...model.problem import ImpactProblem
+from ...model.structure import ImpactStructure
+from ..base import ImpactLaw
+from ..certificate import as_residual
+from .certificate import LZBCertificate, lzb_residuals
+from .dynamics import LZBDynamics
+from .integration import LZBRecord, integrate
 
 DEFAULT_RTOL = 1e-12
 """Relative (and, in the dimensionless variables, absolute) tolerance of the adaptive
