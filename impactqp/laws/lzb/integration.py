@@ -1,7 +1,8 @@
-"""The integration of the LZB model (docs/theory.md §13) with scipy's ODE solvers.
+"""The integration of the LZB model (docs/theory.md §13): the compiled stepper of
+:mod:`impactqp.kernels.lzb`, and scipy's DOP853 as the reference it is tested against.
 
 The impact is integrated piece by piece, each piece until its first event, located on the
-solver's dense output. While every contact stores little energy (below ``ENERGY_LEVEL``:
+stepper's dense output. While every contact stores little energy (below ``ENERGY_LEVEL``:
 the start, the end, a restart) the state is integrated against time, where it is regular.
 Otherwise the primary contact k is the one storing the most potential energy, and the state
 is integrated against its impulse Pₖ with the distributing law dPᵢ/dPₖ = Fᵢ/Fₖ. Events:
@@ -13,8 +14,12 @@ the crossings of the energy level between the two parametrizations. The impact i
 every contact is open: no stored energy and γᵢ ≥ 0.
 
 Adaptive integration uses DOP853 at tolerance ``rtol`` in the dimensionless variables of
-:mod:`impactqp.laws.lzb.dynamics`; a fixed ``step`` uses RK45 steps of that length in the
+:mod:`impactqp.laws.lzb.dynamics`; a fixed ``step`` takes DOP853 steps of that length in the
 primary impulse (error control off), the low-energy pieces against time staying adaptive.
+Both run in one compiled call (:func:`impactqp.kernels.lzb.integrate_impact`); the
+reference (``reference=True``) runs every piece with scipy's ``solve_ivp`` on the same
+compiled rates, events and piece logic. Either stops within a budget of steps derived from
+the options and the number of contacts (:func:`step_budget`).
 """
 
 from __future__ import annotations
@@ -24,31 +29,24 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ...errors import CertificateError
+from ...errors import CertificateError, IntegrationBudgetError
+from ...kernels import lzb_model as kl
+from ...kernels.lzb import dop853_tableau, integrate_impact
 from .dynamics import LZBDynamics
 
-ENERGY_LEVEL = 1e-6
-"""Below this dimensionless energy in every contact (the start, the end, a restart) the
-state is integrated against time; the primary impulse takes over when a contact's energy
-rises to it and hands back when the primary's falls to half of it. With fixed steps the
-level is raised to what a few steps can remove from the primary contact."""
-VELOCITY_LEVEL = 1e-12
-"""Dimensionless contact velocity below which an open contact counts as closing again, and
-above which a plastic contact counts as no longer compressing."""
-END_ENERGY = 1e-20
-"""The impact is over when no contact approaches faster than VELOCITY_LEVEL and none stores
-more than this dimensionless energy (which is reported as left in the contacts)."""
-SWITCH_MARGIN = 1e-6
-"""The primary contact changes when another contact stores this fraction more energy (a tie,
-as in a symmetric impact, keeps the current primary)."""
 MAX_PIECES = 20_000
 """Budget of pieces of one integration."""
-MAX_EVALUATIONS = 1_000_000
-"""Budget of right-hand-side evaluations of one integration (about a minute)."""
-PIECE_SPAN = 1e4
-"""Longest piece, in dimensionless primary impulse or time, before it is restarted."""
-FIRST_STEP = 1e-7
-"""First adaptive step as a fraction of the piece's span (the solver's guess can jump far)."""
+MAX_WORK = 20_000_000
+"""Budget of one integration in contact-steps (accepted steps × contacts): a few seconds of
+the compiled stepper."""
+STEPS_PER_IMPULSE = 4.0
+"""Dimensionless primary impulse per contact an impact takes at most, for the estimate of
+the steps a fixed ``step`` needs (the chains measured take under 1)."""
+
+
+def step_budget(m: int) -> int:
+    """The most accepted steps an integration of m contacts may take: MAX_WORK / m."""
+    return max(MAX_WORK // max(m, 1), 1000)
 
 
 @dataclass
@@ -77,7 +75,16 @@ class LZBRecord:
         The impulse gathered by the primary contact of each piece, summed over the pieces
         (the model's independent variable).
     method : str
-        ``"DOP853, rtol=…"`` or ``"fixed step …"``.
+        ``"DOP853, rtol=…"`` or ``"fixed step …"`` (``", scipy"`` for the reference).
+    error_estimate : float
+        Sum over the accepted steps of the stepper's local error estimate, relative to
+        1 + |x| in the dimensionless variables (compiled stepper; the reference reports
+        rtol × steps): the integration error the certificate allows for (docs/theory.md §13).
+    stored_dimensionless, left_dimensionless : float
+        Σ(Eᵢ + Dᵢ) and ΣEᵢ at the end in units of VΠ: what the energy balance adds to T⁺
+        and the potential energy left, free of overflow at any velocity scale.
+    energy_unit : tuple of float
+        (V, g): the energy unit is V²/g.
     """
 
     impulses: np.ndarray
@@ -91,192 +98,125 @@ class LZBRecord:
     pieces: int = 0
     impulse_variable: float = 0.0
     method: str = ""
+    error_estimate: float = 0.0
+    stored_dimensionless: float = 0.0
+    left_dimensionless: float = 0.0
+    energy_unit: tuple = (1.0, 1.0)
 
 
-class _Budget(Exception):
-    """Raised inside the right-hand side when the evaluation budget is spent."""
+def _prepare(dyn: LZBDynamics, step: float | None) -> tuple[float, int]:
+    """The dimensionless fixed step (0: adaptive) and the step budget; refuses a step so
+    small that the budget cannot hold the steps it needs."""
+    budget = step_budget(dyn.m)
+    if step is None:
+        return 0.0, budget
+    s = dyn.scales
+    h = step / s.velocity * s.delassus  # step / Π, without forming Π
+    need = STEPS_PER_IMPULSE * dyn.m / h if h > 0 else np.inf
+    if not np.isfinite(h) or need > budget:
+        raise IntegrationBudgetError(
+            f"step={step:g} N·s is {h:.3g} of this impact's impulse scale Π = V/g "
+            f"= {s.impulse:.3g} N·s: its {dyn.m} contacts need about {need:.3g} fixed steps, "
+            f"more than the budget of {budget} ({MAX_WORK:g} contact-steps); take step ≥ "
+            f"{STEPS_PER_IMPULSE * dyn.m / budget * s.impulse:.3g} N·s or adaptive steps "
+            "(step=None)")
+    return h, budget
 
 
-def _event(fun, direction: float, kind: str, contact: int):
-    fun.terminal, fun.direction, fun.kind, fun.contact = True, direction, kind, contact
-    return fun
+def _budget_error(status: int, budget: int, dyn: LZBDynamics, step: float | None,
+                  rtol: float) -> CertificateError:
+    options = f"rtol={rtol:g}" if step is None else f"step={step:g} N·s"
+    if status == kl.OUT_OF_STEPS:
+        return IntegrationBudgetError(
+            f"the LZB integration did not end within its budget of {budget} steps "
+            f"({MAX_WORK:g} contact-steps over {dyn.m} contacts, {options}): the contacts "
+            "kept storing energy (an elastic impact where no velocity separates every "
+            "contact never ends)")
+    if status == kl.OUT_OF_PIECES:
+        return IntegrationBudgetError(
+            f"the LZB integration did not end within {MAX_PIECES} pieces ({options}): the "
+            "primary contact or the contacts' state kept changing")
+    return CertificateError(f"the LZB integration failed: the step size fell below the "
+                            f"spacing of floating-point numbers ({options})")
 
 
-class _Run:
-    """One integration: the state (y, P, D), the primary contact and the counters."""
+def _record(dyn: LZBDynamics, y: np.ndarray, P: np.ndarray, D: np.ndarray,
+            left: np.ndarray, istate: np.ndarray, fstate: np.ndarray, primaries: list,
+            method: str) -> LZBRecord:
+    """The record of a finished integration, in physical units."""
+    s = dyn.scales
+    kl.stored_energies(y, dyn.law, left)
+    with np.errstate(over="ignore", under="ignore"):
+        return LZBRecord(
+            impulses=P * s.impulse, potential_energy=left * s.energy, dissipated=D * s.energy,
+            gamma=dyn.gamma(P) * s.velocity, primary_switches=int(istate[kl.SWITCHES]),
+            primary_contacts=[int(k) for k in primaries], steps=int(istate[kl.STEPS]),
+            evaluations=int(istate[kl.EVALUATIONS]), pieces=int(istate[kl.PIECES]),
+            impulse_variable=float(fstate[kl.IMPULSE_VARIABLE]) * s.impulse, method=method,
+            error_estimate=float(fstate[kl.ERROR]),
+            stored_dimensionless=float(np.sum(left) + np.sum(D)),
+            left_dimensionless=float(np.sum(left)),
+            energy_unit=(s.velocity, s.delassus))
 
-    def __init__(self, dyn: LZBDynamics, rtol: float, step: float | None) -> None:
-        self.dyn, self.rtol, m = dyn, rtol, dyn.m
-        self.step = None if step is None else step / dyn.scales.impulse
-        self.y, self.P, self.D = np.zeros(m), np.zeros(m), np.zeros(m)
-        self.left = np.zeros(m)
-        self.primary: int | None = None
-        self.next_primary: int | None = None
-        self.in_time = True
-        self.level = ENERGY_LEVEL
-        self.record = LZBRecord(np.zeros(m), np.zeros(m), np.zeros(m), dyn.gamma0.copy())
 
-    def _level(self, gamma: np.ndarray) -> float:
-        """The energy below which pieces run against time: ENERGY_LEVEL, or with fixed steps
-        at least the energy that a few steps can take out of the primary contact."""
-        if self.step is None:
-            return ENERGY_LEVEL
-        reach = float(np.max(np.abs(gamma))) * max(1.0, self.dyn.expansion.max())
-        return max(ENERGY_LEVEL, 4.0 * self.step * reach)
+def _reference(dyn: LZBDynamics, rtol: float, h: float, budget: int, y, P, D, left, istate,
+               fstate) -> tuple[int, list]:
+    """The same integration with scipy's solve_ivp (DOP853) for every piece, on the compiled
+    rates, events and piece logic; returns (status, primary contacts)."""
+    m, args = dyn.m, dyn.structure
+    indptr, indices, data, gamma0, law = args
+    frozen, gamma, live = np.zeros(m, dtype=np.bool_), np.empty(m), np.empty(m, dtype=np.int64)
+    kinds, contacts = np.empty(3 * m + 3, dtype=np.int64), np.empty(3 * m + 3, dtype=np.int64)
+    directions, x = np.empty(3 * m + 3), np.empty(3 * m)
+    primaries: list = []
+    while True:
+        primary = kl.begin_piece(y, P, D, frozen, gamma, istate, fstate, law, *args[:4])
+        if primary < 0:
+            return kl.DONE, primaries
+        if istate[kl.PIECES] > MAX_PIECES:
+            return kl.OUT_OF_PIECES, primaries
+        primaries.append(primary)
+        k = -1 if istate[kl.IN_TIME] else primary
+        ne, nlive = kl.piece_events(k, frozen, gamma, law, indptr, indices, kinds, contacts,
+                                    directions, live)
+        kl.piece_state(y, P, D, k, law, x)
+        level, before = float(fstate[kl.LEVEL]), P[primary]
 
-    def _events(self, k: int | None, frozen: np.ndarray) -> list:
-        """The events that end a piece with primary k (None: a piece against time)."""
-        dyn, m = self.dyn, self.dyn.m
-        gamma = dyn.gamma(self.P)
+        def fun(t, z, k=k, nlive=nlive):
+            out = np.zeros(3 * m)
+            kl.rates(z, k, live, nlive, indptr, indices, data, gamma0, law, np.empty(m), out)
+            istate[kl.EVALUATIONS] += 1
+            return out
+
         events = []
-        for j in range(m):
-            if frozen[j]:  # an open contact that starts to approach again
-                events.append(_event(lambda t, x, j=j: dyn.gamma(x[m:2 * m])[j]
-                                     + VELOCITY_LEVEL, -1.0, "close", j))
-                continue
-            if j != k:  # a contact that empties
-                events.append(_event(lambda t, x, j=j: x[j], -1.0, "open", j))
-            if dyn.plastic[j]:  # a plastic contact that stops compressing
-                events.append(_event(lambda t, x, j=j: dyn.gamma(x[m:2 * m])[j]
-                                     - VELOCITY_LEVEL, 1.0, "plastic", j))
-            elif dyn.restitution[j] < 1 and abs(gamma[j]) > VELOCITY_LEVEL:
-                # compression turns to expansion or back: the rate of yⱼ has a kink there
-                events.append(_event(lambda t, x, j=j: dyn.gamma(x[m:2 * m])[j],
-                                     -np.sign(gamma[j]), "turn", j))
-        if k is not None:
-            others = np.arange(m) != k
-            power = dyn.eta[others] + 1.0
-
-            def overtaken(t, x):  # −1 while no other contact stores energy
-                top = np.max(np.maximum(x[:m][others], 0.0) ** power, initial=0.0)
-                return top - (1.0 + SWITCH_MARGIN) * x[k] if top > 0 else -1.0
-
-            events.append(_event(overtaken, 1.0, "switch", k))
-            low = 0.5 * self.level
-            events.append(_event(lambda t, x: x[k] - low, -1.0, "low", k))
+        for e in range(ne):
+            def event(t, z, kind=int(kinds[e]), j=int(contacts[e]), k=k, nlive=nlive,
+                      level=level):
+                return kl.event_value(kind, j, k, z, level, live, nlive, law, indptr, indices,
+                                      data, gamma0)
+            event.terminal, event.direction = True, float(directions[e])
+            events.append(event)
+        if h > 0 and k >= 0:
+            options = dict(first_step=h, max_step=h, rtol=1e3, atol=1e3)
         else:
-            power = dyn.eta + 1.0
-            events.append(_event(lambda t, x: np.max(np.maximum(x[:m], 0.0) ** power)
-                                 - self.level, 1.0, "high", -1))
-        return events
-
-    def _solve(self, fun, span: tuple[float, float], z: np.ndarray, k: int | None,
-               frozen: np.ndarray, fixed: bool) -> None:
-        """Integrate one piece from (z, P, D) until its first event; apply the event."""
-        def counted(t, x):
-            self.record.evaluations += 1
-            if self.record.evaluations > MAX_EVALUATIONS:
-                raise _Budget
-            with np.errstate(over="ignore", invalid="ignore"):  # trial steps past an event
-                return fun(t, x)
-
-        events = self._events(k, frozen)
-        if fixed:  # error control off: every step has the length self.step
-            options = dict(method="RK45", first_step=self.step, max_step=self.step, rtol=1e3,
-                           atol=1e3)
-        else:
-            options = dict(method="DOP853", rtol=self.rtol, atol=self.rtol,
-                           first_step=FIRST_STEP * (span[1] - span[0]))
-        with np.errstate(over="ignore", invalid="ignore"):
-            sol = solve_ivp(counted, span, np.concatenate([z, self.P, self.D]), events=events,
+            options = dict(rtol=rtol, atol=rtol, first_step=kl.FIRST_STEP * kl.PIECE_SPAN)
+        with np.errstate(over="ignore", invalid="ignore"):  # trial steps past an event
+            sol = solve_ivp(fun, (0.0, kl.PIECE_SPAN), x, method="DOP853", events=events,
                             **options)
         if sol.status < 0:
-            raise CertificateError(f"the LZB integration failed: {sol.message}")
-        self.record.steps += len(sol.t) - 1
-        m, x = self.dyn.m, sol.y[:, -1]
-        self.y, self.P, self.D = x[:m].copy(), x[m:2 * m], x[2 * m:]
-        if k is not None:
-            self.y[k] = max(x[k], 0.0) ** self.dyn.power[k]
-        self._handle([ev for ev, times in zip(events, sol.t_events) if len(times)])
-        self.y = np.maximum(self.y, 0.0)
-
-    def time_piece(self, frozen: np.ndarray) -> None:
-        """Integrate against time while every contact stores little energy."""
-        dyn, m = self.dyn, self.dyn.m
-
-        def fun(t, x):
-            ydot, pdot, ddot, _ = dyn.time_rates(x[:m], x[m:2 * m], frozen)
-            return np.concatenate([ydot, pdot, ddot])
-
-        self._solve(fun, (0.0, PIECE_SPAN), self.y, None, frozen, False)
-
-    def impulse_piece(self, k: int, frozen: np.ndarray) -> None:
-        """Integrate against the impulse of the primary contact k."""
-        dyn, m = self.dyn, self.dyn.m
-        z = self.y.copy()
-        z[k] = dyn.energy(self.y)[k]
-
-        def fun(t, x):
-            return np.concatenate(dyn.impulse_rates(x[:m], x[m:2 * m], k, frozen))
-
-        self._solve(fun, (0.0, PIECE_SPAN), z, k, frozen, self.step is not None)
-
-    def _handle(self, fired: list) -> None:
-        """Apply the events that ended a piece."""
-        dyn = self.dyn
-        for ev in fired:
-            j = ev.contact
-            if ev.kind == "open":
-                self.left[j] += dyn.energy(self.y)[j]
-                self.y[j] = 0.0
-            elif ev.kind == "plastic":
-                self.D[j] += dyn.energy(self.y)[j]
-                self.y[j] = 0.0
-            elif ev.kind in ("high", "low"):
-                self.in_time = ev.kind == "low"
-            elif ev.kind == "switch":
-                energy = np.where(np.arange(dyn.m) == j, 0.0, dyn.energy(self.y))
-                if energy.max() > 0:
-                    self.next_primary = int(np.argmax(energy))
-
-    def run(self) -> LZBRecord:
-        """Integrate piece by piece until every contact is open."""
-        dyn, rec = self.dyn, self.record
-        try:
-            while True:
-                gamma = dyn.gamma(self.P)
-                spent = dyn.plastic & (gamma > 0) & (self.y > 0)  # plastic, past compression
-                self.D[spent] += dyn.energy(self.y)[spent]
-                self.y[spent] = 0.0
-                energy = dyn.energy(self.y)
-                frozen = (self.y <= 0) & (gamma > -0.5 * VELOCITY_LEVEL)
-                if np.all(gamma > -VELOCITY_LEVEL) and np.all(energy <= END_ENERGY):
-                    break
-                self.level = self._level(gamma)
-                self.in_time |= energy.max() < 0.5 * self.level
-                k = self.next_primary if self.next_primary is not None else \
-                    int(np.argmax(energy)) if np.any(energy > 0) else int(np.argmin(gamma))
-                self.next_primary = None
-                rec.primary_switches += self.primary is not None and k != self.primary
-                self.primary = k
-                rec.primary_contacts.append(k)
-                rec.pieces += 1
-                if rec.pieces > MAX_PIECES:
-                    raise CertificateError(f"the LZB integration did not end within "
-                                           f"{MAX_PIECES} pieces")
-                before = self.P[k]
-                if self.in_time:
-                    self.time_piece(frozen)
-                else:
-                    self.impulse_piece(k, frozen)
-                rec.impulse_variable += self.P[k] - before
-        except _Budget:
-            raise CertificateError(
-                f"the LZB integration did not end within {MAX_EVALUATIONS} evaluations (an "
-                "elastic impact where no velocity separates every contact, T_C = {0}, never "
-                "ends)") from None
-        s = dyn.scales
-        rec.impulses = self.P * s.impulse
-        rec.potential_energy = (self.left + dyn.energy(self.y)) * s.energy
-        rec.dissipated = self.D * s.energy
-        rec.gamma = dyn.gamma(self.P) * s.velocity
-        rec.impulse_variable *= s.impulse
-        rec.method = f"DOP853, rtol={self.rtol:g}" if self.step is None else \
-            f"fixed step {self.step * s.impulse:g}"
-        return rec
+            return kl.STEP_TOO_SMALL, primaries
+        istate[kl.STEPS] += len(sol.t) - 1
+        fstate[kl.ERROR] += rtol * (len(sol.t) - 1) if not (h > 0 and k >= 0) else 0.0
+        if istate[kl.STEPS] > budget:
+            return kl.OUT_OF_STEPS, primaries
+        fired = [e for e, times in enumerate(sol.t_events) if len(times)]
+        x[:] = sol.y[:, -1]
+        kind, j = (int(kinds[fired[0]]), int(contacts[fired[0]])) if fired else (-1, -1)
+        kl.end_piece(kind, j, k, primary, before, x, y, P, D, left, istate, fstate, law)
 
 
-def integrate(dyn: LZBDynamics, *, rtol: float, step: float | None) -> LZBRecord:
+def integrate(dyn: LZBDynamics, *, rtol: float, step: float | None,
+              reference: bool = False) -> LZBRecord:
     """Integrate one multiple impact of the LZB model until every contact is open.
 
     Parameters
@@ -284,9 +224,12 @@ def integrate(dyn: LZBDynamics, *, rtol: float, step: float | None) -> LZBRecord
     dyn : LZBDynamics
         The impact's contacts, G and γ⁻ (with at least one γ⁻ᵢ < 0).
     rtol : float
-        Tolerance of the adaptive solver (dimensionless variables).
+        Tolerance of the adaptive steps (dimensionless variables).
     step : float or None
         Fixed step in the primary impulse (physical units), or None for adaptive steps.
+    reference : bool
+        Integrate each piece with scipy's ``solve_ivp`` (DOP853) instead of the compiled
+        stepper: the slow reference the tests compare against.
 
     Returns
     -------
@@ -294,7 +237,27 @@ def integrate(dyn: LZBDynamics, *, rtol: float, step: float | None) -> LZBRecord
 
     Raises
     ------
+    IntegrationBudgetError
+        A fixed step too small for the budget, or the budget of steps or pieces spent.
     CertificateError
-        The integration failed or did not end within its budget.
+        The step size collapsed.
     """
-    return _Run(dyn, rtol, step).run()
+    m = dyn.m
+    h, budget = _prepare(dyn, step)
+    y, P, D, left = np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m)
+    istate, fstate = kl.new_state(m)
+    fstate[kl.FIXED_STEP] = h
+    if reference:
+        status, primaries = _reference(dyn, rtol, h, budget, y, P, D, left, istate, fstate)
+    else:
+        buffer = np.empty(MAX_PIECES + 1, dtype=np.int64)
+        indptr, indices, data, gamma0, law = dyn.structure
+        status = integrate_impact(indptr, indices, data, gamma0, law, rtol, budget,
+                                  MAX_PIECES, *dop853_tableau(), y, P, D, left, istate, fstate,
+                                  buffer)
+        primaries = buffer[:min(int(istate[kl.PIECES]), MAX_PIECES)].tolist()
+    if status != kl.DONE:
+        raise _budget_error(status, budget, dyn, step, rtol)
+    method = f"DOP853, rtol={rtol:g}" if step is None else f"fixed step {step:g}"
+    return _record(dyn, y, P, D, left, istate, fstate, primaries,
+                   method + (", scipy" if reference else ""))
