@@ -26,8 +26,10 @@ from .lzb_model import (
     OUT_OF_STEPS,
     PIECE_SPAN,
     PIECES,
+    PLASTIC_STOP,
     STEP_TOO_SMALL,
     STEPS,
+    TURN,
     begin_piece,
     end_piece,
     event_value,
@@ -37,6 +39,8 @@ from .lzb_model import (
 )
 
 EPS = float(np.finfo(float).eps)
+KINK_ITERATIONS = 4
+"""Secant steps that place the end of a piece on a kink of the rates."""
 
 
 def dop853_tableau() -> tuple[np.ndarray, ...]:
@@ -118,6 +122,41 @@ def _root(kind, j, k, ga, gb, F, x_old, level, live, nlive, comps, nc, law, indp
 
 
 @kernel
+def _rk_step(x, h, k, live, nlive, comps, nc, indptr, indices, data, gamma0, law, A, B, K,
+             xs, gamma, out):
+    """One DOP853 step of length h from x (K[0] = its rates) into ``out``, stages into K."""
+    for s in range(1, 12):
+        _stage(K, A, s, x, h, comps, nc, xs)
+        rates(xs, k, live, nlive, indptr, indices, data, gamma0, law, gamma, K[s])
+    _combine(K, B, 12, comps, nc, out)
+    for c in range(nc):
+        i = comps[c]
+        out[i] = x[i] + h * out[i]
+
+
+@kernel
+def _step_to_kink(x, tau, kind, j, k, g0, level, live, nlive, comps, nc, indptr, indices,
+                  data, gamma0, law, A, B, K, xs, gamma, out, istate):
+    """The state where a kink of the rates (a turn, a plastic stop) lies, into ``out``: the
+    dense output of the step that crossed it is polluted by the stages past it, so the
+    kink is reached by real steps from x, whose stages see only the rates before it; their
+    length τ (first guess from the dense output) is refined by the secant method on the
+    event's value (docs/theory.md §13)."""
+    t0, ga = 0.0, g0
+    for _ in range(KINK_ITERATIONS):
+        _rk_step(x, tau, k, live, nlive, comps, nc, indptr, indices, data, gamma0, law, A, B,
+                 K, xs, gamma, out)
+        istate[EVALUATIONS] += 11
+        g = event_value(kind, j, k, out, level, live, nlive, law, indptr, indices, data,
+                        gamma0)
+        if g == 0.0 or g == ga:
+            return
+        t0, ga, tau, last = tau, g, tau - g * (tau - t0) / (g - ga), tau
+        if abs(tau - last) <= 4.0 * EPS * abs(last):
+            return
+
+
+@kernel
 def _piece(x, k, live, nlive, kinds, contacts, directions, ne, rtol, fixed, max_steps,
            indptr, indices, data, gamma0, law, A, B, E3, E5, Dd, istate, fstate, work):
     """Integrate one piece from x until its first event (against time when k < 0), x
@@ -156,13 +195,8 @@ def _piece(x, k, live, nlive, kinds, contacts, directions, ne, rtol, fixed, max_
                 return STEP_TOO_SMALL, -1
             t_new = min(t + h_abs, PIECE_SPAN)
             h = t_new - t
-            for s in range(1, 12):
-                _stage(K, A, s, x, h, comps, nc, xs)
-                rates(xs, k, live, nlive, indptr, indices, data, gamma0, law, gamma, K[s])
-            _combine(K, B, 12, comps, nc, x_new)
-            for c in range(nc):
-                i = comps[c]
-                x_new[i] = x[i] + h * x_new[i]
+            _rk_step(x, h, k, live, nlive, comps, nc, indptr, indices, data, gamma0, law, A, B,
+                     K, xs, gamma, x_new)
             rates(x_new, k, live, nlive, indptr, indices, data, gamma0, law, gamma, K[12])
             istate[EVALUATIONS] += 12
             _combine(K, E5, 13, comps, nc, e5)
@@ -216,7 +250,14 @@ def _piece(x, k, live, nlive, kinds, contacts, directions, ne, rtol, fixed, max_
             if theta < first_theta:
                 first, first_theta = e, theta
         if first >= 0:
-            _interpolate(F, x, first_theta, comps, nc, x)
+            if kinds[first] == TURN or kinds[first] == PLASTIC_STOP:
+                _step_to_kink(x, h * first_theta, kinds[first], contacts[first], k,
+                              g_old[first], level, live, nlive, comps, nc, indptr, indices,
+                              data, gamma0, law, A, B, K, xs, gamma, xt, istate)
+            else:
+                _interpolate(F, x, first_theta, comps, nc, xt)
+            for c in range(nc):
+                x[comps[c]] = xt[comps[c]]
             return DONE, first
         for c in range(nc):
             i = comps[c]

@@ -61,13 +61,6 @@ class Scales:
     def impulse(self) -> float:
         return self.velocity / self.delassus
 
-    @property
-    def energy(self) -> float:
-        """VΠ = V²/g in physical units (inf or 0 where it leaves the floating-point range:
-        the certificate works with dimensionless energies and never forms it)."""
-        with np.errstate(over="ignore", under="ignore"):
-            return self.velocity * self.impulse
-
 
 class LZBDynamics:
     """One impact of the LZB model (docs/theory.md §13) in dimensionless form, ready for the

@@ -36,7 +36,7 @@ from .dynamics import LZBDynamics
 
 MAX_PIECES = 20_000
 """Budget of pieces of one integration."""
-MAX_WORK = 20_000_000
+MAX_WORK = 10_000_000
 """Budget of one integration in contact-steps (accepted steps × contacts): a few seconds of
 the compiled stepper."""
 STEPS_PER_IMPULSE = 4.0
@@ -126,6 +126,10 @@ def _prepare(dyn: LZBDynamics, step: float | None) -> tuple[float, int]:
 def _budget_error(status: int, budget: int, dyn: LZBDynamics, step: float | None,
                   rtol: float) -> CertificateError:
     options = f"rtol={rtol:g}" if step is None else f"step={step:g} N·s"
+    spread = 1.0 / float(np.min(dyn.law[kl.KAPPA]))
+    if spread > 1e6:  # contacts whose time scales differ that much make the impact stiff
+        options += (f"; the contacts' scaled force coefficients span {spread:.1e}, check the "
+                    "stiffness ratios")
     if status == kl.OUT_OF_STEPS:
         return IntegrationBudgetError(
             f"the LZB integration did not end within its budget of {budget} steps "
@@ -146,9 +150,10 @@ def _record(dyn: LZBDynamics, y: np.ndarray, P: np.ndarray, D: np.ndarray,
     """The record of a finished integration, in physical units."""
     s = dyn.scales
     kl.stored_energies(y, dyn.law, left)
-    with np.errstate(over="ignore", under="ignore"):
+    with np.errstate(over="ignore", under="ignore"):  # energies V²/g may leave the range
         return LZBRecord(
-            impulses=P * s.impulse, potential_energy=left * s.energy, dissipated=D * s.energy,
+            impulses=P * s.impulse, potential_energy=left * s.velocity * s.impulse,
+            dissipated=D * s.velocity * s.impulse,
             gamma=dyn.gamma(P) * s.velocity, primary_switches=int(istate[kl.SWITCHES]),
             primary_contacts=[int(k) for k in primaries], steps=int(istate[kl.STEPS]),
             evaluations=int(istate[kl.EVALUATIONS]), pieces=int(istate[kl.PIECES]),

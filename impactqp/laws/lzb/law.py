@@ -33,6 +33,8 @@ ENERGY_TARGET = 1e-10
 """Default ``energy_target``: adaptive integrations whose energy balance (docs/theory.md §13)
 misses it are repeated at a tolerance ten times tighter, down to MIN_RTOL."""
 MIN_RTOL = 1e-13
+MIN_EXPONENT, MAX_EXPONENT = 1.0, 3.0
+"""The compliance exponents the model accepts (docs/theory.md §13)."""
 TARGET_CONTACTS = 10
 """With an ``energy_target``, the first integration of an impact of m > TARGET_CONTACTS
 contacts runs at rtol·TARGET_CONTACTS/m (not below MIN_RTOL): its energy balance gathers
@@ -98,13 +100,17 @@ class LZB(ImpactLaw):
         Kᵢ > 0 of each contact's compliance Fᵢ = Kᵢδᵢ^ηᵢ (N/m^ηᵢ); a scalar for all
         contacts. :mod:`impactqp.model.physical_chains` computes Hertz stiffnesses.
     exponent : float or (m,) array_like
-        ηᵢ > 0: 3/2 for Hertz contact, 1 for a linear spring.
+        ηᵢ ∈ [1, 3]: 3/2 for Hertz contact, 1 for a linear spring (MIN_EXPONENT,
+        MAX_EXPONENT: below 1 the force is not Lipschitz at contact, which the model's
+        rates need; above 3 no contact law of the literature).
     restitution : float or (m,) array_like
         Energetic restitution eᵢ ∈ [0, 1]: expansion gives back eᵢ² of the energy stored
         in compression (1: elastic, 0: plastic).
     step : float, optional
         None (default): adaptive steps (DOP853) at relative tolerance ``rtol``. A positive
-        number: fixed Runge–Kutta steps of that length in the primary impulse (N·s).
+        finite number: fixed DOP853 steps of that length in the primary impulse (N·s); an
+        impact whose impulse scale needs more steps than the budget is refused
+        (:class:`~impactqp.errors.IntegrationBudgetError`, docs/theory.md §13).
     rtol : float
         Tolerance of the adaptive integration, in [1e-13, 1e-3].
     energy_target : float or None
@@ -128,7 +134,8 @@ class LZB(ImpactLaw):
                  step: float | None = None, *, rtol: float = DEFAULT_RTOL,
                  energy_target: float | None = ENERGY_TARGET) -> None:
         self.stiffness = _coefficients("stiffness", stiffness, low=0.0)
-        self.exponent = _coefficients("exponent", exponent, low=0.0)
+        self.exponent = _coefficients("exponent", exponent, low=MIN_EXPONENT,
+                                      high=MAX_EXPONENT, open_low=False)
         self.restitution = _coefficients("restitution", restitution, low=0.0, high=1.0,
                                          open_low=False, error=RestitutionError)
         self.step = None if step is None else as_real("step", step, positive=True)
