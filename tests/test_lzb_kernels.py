@@ -84,7 +84,7 @@ def test_rates_keep_the_energy_balance(k: int) -> None:
         m = dyn.m
         out, gamma = np.zeros(3 * m), np.empty(m)
         km.rates(x, k, live, m, *dyn.structure[:4], dyn.law, gamma, out)
-        y, eta = x[:m].copy(), dyn.eta
+        y, eta = x[:m].copy(), dyn.law[km.ETA]
         if k >= 0:
             y[k] = x[k] ** (1 / (eta[k] + 1))
         assert np.allclose(gamma, dyn.gamma(x[m:2 * m]), rtol=1e-14, atol=1e-14)

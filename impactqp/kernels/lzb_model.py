@@ -55,7 +55,6 @@ FIRST_STEP = 1e-7
 KAPPA, ETA, POWER, EXPANSION, PLASTIC = 0, 1, 2, 3, 4
 # the events that end a piece
 CLOSE, OPEN, PLASTIC_STOP, TURN, SWITCH, LOW, HIGH = 0, 1, 2, 3, 4, 5, 6
-EVENT_NAMES = ("close", "open", "plastic", "turn", "switch", "low", "high")
 # slots of ``istate`` (integers) and ``fstate`` (floats)
 NEXT, PRIMARY, IN_TIME, SWITCHES, PIECES, STEPS, EVALUATIONS = 0, 1, 2, 3, 4, 5, 6
 LEVEL, IMPULSE_VARIABLE, FIXED_STEP, ERROR = 0, 1, 2, 3

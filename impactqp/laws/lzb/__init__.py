@@ -4,10 +4,10 @@ compiled stepper of :mod:`impactqp.kernels.lzb` or scipy's reference (:mod:`.int
 and its certificate (:mod:`.certificate`)."""
 
 from .certificate import LZBCertificate, lzb_residuals
-from .dynamics import LZBDynamics, Scales, force_coefficient
+from .dynamics import LZBDynamics, Scales, log_force_coefficient
 from .integration import LZBRecord, integrate
 from .law import DEFAULT_RTOL, ENERGY_TARGET, LZB, MIN_RTOL, LZBAnswer
 
 __all__ = ["DEFAULT_RTOL", "ENERGY_TARGET", "LZB", "MIN_RTOL", "LZBAnswer", "LZBCertificate",
-           "LZBDynamics", "LZBRecord", "Scales", "force_coefficient", "integrate",
+           "LZBDynamics", "LZBRecord", "Scales", "integrate", "log_force_coefficient",
            "lzb_residuals"]

@@ -44,11 +44,6 @@ def log_force_coefficient(stiffness: np.ndarray, exponent: np.ndarray) -> np.nda
     return (exponent * np.log(exponent + 1.0) + np.log(stiffness)) / (exponent + 1.0)
 
 
-def force_coefficient(stiffness: np.ndarray, exponent: np.ndarray) -> np.ndarray:
-    """cᵢ = (ηᵢ + 1)^(ηᵢ/(ηᵢ+1)) Kᵢ^(1/(ηᵢ+1)) (:func:`log_force_coefficient`)."""
-    return np.exp(log_force_coefficient(stiffness, exponent))
-
-
 @dataclass(frozen=True)
 class Scales:
     """The units of the dimensionless variables: velocity V, Delassus g, impulse Π = V/g,
@@ -78,7 +73,7 @@ class LZBDynamics:
     gamma_minus : (m,) ndarray
         Pre-impact contact velocities; at least one negative.
     stiffness, exponent, restitution : (m,) ndarray
-        Kᵢ > 0, ηᵢ > 0, eᵢ ∈ [0, 1].
+        Kᵢ > 0, ηᵢ ∈ [1, 3], eᵢ ∈ [0, 1].
 
     Raises
     ------
@@ -100,8 +95,6 @@ class LZBDynamics:
         self.data = np.ascontiguousarray(G.data)
         self.gamma0 = gamma_minus / V
         self.m = gamma_minus.size
-        self.eta = exponent
-        self.restitution = restitution
         power = 1.0 / (exponent + 1.0)  # y = E^power
         # log κᵢ = log cᵢ + ηᵢ/(ηᵢ+1) log(VΠ), VΠ = V²/g, then divided by the largest
         log_energy = 2.0 * np.log(V) - np.log(g)
@@ -114,15 +107,9 @@ class LZBDynamics:
                              " such a contact never moves in this impact's units")
         expansion = np.divide(1.0, restitution ** 2, out=np.zeros(self.m),
                               where=restitution > 0)  # 1/e², unused when e = 0
-        self.plastic = restitution == 0
         self.law = np.empty((5, self.m))
         self.law[KAPPA], self.law[ETA], self.law[POWER] = kappa, exponent, power
-        self.law[EXPANSION], self.law[PLASTIC] = expansion, self.plastic
-
-    @property
-    def expansion(self) -> np.ndarray:
-        """1/eᵢ² per contact (0 where eᵢ = 0)."""
-        return self.law[EXPANSION]
+        self.law[EXPANSION], self.law[PLASTIC] = expansion, restitution == 0
 
     def gamma(self, P: np.ndarray) -> np.ndarray:
         """Contact velocities γ = γ⁻ + GP (dimensionless)."""
