@@ -78,7 +78,7 @@ class LZBRecord:
         ``"DOP853, rtol=…"`` or ``"fixed step …"`` (``", scipy"`` for the reference).
     error_estimate : float
         Sum over the accepted steps of the stepper's local error estimate, relative to
-        1 + |x| in the dimensionless variables (compiled stepper; the reference reports
+        1 + abs(x) in the dimensionless variables (compiled stepper; the reference reports
         rtol × steps): the integration error the certificate allows for (docs/theory.md §13).
     stored_dimensionless, left_dimensionless : float
         Σ(Eᵢ + Dᵢ) and ΣEᵢ at the end in units of VΠ: what the energy balance adds to T⁺
