@@ -153,3 +153,14 @@ def test_spent_budget_names_itself(monkeypatch, reference: bool) -> None:
     p = iq.newtons_cradle(3)
     with pytest.raises(IntegrationBudgetError, match="budget of 20 steps"):
         LZB(1e6).integrate(p, reference=reference)
+
+
+@pytest.mark.parametrize("reference", [False, True])
+def test_endless_elastic_impact_stops_within_its_budget(monkeypatch, reference: bool) -> None:
+    # one ball between two walls given as a general problem (check() sees no chain): an
+    # elastic impact bounces for ever, and the budget of pieces ends it with its cause
+    monkeypatch.setattr(lzb_integration, "MAX_PIECES", 200)
+    p = iq.ImpactProblem(np.eye(1), np.array([[1.0, -1.0]]), [-1.0])
+    with pytest.raises(IntegrationBudgetError, match=r"200 pieces .*T_C = \{0\}"):
+        LZB(1e6).integrate(p, reference=reference)
+    assert iq.solve(p, LZB(1e6, restitution=0.5)).certificate.ok  # dissipation ends it
