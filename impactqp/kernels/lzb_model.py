@@ -62,7 +62,7 @@ LEVEL, IMPULSE_VARIABLE, FIXED_STEP, ERROR = 0, 1, 2, 3
 DONE, OUT_OF_STEPS, OUT_OF_PIECES, STEP_TOO_SMALL = 0, 1, 2, 3
 
 
-def new_state(m: int) -> tuple[np.ndarray, np.ndarray]:
+def new_state() -> tuple[np.ndarray, np.ndarray]:
     """Fresh ``istate`` (no primary, no next primary, starting against time) and ``fstate``."""
     istate = np.zeros(7, dtype=np.int64)
     istate[NEXT] = -1

@@ -253,7 +253,7 @@ def integrate(dyn: LZBDynamics, *, rtol: float, step: float | None,
     m = dyn.m
     h, budget = _prepare(dyn, step)
     y, P, D, left = np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m)
-    istate, fstate = kl.new_state(m)
+    istate, fstate = kl.new_state()
     fstate[kl.FIXED_STEP] = h
     if reference:
         status, primaries = _reference(dyn, rtol, h, budget, y, P, D, left, istate, fstate)
