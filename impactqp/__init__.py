@@ -46,9 +46,7 @@ from .laws.catalogue import available_backends
 from .laws.certificate import Certificate, SectorLawCertificate
 from .laws.complementarity import Fremond, Newton
 from .laws.functions import fremond, moreau, newton, reflection_law, sector_law
-from .laws.lzb import LZB, LZBAnswer
-from .laws.lzb_certificate import LZBCertificate
-from .laws.lzb_integration import LZBRecord
+from .laws.lzb import LZB, LZBAnswer, LZBCertificate, LZBRecord
 from .laws.moreau import Moreau
 from .laws.pipeline import solve
 from .laws.reflection import ReflectionLaw

@@ -92,3 +92,8 @@ class SectorInputError(InputError):
 
 class SectorTableTooLarge(InputError):
     """The n! cones of the sector table are too many to enumerate (n_balls > 8)."""
+
+
+class IntegrationBudgetError(CertificateError):
+    """An integration (the LZB model's) would exceed or has spent its budget of steps; the
+    message says which budget, why, and what option to change."""

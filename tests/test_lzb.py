@@ -5,6 +5,8 @@ laws."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -88,6 +90,19 @@ def test_ten_ball_chain_matches_siconos_and_conserves() -> None:
     reference = hertz_chain_in_time(chain.masses, float(chain.stiffness[0]), 1.5,
                                     chain.problem.u_minus)
     assert np.abs(r.u_plus - reference).max() <= 1e-7
+
+
+def test_siconos_fixed_steps() -> None:
+    """Siconos' own step, 1e-6 N·s in the primary impulse (about 2·10⁵ steps), runs to the
+    same answer, and a coarser one certifies at the accuracy its steps reach."""
+    chain = monodisperse_chain(10, 0.01, density=7780, young=203e9, poisson=0.3)
+    adaptive = iq.solve(chain.problem, LZB(chain.stiffness)).u_plus
+    for step in (1e-6, 1e-4):
+        r = iq.solve(chain.problem, LZB(chain.stiffness, step=step))
+        assert r.certificate.ok and r.certificate.record.method == f"fixed step {step:g}"
+        assert np.abs(r.u_plus - adaptive).max() <= 1e-8
+        assert np.abs(r.u_plus - SICONOS_CHAIN_OF_BALLS).max() <= 1e-3
+    assert r.certificate.record.steps < 5_000
 
 
 # --------------------------------------------------------------------------- 3 balls
@@ -197,10 +212,24 @@ def test_general_impacts_and_batches() -> None:
 
 def test_failed_certificate_is_never_returned() -> None:
     p = iq.newtons_cradle(3)
-    law = LZB(1e6, step=0.02)  # coarse steps: energy off by ~1e-8
+
+    class Tampered(LZB):  # an integration whose answer loses energy it does not record
+        def closed_form(self, problem: iq.ImpactProblem) -> iq.LZBAnswer:
+            answer = self.integrate(problem)
+            return answer._replace(u_plus=answer.u_plus * (1 - 1e-6),
+                                   impulses=answer.impulses * (1 - 1e-6))
+
     with pytest.raises(iq.CertificateError, match="LZB"):
-        iq.solve(p, law, tol=1e-12)
-    assert iq.solve(p, law, tol=1e-6).certificate.ok
+        iq.solve(p, Tampered(1e6))
+    # coarse fixed steps: the integration's own error estimate sets the tolerance of the
+    # residuals it decides; with the estimate erased the same answer fails at tol = 1e-12
+    law = LZB(1e6, step=0.02)
+    r = iq.solve(p, law, tol=1e-12)
+    cert = r.certificate
+    assert cert.ok and cert.tol == 1e-12 and 1e-12 < cert.integration_tol <= 1e-5
+    assert 1e-12 < cert.energy_balance <= cert.integration_tol
+    erased = dataclasses.replace(cert.record, error_estimate=0.0)
+    assert not law.certificate(p, iq.LZBAnswer(r.u_plus, r.impulses, None, erased), tol=1e-12).ok
 
 
 def test_restrict_to_contacts() -> None:

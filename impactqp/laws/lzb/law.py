@@ -5,7 +5,7 @@ and an energetic restitution coefficient per contact (docs/theory.md §13).
 Unlike the rigid laws of docs/theory.md §3 and §6 the outcome depends on the contacts'
 stiffnesses and exponents: the model disperses the striker's energy along a chain as real
 chains of beads do. It is a closed-form law for the solve pipeline (``forms = ()``, backend
-``"lzb"``): its "solver" is the integration of :mod:`impactqp.laws.lzb_integration`, and its
+``"lzb"``): its "solver" is the integration of :mod:`impactqp.laws.lzb.integration`, and its
 certificate is recomputed from u⁺, Λ and the final state of that integration.
 """
 
@@ -15,16 +15,16 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..base.arrays import as_array, as_real, as_vector
-from ..base.checks import DEFAULT_TOL
-from ..errors import InputError, RestitutionError, ShapeError
-from ..model.problem import ImpactProblem
-from ..model.structure import ImpactStructure
-from .base import ImpactLaw
-from .certificate import as_residual
-from .lzb_certificate import LZBCertificate, lzb_residuals
-from .lzb_dynamics import LZBDynamics
-from .lzb_integration import LZBRecord, integrate
+from ...base.arrays import as_array, as_real, as_vector
+from ...base.checks import DEFAULT_TOL
+from ...errors import InputError, RestitutionError, ShapeError
+from ...model.problem import ImpactProblem
+from ...model.structure import ImpactStructure
+from ..base import ImpactLaw
+from ..certificate import as_residual
+from .certificate import LZBCertificate, integration_tolerance, lzb_residuals
+from .dynamics import LZBDynamics
+from .integration import LZBRecord, integrate
 
 DEFAULT_RTOL = 1e-12
 """Relative (and, in the dimensionless variables, absolute) tolerance of the adaptive
@@ -33,6 +33,18 @@ ENERGY_TARGET = 1e-10
 """Default ``energy_target``: adaptive integrations whose energy balance (docs/theory.md §13)
 misses it are repeated at a tolerance ten times tighter, down to MIN_RTOL."""
 MIN_RTOL = 1e-13
+MIN_EXPONENT, MAX_EXPONENT = 1.0, 3.0
+"""The compliance exponents the model accepts (docs/theory.md §13)."""
+TARGET_CONTACTS = 10
+"""With an ``energy_target``, the first integration of an impact of m > TARGET_CONTACTS
+contacts runs at rtol·TARGET_CONTACTS/m (not below MIN_RTOL): its energy balance gathers
+the error of every contact the wave crosses, and one integration at the tolerance that
+meets the target costs less than a missed one and its repetition."""
+
+
+def first_rtol(rtol: float, m: int) -> float:
+    """The tolerance of the first integration with an energy target (TARGET_CONTACTS)."""
+    return max(MIN_RTOL, min(rtol, rtol * TARGET_CONTACTS / max(m, 1)))
 
 
 def _per_contact(name: str, value: np.ndarray, m: int) -> np.ndarray:
@@ -88,13 +100,17 @@ class LZB(ImpactLaw):
         Kᵢ > 0 of each contact's compliance Fᵢ = Kᵢδᵢ^ηᵢ (N/m^ηᵢ); a scalar for all
         contacts. :mod:`impactqp.model.physical_chains` computes Hertz stiffnesses.
     exponent : float or (m,) array_like
-        ηᵢ > 0: 3/2 for Hertz contact, 1 for a linear spring.
+        ηᵢ ∈ [1, 3]: 3/2 for Hertz contact, 1 for a linear spring (MIN_EXPONENT,
+        MAX_EXPONENT: below 1 the force is not Lipschitz at contact, which the model's
+        rates need; above 3 no contact law of the literature).
     restitution : float or (m,) array_like
         Energetic restitution eᵢ ∈ [0, 1]: expansion gives back eᵢ² of the energy stored
         in compression (1: elastic, 0: plastic).
     step : float, optional
         None (default): adaptive steps (DOP853) at relative tolerance ``rtol``. A positive
-        number: fixed Runge–Kutta steps of that length in the primary impulse (N·s).
+        finite number: fixed DOP853 steps of that length in the primary impulse (N·s); an
+        impact whose impulse scale needs more steps than the budget is refused
+        (:class:`~impactqp.errors.IntegrationBudgetError`, docs/theory.md §13).
     rtol : float
         Tolerance of the adaptive integration, in [1e-13, 1e-3].
     energy_target : float or None
@@ -118,7 +134,8 @@ class LZB(ImpactLaw):
                  step: float | None = None, *, rtol: float = DEFAULT_RTOL,
                  energy_target: float | None = ENERGY_TARGET) -> None:
         self.stiffness = _coefficients("stiffness", stiffness, low=0.0)
-        self.exponent = _coefficients("exponent", exponent, low=0.0)
+        self.exponent = _coefficients("exponent", exponent, low=MIN_EXPONENT,
+                                      high=MAX_EXPONENT, open_low=False)
         self.restitution = _coefficients("restitution", restitution, low=0.0, high=1.0,
                                          open_low=False, error=RestitutionError)
         self.step = None if step is None else as_real("step", step, positive=True)
@@ -166,7 +183,8 @@ class LZB(ImpactLaw):
             raise InputError("the LZB model cannot end an elastic impact of a chain between "
                              "two walls (T_C = {0}); give some contact restitution < 1")
 
-    def integrate(self, problem: ImpactProblem, u_minus: Any = None) -> LZBAnswer:
+    def integrate(self, problem: ImpactProblem, u_minus: Any = None, *,
+                  reference: bool = False) -> LZBAnswer:
         """Run the LZB integration on ``problem`` (or on its M and W with ``u_minus``),
         without certificate (:func:`impactqp.solve` adds it).
 
@@ -175,6 +193,9 @@ class LZB(ImpactLaw):
         problem : ImpactProblem
         u_minus : (n,) array_like, optional
             Another pre-impact velocity for the same M and W.
+        reference : bool
+            Integrate with scipy's DOP853 piece by piece (the slow reference the compiled
+            stepper is tested against) instead of the compiled stepper.
 
         Returns
         -------
@@ -185,8 +206,10 @@ class LZB(ImpactLaw):
         ------
         ShapeError
             Coefficients or ``u_minus`` that do not fit the problem.
+        IntegrationBudgetError
+            A fixed ``step`` too small for this impact's budget of steps, or the budget spent.
         CertificateError
-            The integration failed or did not end within its budget.
+            The integration failed.
         """
         st = problem.structure
         u = problem.u_minus if u_minus is None else as_vector("u_minus", u_minus, st.n)
@@ -195,14 +218,15 @@ class LZB(ImpactLaw):
             return LZBAnswer(u.copy(), np.zeros(st.m), None, None)
         K, eta, e = self.contact_laws(st.m)
         dyn = LZBDynamics(st.delassus, gamma, K, eta, e)
-        rtol = self.rtol
+        rtol = self.rtol if self.energy_target is None else first_rtol(self.rtol, st.m)
         while True:
-            record = integrate(dyn, rtol=rtol, step=self.step)
+            record = integrate(dyn, rtol=rtol, step=self.step, reference=reference)
             u_plus = u + st.impulse_velocity(record.impulses)
             if self.step is not None or self.energy_target is None or rtol <= MIN_RTOL:
                 break
-            stored = np.sum(record.potential_energy) + np.sum(record.dissipated)
-            balance = lzb_residuals(st, u, u_plus, record.impulses, stored=stored)
+            balance = lzb_residuals(st, u, u_plus, record.impulses,
+                                    stored=record.stored_dimensionless,
+                                    energy_unit=record.energy_unit)
             if balance["energy_balance"] <= self.energy_target:
                 break
             rtol = max(rtol / 10.0, MIN_RTOL)
@@ -225,12 +249,16 @@ class LZB(ImpactLaw):
     def certificate(self, problem: ImpactProblem, answer: Any,
                     tol: float = DEFAULT_TOL) -> LZBCertificate:
         record = getattr(answer, "record", None)
-        left = 0.0 if record is None else float(np.sum(record.potential_energy))
-        lost = 0.0 if record is None else float(np.sum(record.dissipated))
+        if record is None:
+            res = lzb_residuals(problem.structure, problem.u_minus, answer.u_plus,
+                                answer.impulses)
+            return LZBCertificate(**{k: as_residual(v) for k, v in res.items()}, tol=tol,
+                                  integration_tol=tol)
         res = lzb_residuals(problem.structure, problem.u_minus, answer.u_plus,
-                            answer.impulses, stored=left + lost)
-        res["potential_left"] = 2.0 * left / problem.velocity_scale ** 2
+                            answer.impulses, stored=record.stored_dimensionless,
+                            left=record.left_dimensionless, energy_unit=record.energy_unit)
         return LZBCertificate(**{k: as_residual(v) for k, v in res.items()}, tol=tol,
+                              integration_tol=integration_tolerance(tol, record),
                               record=record)
 
     def __repr__(self) -> str:
