@@ -69,7 +69,9 @@ def test_z_is_always_in_S(p, eps):
     # classification of Moreau points: α = 0, dissipation = ε (when there is an impact)
     r = iq.moreau(p, eps)
     c = r.classification
-    if p.norm(r.z_perp) > 1e-6 * p.velocity_scale:
+    # dissipation is √(⟨u⁺ − z, u⁺ + z⟩/‖z⊥‖²): a round-off δ of u⁺ moves it by about
+    # √(δV)/‖z⊥‖ near ε = 0, so the 1e-6 check needs an impact that is not tiny against u⁻
+    if p.norm(r.z_perp) > 1e-3 * p.velocity_scale:
         assert c.alpha_deg < 1e-3
         assert abs(c.dissipation - eps) < 1e-6
 
