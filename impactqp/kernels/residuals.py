@@ -131,6 +131,14 @@ def dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, out, work):
     contact scales s and the law's E (m × m; for Moreau's law, ``moreau``, E = εI is used and
     E may be empty) into ``out`` (order :data:`RESIDUALS`); ``work`` is scratch of at least
     2n + 2m floats (a loop over impacts allocates nothing)."""
+    dense_step_residuals(M, Wt, MinvW, s, um, up, lam, um, E, eps, moreau, out, work)
+
+
+@kernel
+def dense_step_residuals(M, Wt, MinvW, s, um, up, lam, ur, E, eps, moreau, out, work):
+    """:func:`dense_residuals` with the restitution acting on the contact velocities of
+    ``ur`` instead of u⁻: w = γ⁺ + E Wᵀur. An impact has ur = u⁻; a Moreau–Jean step has
+    u⁻ = v_free and ur = v_k (``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k``, docs/theory.md §14)."""
     n, m = um.size, lam.size
     f = 1.0 / unit_of(um, up, lam)
     d = work[:n]
@@ -144,11 +152,11 @@ def dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, out, work):
         d[i] = total
     V = velocity_unit(_scaled_quadratic(M, um, um, f), _scaled_quadratic(M, up, up, f))
     momentum = np.sqrt(_high(_scaled_quadratic(M, d, d, 1.0), 0.0))
-    for i in range(m):  # γ⁻ and γ⁺
+    for i in range(m):  # γ⁻ (of ur) and γ⁺
         gm = 0.0
         gp = 0.0
         for j in range(n):
-            gm += Wt[i, j] * (um[j] * f)
+            gm += Wt[i, j] * (ur[j] * f)
             gp += Wt[i, j] * (up[j] * f)
         g[i] = gm
         w[i] = gp

@@ -1,0 +1,342 @@
+"""A whole Moreau–Jean run in compiled code (docs/theory.md §14, "The compiled loop").
+
+:func:`run` integrates a dense linear system with a constant or linear force and a
+complementarity law in its step form ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k ≥ 0``, step after step:
+
+1. closed contacts: gᵢ(q_k) + ½h γᵢ(v_k) ≤ 0;
+2. free velocity v_free = v_k − Ŵ⁻¹r_k (r_k of the force, Ŵ = M + h²θ²K factorized once);
+3. the closed contacts grouped into clusters (connected components of the graph whose edges
+   are the couplings of Ŵ and the bodies each closed contact touches, numbered by their
+   first degree of freedom, as :class:`impactqp.simulation.clusters.ClusterCache` does);
+   a cluster with q = γ(v_free) + Eγ(v_k) ≥ 0 needs no impulse; the others solve the LCP
+   ``0 ≤ Λ ⟂ G_cΛ + q ≥ 0`` by the active-set search
+   (:func:`impactqp.kernels.active_set.lcp_psd_work`, warm-started by the contacts' last
+   support), with G_c = H_cᵀŴ⁻¹H_c and Ŵ⁻¹H_c taken from the products of all contacts
+   formed once, and their certificate is recomputed by
+   :func:`impactqp.kernels.residuals.dense_step_residuals`;
+4. q_{k+1} = q_k + h((1 − θ)v_k + θv_{k+1}), and the kept rows are recorded.
+
+The kernel stops early, with the state of the last completed step, when a certificate fails
+(:data:`FAILED`: the caller solves that step on the general path and resumes) or when the
+event buffers are full (:data:`FULL`: the caller enlarges them and resumes).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .active_set import SOLVED, lcp_psd_work
+from .jit import kernel
+from .residuals import dense_step_residuals
+
+DONE, FAILED, FULL = 0, 1, 2
+"""Status codes of :func:`run`."""
+
+CHECKED = 4
+"""Residuals of the step law's certificate: momentum, impulse sign, law feasibility and
+complementarity (the first four of :data:`impactqp.kernels.residuals.RESIDUALS`)."""
+
+
+@kernel
+def _root(parent, i):
+    """The root of i in the union–find forest, halving the path on the way."""
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
+
+
+@kernel
+def _join(parent, a, b):
+    """Merge the sets of a and b; the smaller index becomes the root."""
+    ra = _root(parent, a)
+    rb = _root(parent, b)
+    if ra < rb:
+        parent[rb] = ra
+    elif rb < ra:
+        parent[ra] = rb
+
+
+@kernel
+def _free_velocity(v, q, chol, K, c, shift, h, theta, linear, out):
+    """v_free = v − shift (constant force: shift = Ŵ⁻¹r formed once) or, for the force
+    c − Kq, v − Ŵ⁻¹(hKq + h²θKv − hc) with Ŵ = LLᵀ (``chol`` = L), solved as LAPACK's
+    potrs does (forward, then backward substitution)."""
+    n = v.size
+    if not linear:
+        for i in range(n):
+            out[i] = v[i] - shift[i]
+        return
+    y = np.empty(n)
+    for i in range(n):
+        kq = 0.0
+        kv = 0.0
+        for j in range(n):
+            kq += K[i, j] * q[j]
+            kv += K[i, j] * v[j]
+        total = h * kq + (h * h * theta) * kv - h * c[i]
+        for j in range(i):
+            total -= chol[i, j] * y[j]
+        y[i] = total / chol[i, i]
+    for i in range(n - 1, -1, -1):
+        total = y[i]
+        for j in range(i + 1, n):
+            total -= chol[j, i] * y[j]
+        y[i] = total / chol[i, i]
+    for i in range(n):
+        out[i] = v[i] - y[i]
+
+
+@kernel
+def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, chol,
+        K, c, shift, linear, MinvH, G, s, E, couple_a, couple_b, passive, tol, kept, Q, V, L,
+        keep, ev_head, ev_res, ev_dofs, ev_contacts, ev_um, ev_up, ev_vp, ev_lam, counts):
+    """Steps k_first … k_stop − 1 of a Moreau–Jean run (module docstring), in place.
+
+    Parameters
+    ----------
+    q, v : (n,) float arrays
+        The state at step k_first; on return, the state after the last completed step.
+    k_first, k_stop, row : int
+        First step, step to stop before, next record row.
+    h, theta : float
+        Step and θ.
+    Ht_ptr, Ht_idx, Ht_val : arrays
+        Hᵀ in compressed rows (contact i acts on dofs Ht_idx[Ht_ptr[i]:Ht_ptr[i + 1]]).
+    b : (m,) float array
+        Gap offsets.
+    Wh, chol : (n, n) float arrays
+        Ŵ and its lower Cholesky factor (used with ``linear``).
+    K, c : (n, n), (n,) float arrays
+        The linear force c − Kq (with ``linear``).
+    shift : (n,) float array
+        Ŵ⁻¹r of a constant force (without ``linear``).
+    linear : bool
+        The force is c − Kq.
+    MinvH, G, s : (n, m), (m, m), (m,) float arrays
+        Ŵ⁻¹H, HᵀŴ⁻¹H and sᵢ = √Gᵢᵢ of all contacts.
+    E : (m, m) float array
+        The step law's restitution over all contacts.
+    couple_a, couple_b : int arrays
+        Pairs of degrees of freedom that Ŵ couples.
+    passive : (m,) bool array
+        Warm start of the LCP searches (each contact's last support), updated.
+    tol : float
+        Tolerance of every residual.
+    kept : int array
+        Step numbers of the record rows; Q, V, L receive them.
+    keep : bool
+        Record every solved cluster in the ev_* buffers.
+    ev_head : (E, 4) int array
+        Per recorded cluster: step number k + 1, first entry in the dof buffers, first entry in
+        the contact buffers, number of contacts (dofs end where the next cluster's start).
+    ev_res : (E, 4) float array
+        Its residuals.
+    ev_dofs, ev_um, ev_up, ev_vp : int and float arrays
+        Its degrees of freedom, v_free, v_{k+1} and v_k on them.
+    ev_contacts, ev_lam : int and float arrays
+        Its contacts and impulses.
+    counts : (3,) int array
+        Used entries of (ev_head, dof buffers, contact buffers), updated.
+
+    Returns
+    -------
+    (int, int, int)
+        Status (:data:`DONE`, :data:`FAILED`, :data:`FULL`), the first step not done, the
+        next record row.
+    """
+    n, m = v.size, b.size
+    vf = np.empty(n)
+    gk = np.empty(m)
+    vn = np.empty(n)
+    lam_all = np.zeros(m)
+    closed = np.zeros(m, dtype=np.bool_)
+    parent = np.empty(n, dtype=np.int64)
+    cluster_of = np.empty(n, dtype=np.int64)
+    n_of = np.zeros(n + 1, dtype=np.int64)
+    m_of = np.zeros(n + 1, dtype=np.int64)
+    dofs = np.empty(n, dtype=np.int64)
+    cons = np.empty(m, dtype=np.int64)
+    um = np.empty(n)
+    up = np.empty(n)
+    vp = np.empty(n)
+    Mc = np.empty(n * n)
+    Wt = np.empty(m * n)
+    MW = np.empty(n * m)
+    Gc = np.empty(m * m)
+    Ec = np.empty(m * m)
+    sc = np.empty(m)
+    qc = np.empty(m)
+    lam = np.empty(m)
+    w = np.empty(m)
+    pas = np.empty(m, dtype=np.bool_)
+    Lf = np.empty((m, m))
+    idx = np.empty(m, dtype=np.int64)
+    sv = np.empty(m)
+    blocked = np.empty(m, dtype=np.bool_)
+    res = np.empty(6)
+    work = np.empty(2 * n + 2 * m)
+    for k in range(k_first, k_stop):
+        if keep and (counts[0] + n > ev_head.shape[0] or counts[1] + n > ev_dofs.size
+                     or counts[2] + m > ev_contacts.size):
+            return FULL, k, row
+        start = (counts[0], counts[1], counts[2])
+        any_closed = False
+        for i in range(m):  # 1. g(q_k) + h/2 γ(v_k) ≤ 0
+            g = 0.0
+            gam = 0.0
+            for p in range(Ht_ptr[i], Ht_ptr[i + 1]):
+                g += Ht_val[p] * q[Ht_idx[p]]
+                gam += Ht_val[p] * v[Ht_idx[p]]
+            closed[i] = g + b[i] + (0.5 * h) * gam <= 0.0
+            gk[i] = gam
+            any_closed |= closed[i]
+            lam_all[i] = 0.0
+        _free_velocity(v, q, chol, K, c, shift, h, theta, linear, vf)  # 2.
+        for i in range(n):
+            vn[i] = vf[i]
+        if any_closed:  # 3. clusters: dofs joined by Ŵ and by the closed contacts
+            for i in range(n):
+                parent[i] = i
+            for p in range(couple_a.size):
+                _join(parent, couple_a[p], couple_b[p])
+            for i in range(m):
+                if closed[i]:
+                    for p in range(Ht_ptr[i] + 1, Ht_ptr[i + 1]):
+                        _join(parent, Ht_idx[Ht_ptr[i]], Ht_idx[p])
+            for i in range(n):
+                cluster_of[i] = -1
+            n_cl = 0
+            for i in range(n):  # clusters in the order of their first dof
+                r = _root(parent, i)
+                if r == i:
+                    cluster_of[i] = -2  # a root; numbered when a closed contact touches it
+            for i in range(m):
+                if closed[i]:
+                    r = _root(parent, Ht_idx[Ht_ptr[i]])
+                    cluster_of[r] = -3
+            for i in range(n):
+                if cluster_of[i] == -3:
+                    cluster_of[i] = n_cl
+                    n_cl += 1
+            for a in range(n_cl + 1):
+                n_of[a] = 0
+                m_of[a] = 0
+            for i in range(n):  # counting sort of dofs and contacts by cluster
+                a = cluster_of[_root(parent, i)]
+                if a >= 0:
+                    n_of[a + 1] += 1
+            for i in range(m):
+                if closed[i]:
+                    m_of[cluster_of[_root(parent, Ht_idx[Ht_ptr[i]])] + 1] += 1
+            for a in range(n_cl):
+                n_of[a + 1] += n_of[a]
+                m_of[a + 1] += m_of[a]
+            fill_n = n_of[:n_cl].copy()
+            fill_m = m_of[:n_cl].copy()
+            for i in range(n):
+                a = cluster_of[_root(parent, i)]
+                if a >= 0:
+                    dofs[fill_n[a]] = i
+                    fill_n[a] += 1
+            for i in range(m):
+                if closed[i]:
+                    a = cluster_of[_root(parent, Ht_idx[Ht_ptr[i]])]
+                    cons[fill_m[a]] = i
+                    fill_m[a] += 1
+            for a in range(n_cl):
+                D = dofs[n_of[a]:n_of[a + 1]]
+                C = cons[m_of[a]:m_of[a + 1]]
+                nc, mc = D.size, C.size
+                for x in range(nc):
+                    um[x] = vf[D[x]]
+                    vp[x] = v[D[x]]
+                need = False
+                for x in range(mc):  # q = γ(v_free) + Eγ(v_k)
+                    i = C[x]
+                    total = 0.0
+                    for p in range(Ht_ptr[i], Ht_ptr[i + 1]):
+                        total += Ht_val[p] * vf[Ht_idx[p]]
+                    restitution = 0.0
+                    for y in range(mc):
+                        restitution += E[i, C[y]] * gk[C[y]]
+                    total += restitution
+                    qc[x] = total
+                    need |= total < 0.0
+                if not need:
+                    continue
+                Mv = Mc[:nc * nc].reshape((nc, nc))
+                Wv = Wt[:mc * nc].reshape((mc, nc))
+                Xv = MW[:nc * mc].reshape((nc, mc))
+                Gv = Gc[:mc * mc].reshape((mc, mc))
+                Ev = Ec[:mc * mc].reshape((mc, mc))
+                for x in range(nc):
+                    for y in range(nc):
+                        Mv[x, y] = Wh[D[x], D[y]]
+                    for y in range(mc):
+                        Xv[x, y] = MinvH[D[x], C[y]]
+                for x in range(mc):
+                    for y in range(nc):
+                        Wv[x, y] = 0.0
+                    sc[x] = s[C[x]]
+                    pas[x] = passive[C[x]]
+                    for y in range(mc):
+                        Gv[x, y] = G[C[x], C[y]]
+                        Ev[x, y] = E[C[x], C[y]]
+                for x in range(mc):
+                    i = C[x]
+                    for p in range(Ht_ptr[i], Ht_ptr[i + 1]):
+                        for y in range(nc):
+                            if D[y] == Ht_idx[p]:
+                                Wv[x, y] = Ht_val[p]
+                status = lcp_psd_work(Gv, qc[:mc], pas[:mc], lam[:mc], w[:mc], 20 * mc + 50,
+                                      Lf, idx, sv, blocked)
+                if status != SOLVED:
+                    counts[0], counts[1], counts[2] = start
+                    return FAILED, k, row
+                for x in range(nc):
+                    total = um[x]
+                    for y in range(mc):
+                        total += Xv[x, y] * lam[y]
+                    up[x] = total
+                dense_step_residuals(Mv, Wv, Xv, sc[:mc], um[:nc], up[:nc], lam[:mc],
+                                     vp[:nc], Ev, 0.0, False, res, work)
+                for x in range(CHECKED):
+                    if not res[x] <= tol:  # NaN fails
+                        counts[0], counts[1], counts[2] = start
+                        return FAILED, k, row
+                for x in range(mc):
+                    passive[C[x]] = pas[x]
+                    lam_all[C[x]] = lam[x]
+                for x in range(nc):
+                    vn[D[x]] = up[x]
+                if keep:
+                    e = counts[0]
+                    ev_head[e, 0] = k + 1
+                    ev_head[e, 1] = counts[1]
+                    ev_head[e, 2] = counts[2]
+                    ev_head[e, 3] = mc
+                    for x in range(CHECKED):
+                        ev_res[e, x] = res[x]
+                    for x in range(nc):
+                        ev_dofs[counts[1] + x] = D[x]
+                        ev_um[counts[1] + x] = um[x]
+                        ev_up[counts[1] + x] = up[x]
+                        ev_vp[counts[1] + x] = vp[x]
+                    for x in range(mc):
+                        ev_contacts[counts[2] + x] = C[x]
+                        ev_lam[counts[2] + x] = lam[x]
+                    counts[0] += 1
+                    counts[1] += nc
+                    counts[2] += mc
+        for i in range(n):  # 4. q_{k+1}, v_{k+1}
+            q[i] = q[i] + h * ((1.0 - theta) * v[i] + theta * vn[i])
+            v[i] = vn[i]
+        if row < kept.size and kept[row] == k + 1:
+            for i in range(n):
+                Q[row, i] = q[i]
+                V[row, i] = v[i]
+            for i in range(m):
+                L[row, i] = lam_all[i]
+            row += 1
+    return DONE, k_stop, row
