@@ -58,16 +58,15 @@ def _join(parent, a, b):
 
 
 @kernel
-def _free_velocity(v, q, chol, K, c, shift, h, theta, linear, out):
+def _free_velocity(v, q, chol, K, c, shift, h, theta, linear, out, y):
     """v_free = v − shift (constant force: shift = Ŵ⁻¹r formed once) or, for the force
     c − Kq, v − Ŵ⁻¹(hKq + h²θKv − hc) with Ŵ = LLᵀ (``chol`` = L), solved as LAPACK's
-    potrs does (forward, then backward substitution)."""
+    potrs does (forward, then backward substitution; ``y`` is scratch of n floats)."""
     n = v.size
     if not linear:
         for i in range(n):
             out[i] = v[i] - shift[i]
         return
-    y = np.empty(n)
     for i in range(n):
         kq = 0.0
         kv = 0.0
@@ -149,12 +148,15 @@ def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, cho
     vf = np.empty(n)
     gk = np.empty(m)
     vn = np.empty(n)
+    scratch = np.empty(n)
     lam_all = np.zeros(m)
     closed = np.zeros(m, dtype=np.bool_)
     parent = np.empty(n, dtype=np.int64)
     cluster_of = np.empty(n, dtype=np.int64)
     n_of = np.zeros(n + 1, dtype=np.int64)
     m_of = np.zeros(n + 1, dtype=np.int64)
+    fill_n = np.empty(n, dtype=np.int64)
+    fill_m = np.empty(n, dtype=np.int64)
     dofs = np.empty(n, dtype=np.int64)
     cons = np.empty(m, dtype=np.int64)
     um = np.empty(n)
@@ -192,7 +194,7 @@ def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, cho
             gk[i] = gam
             any_closed |= closed[i]
             lam_all[i] = 0.0
-        _free_velocity(v, q, chol, K, c, shift, h, theta, linear, vf)  # 2.
+        _free_velocity(v, q, chol, K, c, shift, h, theta, linear, vf, scratch)  # 2.
         for i in range(n):
             vn[i] = vf[i]
         if any_closed:  # 3. clusters: dofs joined by Ŵ and by the closed contacts
@@ -232,8 +234,9 @@ def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, cho
             for a in range(n_cl):
                 n_of[a + 1] += n_of[a]
                 m_of[a + 1] += m_of[a]
-            fill_n = n_of[:n_cl].copy()
-            fill_m = m_of[:n_cl].copy()
+            for a in range(n_cl):
+                fill_n[a] = n_of[a]
+                fill_m[a] = m_of[a]
             for i in range(n):
                 a = cluster_of[_root(parent, i)]
                 if a >= 0:

@@ -235,25 +235,30 @@ class _CompiledLoop:
                         np.ascontiguousarray(pairs[:, 0], dtype=np.int64),
                         np.ascontiguousarray(pairs[:, 1], dtype=np.int64))
         self.passive = np.zeros(m, dtype=bool)
-        size = 64 if keep else 0
-        self.buffers = self._buffers(size, size * max(n, 1), size * max(m, 1))
+        self.buffers = self._buffers(*(self._room(0, 0, 0) if keep else (0, 0, 0)))
         self.counts = np.zeros(3, dtype=np.int64)
         self.pieces: list[tuple[int, int] | list[ImpactEvent]] = []
 
     @staticmethod
     def _buffers(events: int, dofs: int, contacts: int) -> tuple[np.ndarray, ...]:
-        """(head, residuals, dofs, contacts, u⁻, u⁺, v_k, Λ) of ``events`` recorded clusters."""
-        return (np.zeros((events, 4), dtype=np.int64), np.zeros((events, CHECKED)),
-                np.zeros(dofs, dtype=np.int64), np.zeros(contacts, dtype=np.int64),
-                np.zeros(dofs), np.zeros(dofs), np.zeros(dofs), np.zeros(contacts))
+        """(head, residuals, dofs, contacts, u⁻, u⁺, v_k, Λ) of ``events`` recorded clusters
+        on ``dofs`` degrees of freedom and ``contacts`` contacts in all."""
+        return (np.empty((events, 4), dtype=np.int64), np.empty((events, CHECKED)),
+                np.empty(dofs, dtype=np.int64), np.empty(contacts, dtype=np.int64),
+                np.empty(dofs), np.empty(dofs), np.empty(dofs), np.empty(contacts))
+
+    def _room(self, events: int, dofs: int, contacts: int) -> tuple[int, int, int]:
+        """Buffer sizes for twice what is used plus one step's worst case (a cluster per
+        degree of freedom, every dof and contact in some cluster) and some slack."""
+        n, m = self.system.n_dof, self.system.n_contacts
+        return 2 * events + n + 64, 2 * dofs + n + 256, 2 * contacts + m + 256
 
     def _grow(self) -> None:
-        """Twice the room in every event buffer, keeping what is recorded."""
-        old = self.buffers
-        new = self._buffers(2 * old[0].shape[0] + 64, 2 * old[2].size + 64 * self.system.n_dof,
-                            2 * old[3].size + 64 * self.system.n_contacts)
-        for a, b in zip(old, new):
-            b[:a.shape[0]] = a
+        """More room in every event buffer (:meth:`_room`), keeping what is recorded."""
+        e, d, c = (int(x) for x in self.counts)
+        new = self._buffers(*self._room(e, d, c))
+        for a, b, used in zip(self.buffers, new, (e, e, d, c, d, d, d, c)):
+            b[:used] = a[:used]
         self.buffers = new
 
     def run(self, steps: int, kept: np.ndarray, Q: np.ndarray, V: np.ndarray, L: np.ndarray,
