@@ -208,17 +208,12 @@ def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, cho
                         _join(parent, Ht_idx[Ht_ptr[i]], Ht_idx[p])
             for i in range(n):
                 cluster_of[i] = -1
-            n_cl = 0
-            for i in range(n):  # clusters in the order of their first dof
-                r = _root(parent, i)
-                if r == i:
-                    cluster_of[i] = -2  # a root; numbered when a closed contact touches it
-            for i in range(m):
+            for i in range(m):  # roots (each component's first dof) with a closed contact
                 if closed[i]:
-                    r = _root(parent, Ht_idx[Ht_ptr[i]])
-                    cluster_of[r] = -3
-            for i in range(n):
-                if cluster_of[i] == -3:
+                    cluster_of[_root(parent, Ht_idx[Ht_ptr[i]])] = -2
+            n_cl = 0
+            for i in range(n):  # numbered in the order of their first dof
+                if cluster_of[i] == -2:
                     cluster_of[i] = n_cl
                     n_cl += 1
             for a in range(n_cl + 1):
