@@ -304,7 +304,7 @@ class _CompiledLoop:
         the step law on it and the certificate of the residuals the kernel checked."""
         head, res, dofs, contacts, um, up, vp, lam = self.buffers
         ends = np.append(head[1:int(self.counts[0]), 1], self.counts[1])
-        cache = ClusterCache(self.free.metric, self.system.H, self.system.chain)
+        cache = self.step.solver.cache  # the structures of the Python loop's steps
         closed = np.zeros(self.system.n_contacts, dtype=bool)
         names = RESIDUALS[:CHECKED]
         out: list[ImpactEvent] = []
