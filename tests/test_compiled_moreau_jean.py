@@ -13,7 +13,7 @@ from test_simulation import SICONOS_BOUNCING_BALL
 
 import impactqp as iq
 from impactqp.errors import InputError
-from impactqp.kernels.residuals import RESIDUALS, dense_step_residuals
+from impactqp.kernels.residuals import RESIDUALS, chain_step_residuals, dense_step_residuals
 from impactqp.simulation import time_stepping
 from impactqp.simulation.step_law import MoreauJeanStep
 from impactqp.simulation.time_stepping import compiled_applies, moreau_jean
@@ -141,9 +141,11 @@ def _corrupt(monkeypatch, which: int) -> None:
 
 @pytest.mark.parametrize("which", [0, 1], ids=["Minv_H", "delassus"])
 def test_a_corrupted_compiled_step_is_solved_again_by_the_python_loop(monkeypatch, which):
-    slow = _run("beads10", "newton", 0.5, False)
+    # one coefficient per contact: the LCP search path (one coefficient on a chain takes
+    # the isotonic projection, which reads neither array)
+    slow = _run("beads10", "newton-per-contact", 0.5, False)
     _corrupt(monkeypatch, which)
-    fast = _run.__wrapped__("beads10", "newton", 0.5, True)
+    fast = _run.__wrapped__("beads10", "newton-per-contact", 0.5, True)
     assert fast.settings["loop"] == "compiled"
     _close(fast.q, slow.q)
     _close(fast.v, slow.v)
@@ -256,3 +258,25 @@ def test_coupled_dense_system(law, linear):
         assert a.time == b.time
         np.testing.assert_array_equal(a.dofs, b.dofs)
         np.testing.assert_array_equal(a.contacts, b.contacts)
+
+
+@pytest.mark.parametrize("walls", [(True, False), (False, False), (True, True)])
+def test_chain_step_residuals_are_the_step_law_certificate(walls):
+    # the chain pass with the restitution on γ_k against the step law's own certificate,
+    # on a right and on a wrong answer of a step of a chain
+    rng = np.random.default_rng(7)
+    left, right = walls
+    problem = iq.chain(rng.uniform(0.5, 2.0, 6), rng.normal(size=6), left_wall=left,
+                       right_wall=right)
+    st, e = problem.structure, 0.7
+    law = MoreauJeanStep(e, rng.normal(size=6))
+    result = iq.solve(problem, law)
+    masses = st.chain.masses
+    for up, ok in ((result.u_plus, True), (result.u_plus + 1e-3, False)):
+        out = np.empty(6)
+        chain_step_residuals(problem.u_minus, up, result.impulses, law.v_previous, masses,
+                             1.0 / masses, st.contact_scale, left, right, e, 0.0, False, out)
+        theirs = law.residuals(st, problem.u_minus, up, result.impulses)
+        for i, name in enumerate(RESIDUALS[:4]):
+            assert out[i] == pytest.approx(float(theirs[name]), rel=1e-9, abs=1e-15)
+        assert (max(out[:4]) <= 1e-9) == ok

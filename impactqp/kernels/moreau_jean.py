@@ -5,15 +5,18 @@ complementarity law in its step form ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k ≥ 0``, st
 
 1. closed contacts: gᵢ(q_k) + ½h γᵢ(v_k) ≤ 0;
 2. free velocity v_free = v_k − Ŵ⁻¹r_k (r_k of the force, Ŵ = M + h²θ²K factorized once);
-3. the closed contacts grouped into clusters (connected components of the graph whose edges
-   are the couplings of Ŵ and the bodies each closed contact touches, numbered by their
-   first degree of freedom, as :class:`impactqp.simulation.clusters.ClusterCache` does);
+3. the closed contacts grouped into clusters by :func:`impactqp.kernels.clusters.group`
+   (as :class:`impactqp.simulation.clusters.ClusterCache` groups them);
    a cluster with q = γ(v_free) + Eγ(v_k) ≥ 0 needs no impulse; the others solve the LCP
    ``0 ≤ Λ ⟂ G_cΛ + q ≥ 0`` by the active-set search
    (:func:`impactqp.kernels.active_set.lcp_psd_work`, warm-started by the contacts' last
    support), with G_c = H_cᵀŴ⁻¹H_c and Ŵ⁻¹H_c taken from the products of all contacts
    formed once, and their certificate is recomputed by
-   :func:`impactqp.kernels.residuals.dense_step_residuals`;
+   :func:`impactqp.kernels.residuals.dense_step_residuals`; on a chain of balls with one
+   restitution e (what the isotonic path of the Python loop takes) a run is instead
+   z = prox_{T_C}(v_free + e v_k) by :func:`impactqp.kernels.chain.project`,
+   v_{k+1} = z − e v_k, certified by :func:`impactqp.kernels.residuals.chain_step_residuals`
+   in O(N);
 4. q_{k+1} = q_k + h((1 − θ)v_k + θv_{k+1}), and the kept rows are recorded.
 
 The kernel stops early, with the state of the last completed step, when a certificate fails
@@ -26,8 +29,10 @@ from __future__ import annotations
 import numpy as np
 
 from .active_set import SOLVED, lcp_psd_work
+from .chain import project
+from .clusters import group, group_work
 from .jit import kernel
-from .residuals import dense_step_residuals
+from .residuals import chain_step_residuals, dense_step_residuals
 
 DONE, FAILED, FULL = 0, 1, 2
 """Status codes of :func:`run`."""
@@ -35,26 +40,6 @@ DONE, FAILED, FULL = 0, 1, 2
 CHECKED = 4
 """Residuals of the step law's certificate: momentum, impulse sign, law feasibility and
 complementarity (the first four of :data:`impactqp.kernels.residuals.RESIDUALS`)."""
-
-
-@kernel
-def _root(parent, i):
-    """The root of i in the union–find forest, halving the path on the way."""
-    while parent[i] != i:
-        parent[i] = parent[parent[i]]
-        i = parent[i]
-    return i
-
-
-@kernel
-def _join(parent, a, b):
-    """Merge the sets of a and b; the smaller index becomes the root."""
-    ra = _root(parent, a)
-    rb = _root(parent, b)
-    if ra < rb:
-        parent[rb] = ra
-    elif rb < ra:
-        parent[ra] = rb
 
 
 @kernel
@@ -87,9 +72,106 @@ def _free_velocity(v, q, chol, K, c, shift, h, theta, linear, out, y):
 
 
 @kernel
-def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, chol,
-        K, c, shift, linear, MinvH, G, s, E, couple_a, couple_b, passive, tol, kept, Q, V, L,
-        keep, ev_head, ev_res, ev_dofs, ev_contacts, ev_um, ev_up, ev_vp, ev_lam, counts):
+def _dense_work(n, m):
+    """Scratch of :func:`_solve_dense` for clusters of up to n dofs and m contacts."""
+    return (np.empty(n * n), np.empty(m * n), np.empty(n * m), np.empty(m * m),
+            np.empty(m * m), np.empty(m), np.empty(m), np.empty(m, dtype=np.bool_),
+            np.empty((m, m)), np.empty(m, dtype=np.int64), np.empty(m),
+            np.empty(m, dtype=np.bool_))
+
+
+@kernel
+def _chain_work(n):
+    """Scratch of :func:`_solve_chain` for runs of up to n balls."""
+    return np.empty(n + 1), np.empty(n), np.empty(n + 1), np.empty(n + 1, dtype=np.int64)
+
+
+@kernel
+def _solve_dense(D, C, um, vp, up, lam, qc, Wh, MinvH, G, s, E, Ht_ptr, Ht_idx, Ht_val,
+                 passive, tol, dense_work, res, work):
+    """One cluster (dofs D, contacts C, u⁻ = um, v_k = vp on D, q = qc) by the active-set
+    search on G_CC, u⁺ = u⁻ + (Ŵ⁻¹H)_DC Λ and the dense certificate; True when certified
+    (then ``passive`` keeps the support)."""
+    nc, mc = D.size, C.size
+    Mc, Wt, MW, Gc, Ec, sc, w, pas, Lf, idx, sv, blocked = dense_work
+    Mv = Mc[:nc * nc].reshape((nc, nc))
+    Wv = Wt[:mc * nc].reshape((mc, nc))
+    Xv = MW[:nc * mc].reshape((nc, mc))
+    Gv = Gc[:mc * mc].reshape((mc, mc))
+    Ev = Ec[:mc * mc].reshape((mc, mc))
+    for x in range(nc):
+        for y in range(nc):
+            Mv[x, y] = Wh[D[x], D[y]]
+        for y in range(mc):
+            Xv[x, y] = MinvH[D[x], C[y]]
+    for x in range(mc):
+        for y in range(nc):
+            Wv[x, y] = 0.0
+        sc[x] = s[C[x]]
+        pas[x] = passive[C[x]]
+        for y in range(mc):
+            Gv[x, y] = G[C[x], C[y]]
+            Ev[x, y] = E[C[x], C[y]]
+    for x in range(mc):
+        i = C[x]
+        for p in range(Ht_ptr[i], Ht_ptr[i + 1]):
+            for y in range(nc):
+                if D[y] == Ht_idx[p]:
+                    Wv[x, y] = Ht_val[p]
+    if lcp_psd_work(Gv, qc[:mc], pas[:mc], lam[:mc], w[:mc], 20 * mc + 50, Lf, idx, sv,
+                    blocked) != SOLVED:
+        return False
+    for x in range(nc):
+        total = um[x]
+        for y in range(mc):
+            total += Xv[x, y] * lam[y]
+        up[x] = total
+    dense_step_residuals(Mv, Wv, Xv, sc[:mc], um[:nc], up[:nc], lam[:mc], vp[:nc], Ev, 0.0,
+                         False, res, work)
+    for x in range(CHECKED):
+        if not res[x] <= tol:  # NaN fails
+            return False
+    for x in range(mc):
+        passive[C[x]] = pas[x]
+    return True
+
+
+@kernel
+def _solve_chain(D, C, um, vp, up, lam, s, masses, inverse, left, right, e, tol, chain_work,
+                 res):
+    """One run of a chain (balls D, contacts C) with one restitution e, as the isotonic path
+    solves it (docs/theory.md §14): z = prox_{T_C}(u⁻ + e v_k) by
+    :func:`impactqp.kernels.chain.project`, u⁺ = z − e v_k, and the chain certificate;
+    True when certified."""
+    nc, mc = D.size, C.size
+    shifted, z, L, starts = chain_work
+    first = D[0]
+    for x in range(nc):
+        shifted[x] = um[x] + e * vp[x]
+    weight = up  # scratch until u⁺ is formed
+    project(masses[first:first + nc], shifted[:nc], left, right, z[:nc], L[:nc + 1],
+            starts[:nc + 1], weight[:nc])
+    lo = 0 if left else 1
+    for x in range(mc):
+        lam[x] = L[lo + x]
+    for x in range(nc):
+        up[x] = z[x] - e * vp[x]
+    sc = shifted  # scratch again: the contact scales of the run
+    for x in range(mc):
+        sc[x] = s[C[x]]
+    chain_step_residuals(um[:nc], up[:nc], lam[:mc], vp[:nc], masses[first:first + nc],
+                         inverse[first:first + nc], sc[:mc], left, right, e, 0.0, False, res)
+    for x in range(CHECKED):
+        if not res[x] <= tol:  # NaN fails
+            return False
+    return True
+
+
+@kernel
+def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, chol, K, c,
+        shift, linear, MinvH, G, s, E, diagonal, couple_a, couple_b, passive, chain, masses,
+        inverse, left_wall, right_wall, e_chain, tol, kept, Q, V, L, keep, ev_head, ev_res,
+        ev_dofs, ev_contacts, ev_um, ev_up, ev_vp, ev_lam, counts):
     """Steps k_first … k_stop − 1 of a Moreau–Jean run (module docstring), in place.
 
     Parameters
@@ -116,10 +198,22 @@ def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, cho
         Ŵ⁻¹H, HᵀŴ⁻¹H and sᵢ = √Gᵢᵢ of all contacts.
     E : (m, m) float array
         The step law's restitution over all contacts.
+    diagonal : bool
+        E is diagonal (Moreau, Newton): Eγ_k needs no sum over the cluster.
     couple_a, couple_b : int arrays
         Pairs of degrees of freedom that Ŵ couples.
     passive : (m,) bool array
         Warm start of the LCP searches (each contact's last support), updated.
+    chain : bool
+        A chain of balls (docs/theory.md §5) with diagonal Ŵ and one restitution
+        ``e_chain``: every cluster is a run of balls, solved by the isotonic projection
+        (:func:`_solve_chain`) instead of the LCP search.
+    masses, inverse : (n,) float arrays
+        With ``chain``: the diagonal of Ŵ and its inverse.
+    left_wall, right_wall : bool
+        With ``chain``: the chain's walls (first and last contacts).
+    e_chain : float
+        With ``chain``: the restitution.
     tol : float
         Tolerance of every residual.
     kept : int array
@@ -151,31 +245,18 @@ def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, cho
     scratch = np.empty(n)
     lam_all = np.zeros(m)
     closed = np.zeros(m, dtype=np.bool_)
-    parent = np.empty(n, dtype=np.int64)
-    cluster_of = np.empty(n, dtype=np.int64)
+    cluster_work = group_work(n)
     n_of = np.zeros(n + 1, dtype=np.int64)
     m_of = np.zeros(n + 1, dtype=np.int64)
-    fill_n = np.empty(n, dtype=np.int64)
-    fill_m = np.empty(n, dtype=np.int64)
     dofs = np.empty(n, dtype=np.int64)
     cons = np.empty(m, dtype=np.int64)
     um = np.empty(n)
     up = np.empty(n)
     vp = np.empty(n)
-    Mc = np.empty(n * n)
-    Wt = np.empty(m * n)
-    MW = np.empty(n * m)
-    Gc = np.empty(m * m)
-    Ec = np.empty(m * m)
-    sc = np.empty(m)
     qc = np.empty(m)
     lam = np.empty(m)
-    w = np.empty(m)
-    pas = np.empty(m, dtype=np.bool_)
-    Lf = np.empty((m, m))
-    idx = np.empty(m, dtype=np.int64)
-    sv = np.empty(m)
-    blocked = np.empty(m, dtype=np.bool_)
+    dense_work = _dense_work(0 if chain else n, 0 if chain else m)
+    chain_work = _chain_work(n if chain else 0)
     res = np.empty(6)
     work = np.empty(2 * n + 2 * m)
     for k in range(k_first, k_stop):
@@ -198,50 +279,8 @@ def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, cho
         for i in range(n):
             vn[i] = vf[i]
         if any_closed:  # 3. clusters: dofs joined by Ŵ and by the closed contacts
-            for i in range(n):
-                parent[i] = i
-            for p in range(couple_a.size):
-                _join(parent, couple_a[p], couple_b[p])
-            for i in range(m):
-                if closed[i]:
-                    for p in range(Ht_ptr[i] + 1, Ht_ptr[i + 1]):
-                        _join(parent, Ht_idx[Ht_ptr[i]], Ht_idx[p])
-            for i in range(n):
-                cluster_of[i] = -1
-            for i in range(m):  # roots (each component's first dof) with a closed contact
-                if closed[i]:
-                    cluster_of[_root(parent, Ht_idx[Ht_ptr[i]])] = -2
-            n_cl = 0
-            for i in range(n):  # numbered in the order of their first dof
-                if cluster_of[i] == -2:
-                    cluster_of[i] = n_cl
-                    n_cl += 1
-            for a in range(n_cl + 1):
-                n_of[a] = 0
-                m_of[a] = 0
-            for i in range(n):  # counting sort of dofs and contacts by cluster
-                a = cluster_of[_root(parent, i)]
-                if a >= 0:
-                    n_of[a + 1] += 1
-            for i in range(m):
-                if closed[i]:
-                    m_of[cluster_of[_root(parent, Ht_idx[Ht_ptr[i]])] + 1] += 1
-            for a in range(n_cl):
-                n_of[a + 1] += n_of[a]
-                m_of[a + 1] += m_of[a]
-            for a in range(n_cl):
-                fill_n[a] = n_of[a]
-                fill_m[a] = m_of[a]
-            for i in range(n):
-                a = cluster_of[_root(parent, i)]
-                if a >= 0:
-                    dofs[fill_n[a]] = i
-                    fill_n[a] += 1
-            for i in range(m):
-                if closed[i]:
-                    a = cluster_of[_root(parent, Ht_idx[Ht_ptr[i]])]
-                    cons[fill_m[a]] = i
-                    fill_m[a] += 1
+            n_cl = group(closed, Ht_ptr, Ht_idx, couple_a, couple_b, cluster_work, dofs,
+                         cons, n_of, m_of)
             for a in range(n_cl):
                 D = dofs[n_of[a]:n_of[a + 1]]
                 C = cons[m_of[a]:m_of[a + 1]]
@@ -255,56 +294,28 @@ def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, cho
                     total = 0.0
                     for p in range(Ht_ptr[i], Ht_ptr[i + 1]):
                         total += Ht_val[p] * vf[Ht_idx[p]]
-                    restitution = 0.0
-                    for y in range(mc):
-                        restitution += E[i, C[y]] * gk[C[y]]
-                    total += restitution
+                    if diagonal:
+                        total += E[i, i] * gk[i]
+                    else:
+                        restitution = 0.0
+                        for y in range(mc):
+                            restitution += E[i, C[y]] * gk[C[y]]
+                        total += restitution
                     qc[x] = total
                     need |= total < 0.0
                 if not need:
                     continue
-                Mv = Mc[:nc * nc].reshape((nc, nc))
-                Wv = Wt[:mc * nc].reshape((mc, nc))
-                Xv = MW[:nc * mc].reshape((nc, mc))
-                Gv = Gc[:mc * mc].reshape((mc, mc))
-                Ev = Ec[:mc * mc].reshape((mc, mc))
-                for x in range(nc):
-                    for y in range(nc):
-                        Mv[x, y] = Wh[D[x], D[y]]
-                    for y in range(mc):
-                        Xv[x, y] = MinvH[D[x], C[y]]
-                for x in range(mc):
-                    for y in range(nc):
-                        Wv[x, y] = 0.0
-                    sc[x] = s[C[x]]
-                    pas[x] = passive[C[x]]
-                    for y in range(mc):
-                        Gv[x, y] = G[C[x], C[y]]
-                        Ev[x, y] = E[C[x], C[y]]
-                for x in range(mc):
-                    i = C[x]
-                    for p in range(Ht_ptr[i], Ht_ptr[i + 1]):
-                        for y in range(nc):
-                            if D[y] == Ht_idx[p]:
-                                Wv[x, y] = Ht_val[p]
-                status = lcp_psd_work(Gv, qc[:mc], pas[:mc], lam[:mc], w[:mc], 20 * mc + 50,
-                                      Lf, idx, sv, blocked)
-                if status != SOLVED:
+                if chain:
+                    ok = _solve_chain(D, C, um, vp, up, lam, s, masses, inverse,
+                                      left_wall and C[0] == 0, right_wall and C[mc - 1] == m - 1,
+                                      e_chain, tol, chain_work, res)
+                else:
+                    ok = _solve_dense(D, C, um, vp, up, lam, qc, Wh, MinvH, G, s, E, Ht_ptr,
+                                      Ht_idx, Ht_val, passive, tol, dense_work, res, work)
+                if not ok:
                     counts[0], counts[1], counts[2] = start
                     return FAILED, k, row
-                for x in range(nc):
-                    total = um[x]
-                    for y in range(mc):
-                        total += Xv[x, y] * lam[y]
-                    up[x] = total
-                dense_step_residuals(Mv, Wv, Xv, sc[:mc], um[:nc], up[:nc], lam[:mc],
-                                     vp[:nc], Ev, 0.0, False, res, work)
-                for x in range(CHECKED):
-                    if not res[x] <= tol:  # NaN fails
-                        counts[0], counts[1], counts[2] = start
-                        return FAILED, k, row
                 for x in range(mc):
-                    passive[C[x]] = pas[x]
                     lam_all[C[x]] = lam[x]
                 for x in range(nc):
                     vn[D[x]] = up[x]

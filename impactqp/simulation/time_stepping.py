@@ -214,7 +214,14 @@ class _CompiledLoop:
         n, m = system.n_dof, system.n_contacts
         Wh = np.ascontiguousarray(free.metric, dtype=float)
         H = np.ascontiguousarray(system.H, dtype=float)
-        full = ImpactStructure(Wh, H)
+        cache = step.solver.cache
+        if cache.diagonal is not None:  # diagonal Ŵ: products without a factorization
+            MinvH = H / cache.diagonal[:, None]
+            G = sp.csc_matrix(H.T) @ sp.csc_matrix(MinvH)
+            G = (0.5 * (G + G.T)).toarray()
+        else:
+            full = ImpactStructure(Wh, H)
+            MinvH, G = full.dense_Minv_W, np.asarray(full.delassus)
         Ht = sp.csr_matrix(H.T)
         Ht.sort_indices()
         linear = free.K is not None
@@ -226,15 +233,21 @@ class _CompiledLoop:
             shift = free.solver.solve_mass(free.residual(step.t0, system.q0, system.v0))
             self.force = (np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0), shift, False)
         pairs = np.argwhere(np.triu(Wh != 0.0, 1))
+        E = law.step_restitution(np.arange(m))
         self.geometry = (Ht.indptr.astype(np.int64), Ht.indices.astype(np.int64),
                          Ht.data.astype(float), system.b, Wh)
-        self.impacts = (np.ascontiguousarray(full.dense_Minv_W),
-                        np.ascontiguousarray(np.asarray(full.delassus), dtype=float),
-                        np.ascontiguousarray(full.contact_scale),
-                        restitution_matrix(law.step_restitution(np.arange(m)), m),
+        self.impacts = (np.ascontiguousarray(MinvH), np.ascontiguousarray(G, dtype=float),
+                        np.sqrt(np.diag(G)),
+                        restitution_matrix(E, m), np.ndim(E) < 2,
                         np.ascontiguousarray(pairs[:, 0], dtype=np.int64),
                         np.ascontiguousarray(pairs[:, 1], dtype=np.int64))
         self.passive = np.zeros(m, dtype=bool)
+        if cache.chain is not None and np.ndim(E) == 0:  # runs of balls: isotonic
+            chain = cache.chain
+            self.chain = (True, cache.diagonal, 1.0 / cache.diagonal, bool(chain.left_wall),
+                          bool(chain.right_wall), float(E))
+        else:
+            self.chain = (False, np.zeros(0), np.zeros(0), False, False, 0.0)
         self.buffers = self._buffers(*(self._room(0, 0, 0) if keep else (0, 0, 0)))
         self.counts = np.zeros(3, dtype=np.int64)
         self.pieces: list[tuple[int, int] | list[ImpactEvent]] = []
@@ -272,7 +285,8 @@ class _CompiledLoop:
         while k < steps:
             stop = steps if progress is None else min(steps, (k // report + 1) * report)
             status, k, row = run(q, v, k, stop, row, h, step.theta, *self.geometry,
-                                 *self.force, *self.impacts, self.passive, self.tol, kept,
+                                 *self.force, *self.impacts, self.passive, *self.chain,
+                                 self.tol, kept,
                                  Q, V, L, self.keep, *self.buffers, self.counts)
             if status == FAILED:  # the Python loop's step, whose solve raises what it raises
                 self._close(first)
