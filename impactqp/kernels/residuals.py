@@ -131,6 +131,14 @@ def dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, out, work):
     contact scales s and the law's E (m × m; for Moreau's law, ``moreau``, E = εI is used and
     E may be empty) into ``out`` (order :data:`RESIDUALS`); ``work`` is scratch of at least
     2n + 2m floats (a loop over impacts allocates nothing)."""
+    dense_step_residuals(M, Wt, MinvW, s, um, up, lam, um, E, eps, moreau, out, work)
+
+
+@kernel
+def dense_step_residuals(M, Wt, MinvW, s, um, up, lam, ur, E, eps, moreau, out, work):
+    """:func:`dense_residuals` with the restitution acting on the contact velocities of
+    ``ur`` instead of u⁻: w = γ⁺ + E Wᵀur. An impact has ur = u⁻; a Moreau–Jean step has
+    u⁻ = v_free and ur = v_k (``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k``, docs/theory.md §14)."""
     n, m = um.size, lam.size
     f = 1.0 / unit_of(um, up, lam)
     d = work[:n]
@@ -144,11 +152,11 @@ def dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, out, work):
         d[i] = total
     V = velocity_unit(_scaled_quadratic(M, um, um, f), _scaled_quadratic(M, up, up, f))
     momentum = np.sqrt(_high(_scaled_quadratic(M, d, d, 1.0), 0.0))
-    for i in range(m):  # γ⁻ and γ⁺
+    for i in range(m):  # γ⁻ (of ur) and γ⁺
         gm = 0.0
         gp = 0.0
         for j in range(n):
-            gm += Wt[i, j] * (um[j] * f)
+            gm += Wt[i, j] * (ur[j] * f)
             gp += Wt[i, j] * (up[j] * f)
         g[i] = gm
         w[i] = gp
@@ -183,9 +191,9 @@ def dense_residual_rows(M, Wt, MinvW, s, Um, Up, Lam, E, eps, moreau):
 
 
 @inline_kernel
-def _chain_pass(um, up, lam, masses, inverse, s, left_wall, right_wall, E, eps, moreau, f,
-                out):
-    """:func:`chain_residuals` with the inputs multiplied by f."""
+def _chain_pass(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, eps, moreau,
+                f, out):
+    """:func:`chain_step_residuals` with the inputs multiplied by f."""
     n = um.size
     lo = 0 if left_wall else 1  # Λ = (L_lo, L_lo+1, …)
     V2m = 0.0
@@ -194,11 +202,12 @@ def _chain_pass(um, up, lam, masses, inverse, s, left_wall, right_wall, E, eps, 
     mt_u = 0.0
     mt_t = 0.0
     acc = NEW_FOLD
-    a_left = 0.0
     b_left = 0.0
+    g_left = 0.0
     for j in range(n):
         a = um[j] * f
         b = up[j] * f
+        g = ur[j] * f  # the velocity the restitution acts on
         t = b - a
         mj = masses[j]
         V2m += mj * a * a
@@ -213,14 +222,14 @@ def _chain_pass(um, up, lam, masses, inverse, s, left_wall, right_wall, E, eps, 
             r += lam[k + 1] * f
         q += r * r * inverse[j]
         if j > 0:  # the gap left of ball j
-            acc = fold_contact(acc, lam[k] * f, b - b_left + E * (a - a_left), s[k])
+            acc = fold_contact(acc, lam[k] * f, b - b_left + E * (g - g_left), s[k])
         elif left_wall:
-            acc = fold_contact(acc, lam[0] * f, b + E * a, s[0])
-        a_left = a
+            acc = fold_contact(acc, lam[0] * f, b + E * g, s[0])
         b_left = b
+        g_left = g
     if right_wall:
         last = lam.size - 1
-        acc = fold_contact(acc, lam[last] * f, -(b_left + E * a_left), s[last])
+        acc = fold_contact(acc, lam[last] * f, -(b_left + E * g_left), s[last])
     V = velocity_unit(V2m, V2p)
     cross = -(mt_u + mt_t / (1.0 + eps)) / (1.0 + eps) if moreau else 0.0
     finish(V, np.sqrt(q), acc, eps, moreau, cross, out)
@@ -238,12 +247,21 @@ def chain_residuals(um, up, lam, masses, inverse, s, left_wall, right_wall, E, e
     and ⟨z, u⁻ − z⟩ = −(⟨t, u⁻⟩ + ‖t‖²/(1+ε))/(1+ε) in the kinetic metric. Inputs are
     divided by :func:`unit_of` only when max|u⁻ⱼ| is outside :data:`SCALE_RANGE`.
     """
+    chain_step_residuals(um, up, lam, um, masses, inverse, s, left_wall, right_wall, E, eps,
+                         moreau, out)
+
+
+@inline_kernel
+def chain_step_residuals(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, eps,
+                         moreau, out):
+    """:func:`chain_residuals` with the restitution acting on the contact velocities of
+    ``ur`` instead of u⁻ (a Moreau–Jean step: ur = v_k, docs/theory.md §14)."""
     top = 0.0
     for j in range(um.size):
         top = max(top, abs(um[j]))
     f = 1.0 if SCALE_RANGE[0] < top < SCALE_RANGE[1] else 1.0 / unit_of(um, up, lam)
-    _chain_pass(um, up, lam, masses, inverse, s, left_wall, right_wall, E, eps, moreau, f,
-                out)
+    _chain_pass(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, eps, moreau,
+                f, out)
 
 
 @kernel

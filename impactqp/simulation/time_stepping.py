@@ -12,6 +12,15 @@ uses:
    :func:`impactqp.solve` (complementarity laws in the step form
    ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k``), giving v_{k+1} = u⁺;
 4. q_{k+1} = q_k + h((1 − θ)v_k + θv_{k+1}).
+
+Two loops run these steps. The compiled loop (:func:`impactqp.kernels.moreau_jean.run`)
+takes a run when :func:`compiled_applies` says so: a built-in complementarity law (Moreau,
+Newton, Frémond, by exact type), a constant or linear force, ``backend="auto"`` and a system
+small enough to be held dense. Every other run — a callable force, any other law (the sector
+and reflection laws, LZB, a user's law), a named backend, a large system — takes the Python
+loop, which solves each cluster through :func:`impactqp.solve`. A step whose compiled
+certificate fails is solved again by the Python loop's step (which raises what it raises),
+and the compiled loop resumes after it.
 """
 
 from __future__ import annotations
@@ -23,12 +32,29 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.checks import DEFAULT_TOL
+from ..errors import InputError
+from ..kernels.moreau_jean import CHECKED, DONE, FAILED, run
+from ..kernels.residuals import RESIDUALS
 from ..laws.base import ImpactLaw
+from ..laws.certificate import Certificate
+from ..laws.complementarity import Fremond, Newton
+from ..laws.moreau import Moreau
+from ..laws.result import ImpactResult
+from ..model.problem import ImpactProblem
+from ..model.residuals import restitution_matrix
 from ..model.structure import ImpactStructure
 from .clusters import ClusterCache
-from .impacts import ImpactSolver
+from .impacts import ImpactEvent, ImpactSolver
+from .step_law import MoreauJeanStep
 from .system import LinearSystem
 from .trajectory import Trajectory
+
+COMPILED_LAWS = (Moreau, Newton, Fremond)
+"""The laws the compiled loop takes, by exact type (a subclass may change the law)."""
+
+MAX_COMPILED = 400
+"""Most degrees of freedom and most contacts the compiled loop takes (it holds Ŵ⁻¹, Ŵ⁻¹H
+and HᵀŴ⁻¹H dense)."""
 
 
 def step_count(t0: float, t_end: float, h: float) -> int:
@@ -53,7 +79,8 @@ class _FreeVelocity:
             self.solver = ImpactStructure(self.metric, np.zeros((system.n_dof, 0)))
             self.constant = lin.constant
 
-    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    def residual(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """r with Ŵ(v_free − v) = −r."""
         h, th = self.h, self.theta
         if self.K is not None:  # Ŵ(v_free − v_k) = h c − hKq_k − h²θKv_k
             residual = h * (self.K @ q) + (h * h * th) * (self.K @ v) - h * self.constant
@@ -64,13 +91,27 @@ class _FreeVelocity:
             f_k = self.system.force_at(t, q, v)
             f_next = self.system.force_at(t + h, q + h * v, v)
             residual = -(h * (1.0 - th)) * f_k - (h * th) * f_next
-        return v - self.solver.solve_mass(np.asarray(residual, dtype=float))
+        return np.asarray(residual, dtype=float)
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return v - self.solver.solve_mass(self.residual(t, q, v))
+
+
+def compiled_applies(system: LinearSystem, law: ImpactLaw, backend: str) -> bool:
+    """Whether a run takes the compiled loop (the module docstring's rule): Moreau's,
+    Newton's or Frémond's law (exact types), a constant or linear force, ``backend="auto"``,
+    a dense system (M and H not scipy.sparse) with at least one contact and at most
+    :data:`MAX_COMPILED` degrees of freedom and contacts."""
+    return (backend == "auto" and type(law) in COMPILED_LAWS and not system.structure.sparse
+            and (system.constant_force is not None or system.linear_force is not None)
+            and 0 < system.n_contacts <= MAX_COMPILED and system.n_dof <= MAX_COMPILED)
 
 
 def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
                 theta: float = 0.5, *, t0: float = 0.0, backend: str = "auto",
                 tol: float = DEFAULT_TOL, record_every: int = 1, keep_events: bool = True,
-                progress: Callable[[float], None] | None = None) -> Trajectory:
+                progress: Callable[[float], None] | None = None,
+                compiled: bool | None = None) -> Trajectory:
     """Integrate ``system`` from t0 to t_end by Moreau–Jean time-stepping (docs/theory.md §14).
 
     Parameters
@@ -91,10 +132,14 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
         Keep every solved impact problem as an :class:`~.impacts.ImpactEvent`.
     progress : callable, optional
         Called with the current time now and then (a progress bar).
+    compiled : bool, optional
+        Force the compiled loop (True; only where :func:`compiled_applies`) or the Python
+        loop (False); by default the rule of :func:`compiled_applies` decides.
 
     Returns
     -------
     Trajectory
+        ``settings["loop"]`` says which loop ran (``"compiled"`` or ``"python"``).
     """
     free = _FreeVelocity(system, h, theta)
     cache = ClusterCache(free.metric, system.H, system.chain)
@@ -104,31 +149,198 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     n, m = system.n_dof, system.n_contacts
     T, Q, V = t0 + kept * h, np.empty((kept.size, n)), np.empty((kept.size, n))
     L = np.zeros((kept.size, m))
-    q, v = system.q0.copy(), system.v0.copy()
-    Q[0], V[0] = q, v
-    row, events = 1, []
+    Q[0], V[0] = system.q0, system.v0
     report = max(1, steps // 200)
-    for k in range(steps):
-        t = t0 + k * h
-        closed = system.gaps(q) + (0.5 * h) * system.contact_velocities(v) <= 0.0
-        v_free = free(t, q, v)
-        if closed.any():
-            v_next, lam, new = solver.solve(t0 + (k + 1) * h, v_free, closed, v_previous=v)
+    use = compiled_applies(system, law, backend) if compiled is None else compiled
+    if use and not compiled_applies(system, law, backend):
+        raise InputError("compiled=True: the compiled loop does not take this run (a law, "
+                         "force, backend or size outside compiled_applies)")
+    step = _Step(system, free, solver, h, theta, t0)
+    if use:
+        events = _CompiledLoop(system, law, free, step, tol, keep_events).run(
+            steps, kept, Q, V, L, report, progress)
+    else:
+        events = []
+        q, v = system.q0.copy(), system.v0.copy()
+        row = 1
+        for k in range(steps):
+            q, v, lam, new = step(k, q, v)
             if keep_events:
                 events.extend(new)
-        else:
-            v_next, lam = v_free, None
-        q = q + h * ((1.0 - theta) * v + theta * v_next)
-        v = v_next
-        if row < kept.size and kept[row] == k + 1:
-            Q[row], V[row] = q, v
-            if lam is not None:
-                L[row] = lam
-            row += 1
-        if progress is not None and (k + 1) % report == 0:
-            progress(t0 + (k + 1) * h)
+            if row < kept.size and kept[row] == k + 1:
+                Q[row], V[row] = q, v
+                if lam is not None:
+                    L[row] = lam
+                row += 1
+            if progress is not None and (k + 1) % report == 0:
+                progress(t0 + (k + 1) * h)
     settings = {"h": h, "theta": theta, "t0": t0, "t_end": t_end, "steps": steps,
                 "backend": backend, "tol": tol, "record_every": record_every,
                 "keep_events": keep_events,
-                "activation": "g + h/2 γ <= 0"}
+                "activation": "g + h/2 γ <= 0", "loop": "compiled" if use else "python"}
     return Trajectory(system, law, "moreau-jean", T, Q, V, L, events, settings)
+
+
+class _Step:
+    """One step of the Python loop: (q_{k+1}, v_{k+1}, Λ or None, events) from (q_k, v_k)."""
+
+    def __init__(self, system: LinearSystem, free: _FreeVelocity, solver: ImpactSolver,
+                 h: float, theta: float, t0: float) -> None:
+        self.system, self.free, self.solver = system, free, solver
+        self.h, self.theta, self.t0 = h, theta, t0
+
+    def __call__(self, k: int, q: np.ndarray, v: np.ndarray,
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, list[ImpactEvent]]:
+        h, theta, system = self.h, self.theta, self.system
+        closed = system.gaps(q) + (0.5 * h) * system.contact_velocities(v) <= 0.0
+        v_free = self.free(self.t0 + k * h, q, v)
+        if closed.any():
+            v_next, lam, new = self.solver.solve(self.t0 + (k + 1) * h, v_free, closed,
+                                                 v_previous=v)
+        else:
+            v_next, lam, new = v_free, None, []
+        return q + h * ((1.0 - theta) * v + theta * v_next), v_next, lam, new
+
+
+class _CompiledLoop:
+    """The arrays of :func:`impactqp.kernels.moreau_jean.run`, formed once per run, the calls
+    of the kernel (resumed after a step solved by the Python loop or after enlarging the
+    event buffers) and the events built from what the kernel recorded."""
+
+    def __init__(self, system: LinearSystem, law: ImpactLaw, free: _FreeVelocity,
+                 step: _Step, tol: float, keep: bool) -> None:
+        self.system, self.law, self.free, self.step = system, law, free, step
+        self.tol, self.keep = tol, keep
+        n, m = system.n_dof, system.n_contacts
+        Wh = np.ascontiguousarray(free.metric, dtype=float)
+        H = np.ascontiguousarray(system.H, dtype=float)
+        cache = step.solver.cache
+        if cache.diagonal is not None:  # diagonal Ŵ: products without a factorization
+            MinvH = H / cache.diagonal[:, None]
+            G = sp.csc_matrix(H.T) @ sp.csc_matrix(MinvH)
+            G = (0.5 * (G + G.T)).toarray()
+        else:
+            full = ImpactStructure(Wh, H)
+            MinvH, G = full.dense_Minv_W, np.asarray(full.delassus)
+        Ht = sp.csr_matrix(H.T)
+        Ht.sort_indices()
+        linear = free.K is not None
+        if linear:
+            K = free.K.toarray() if sp.issparse(free.K) else free.K
+            self.force = (free.solver.cholesky_factor, np.ascontiguousarray(K, dtype=float),
+                          free.constant, np.zeros(n), True)
+        else:
+            shift = free.solver.solve_mass(free.residual(step.t0, system.q0, system.v0))
+            self.force = (np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0), shift, False)
+        pairs = np.argwhere(np.triu(Wh != 0.0, 1))
+        E = law.step_restitution(np.arange(m))
+        self.geometry = (Ht.indptr.astype(np.int64), Ht.indices.astype(np.int64),
+                         Ht.data.astype(float), system.b, Wh)
+        self.impacts = (np.ascontiguousarray(MinvH), np.ascontiguousarray(G, dtype=float),
+                        np.sqrt(np.diag(G)),
+                        restitution_matrix(E, m), np.ndim(E) < 2,
+                        np.ascontiguousarray(pairs[:, 0], dtype=np.int64),
+                        np.ascontiguousarray(pairs[:, 1], dtype=np.int64))
+        self.passive = np.zeros(m, dtype=bool)
+        if cache.chain is not None and np.ndim(E) == 0:  # runs of balls: isotonic
+            chain = cache.chain
+            self.chain = (True, cache.diagonal, 1.0 / cache.diagonal, bool(chain.left_wall),
+                          bool(chain.right_wall), float(E))
+        else:
+            self.chain = (False, np.zeros(0), np.zeros(0), False, False, 0.0)
+        self.buffers = self._buffers(*(self._room(0, 0, 0) if keep else (0, 0, 0)))
+        self.counts = np.zeros(3, dtype=np.int64)
+        self.pieces: list[tuple[int, int] | list[ImpactEvent]] = []
+
+    @staticmethod
+    def _buffers(events: int, dofs: int, contacts: int) -> tuple[np.ndarray, ...]:
+        """(head, residuals, dofs, contacts, u⁻, u⁺, v_k, Λ) of ``events`` recorded clusters
+        on ``dofs`` degrees of freedom and ``contacts`` contacts in all."""
+        return (np.empty((events, 4), dtype=np.int64), np.empty((events, CHECKED)),
+                np.empty(dofs, dtype=np.int64), np.empty(contacts, dtype=np.int64),
+                np.empty(dofs), np.empty(dofs), np.empty(dofs), np.empty(contacts))
+
+    def _room(self, events: int, dofs: int, contacts: int) -> tuple[int, int, int]:
+        """Buffer sizes for twice what is used plus one step's worst case (a cluster per
+        degree of freedom, every dof and contact in some cluster) and some slack."""
+        n, m = self.system.n_dof, self.system.n_contacts
+        return 2 * events + n + 64, 2 * dofs + n + 256, 2 * contacts + m + 256
+
+    def _grow(self) -> None:
+        """More room in every event buffer (:meth:`_room`), keeping what is recorded."""
+        e, d, c = (int(x) for x in self.counts)
+        new = self._buffers(*self._room(e, d, c))
+        for a, b, used in zip(self.buffers, new, (e, e, d, c, d, d, d, c)):
+            b[:used] = a[:used]
+        self.buffers = new
+
+    def run(self, steps: int, kept: np.ndarray, Q: np.ndarray, V: np.ndarray, L: np.ndarray,
+            report: int, progress: Callable[[float], None] | None,
+            ) -> Callable[[], list[ImpactEvent]] | list[ImpactEvent]:
+        """Fill Q, V, L (rows ``kept``) over ``steps`` steps; returns the events (a builder
+        called on first read) or [] without ``keep``."""
+        step, h, t0 = self.step, self.step.h, self.step.t0
+        q, v = self.system.q0.copy(), self.system.v0.copy()
+        k, row, first, reported = 0, 1, 0, 0
+        while k < steps:
+            stop = steps if progress is None else min(steps, (k // report + 1) * report)
+            status, k, row = run(q, v, k, stop, row, h, step.theta, *self.geometry,
+                                 *self.force, *self.impacts, self.passive, *self.chain,
+                                 self.tol, kept,
+                                 Q, V, L, self.keep, *self.buffers, self.counts)
+            if status == FAILED:  # the Python loop's step, whose solve raises what it raises
+                self._close(first)
+                q_next, v_next, lam, new = step(k, q, v)
+                q[:], v[:] = q_next, v_next
+                if self.keep:
+                    self.pieces.append(new)
+                first = int(self.counts[0])
+                k += 1
+                if row < kept.size and kept[row] == k:
+                    Q[row], V[row] = q, v
+                    L[row] = 0.0 if lam is None else lam
+                    row += 1
+            elif status != DONE:  # the event buffers are full
+                self._grow()
+            if progress is not None and k % report == 0 and k > reported:
+                progress(t0 + k * h)
+                reported = k
+        self._close(first)
+        return self._events if self.keep else []
+
+    def _close(self, first: int) -> None:
+        """Mark the kernel's events since ``first`` as the next piece of the list."""
+        if self.keep and self.counts[0] > first:
+            self.pieces.append((first, int(self.counts[0])))
+
+    def _events(self) -> list[ImpactEvent]:
+        """The ImpactEvents of the run, in order: each recorded cluster with its problem,
+        the step law on it and the certificate of the residuals the kernel checked."""
+        head, res, dofs, contacts, um, up, vp, lam = self.buffers
+        ends = np.append(head[1:int(self.counts[0]), 1], self.counts[1])
+        cache = self.step.solver.cache  # the structures of the Python loop's steps
+        closed = np.zeros(self.system.n_contacts, dtype=bool)
+        names = RESIDUALS[:CHECKED]
+        out: list[ImpactEvent] = []
+        for piece in self.pieces:
+            if isinstance(piece, list):
+                out.extend(piece)
+                continue
+            for e in range(*piece):
+                step, d0, c0, mc = (int(x) for x in head[e])
+                d = slice(d0, int(ends[e]))
+                c = contacts[c0:c0 + mc].copy()
+                closed[:] = False
+                closed[c] = True
+                (cl,) = cache.clusters(closed)
+                problem = ImpactProblem.from_structure(cl.structure, um[d].copy())
+                law = MoreauJeanStep(self.law.step_restitution(c), vp[d].copy())
+                cert = Certificate(dict(zip(names, res[e].tolist())), self.tol)
+                result = ImpactResult(problem, law.name, law.coefficients_for(problem),
+                                      up[d].copy(), lam[c0:c0 + mc].copy(), "kernel", cert,
+                                      form="impulse", impact_law=law,
+                                      attempts=["kernel (compiled Moreau–Jean loop): "
+                                                "certified"])
+                out.append(ImpactEvent(self.step.t0 + step * self.step.h, "step",
+                                       dofs[d].copy(), c, result))
+        return out

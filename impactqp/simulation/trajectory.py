@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import json
+from collections.abc import Callable
 from functools import cached_property
 from pathlib import Path
 from typing import Any
@@ -38,18 +39,27 @@ class Trajectory:
         Contact impulses Λ of the step ending at that record (time-stepping), or of the
         impact just before it (event-driven); zero elsewhere.
     events : list of ImpactEvent
-        Every impact problem solved, in order, each with its certificate.
+        Every impact problem solved, in order, each with its certificate (a run may pass a
+        callable that builds the list: it is called on first read).
     settings : dict
         The integrator's parameters.
     """
 
     def __init__(self, system: LinearSystem, law: ImpactLaw, scheme: str, t: np.ndarray,
                  q: np.ndarray, v: np.ndarray, impulses: np.ndarray,
-                 events: list[ImpactEvent], settings: dict[str, Any]) -> None:
+                 events: list[ImpactEvent] | Callable[[], list[ImpactEvent]],
+                 settings: dict[str, Any]) -> None:
         self.system, self.law, self.scheme = system, law, scheme
         self.t, self.q, self.v, self.impulses = t, q, v, impulses
-        self.events = events
+        self._events = events
         self.settings = settings
+
+    @property
+    def events(self) -> list[ImpactEvent]:
+        """Every impact problem solved, in order, each with its certificate."""
+        if callable(self._events):
+            self._events = self._events()
+        return self._events
 
     # --- derived quantities --------------------------------------------------------------
     @property
