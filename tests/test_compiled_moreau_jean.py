@@ -93,7 +93,7 @@ def test_compiled_loop_equals_the_python_loop(name, law, theta, record_every):
         _close(a.u_minus, b.u_minus, np.abs(slow.v).max())
         np.testing.assert_allclose(a.impulses, b.impulses, rtol=0, atol=1e-12 * scale)
         assert a.certified and sorted(a.certificate.values) == sorted(b.certificate.values)
-        assert a.result.backend == "kernel"
+        assert a.result.backend == time_stepping.LOOP_BACKEND
         np.testing.assert_array_equal(np.shape(a.result.impact_law.E),
                                       np.shape(b.result.impact_law.E))
     assert fast.certified and slow.certified
@@ -151,7 +151,8 @@ def test_a_corrupted_compiled_step_is_solved_again_by_the_python_loop(monkeypatc
     _close(fast.v, slow.v)
     # no corrupted answer passed its certificate: every event is the Python loop's
     assert len(fast.events) == len(slow.events) > 0
-    assert all(e.result.backend != "kernel" and e.certified for e in fast.events)
+    assert all(e.result.backend != time_stepping.LOOP_BACKEND and e.certified
+               for e in fast.events)
 
 
 def test_progress_is_reported_at_the_same_times():

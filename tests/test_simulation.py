@@ -400,6 +400,7 @@ def test_figures(tmp_path, event_ball):
         animate_cradle(cradle, tmp_path / "c.png")
 
 
+@pytest.mark.filterwarnings("ignore:Animation was deleted without rendering")
 def test_a_trajectory_draws_itself(tmp_path, event_ball):
     pytest.importorskip("matplotlib")
     from matplotlib.animation import FuncAnimation

@@ -49,6 +49,9 @@ from .step_law import MoreauJeanStep
 from .system import LinearSystem
 from .trajectory import Trajectory
 
+LOOP_BACKEND = "compiled Moreau–Jean loop"
+"""What answered an impact solved inside the compiled loop (its events' ``result.backend``)."""
+
 COMPILED_LAWS = (Moreau, Newton, Fremond)
 """The laws the compiled loop takes, by exact type (a subclass may change the law)."""
 
@@ -337,10 +340,9 @@ class _CompiledLoop:
                 law = MoreauJeanStep(self.law.step_restitution(c), vp[d].copy())
                 cert = Certificate(dict(zip(names, res[e].tolist())), self.tol)
                 result = ImpactResult(problem, law.name, law.coefficients_for(problem),
-                                      up[d].copy(), lam[c0:c0 + mc].copy(), "kernel", cert,
-                                      form="impulse", impact_law=law,
-                                      attempts=["kernel (compiled Moreau–Jean loop): "
-                                                "certified"])
+                                      up[d].copy(), lam[c0:c0 + mc].copy(), LOOP_BACKEND,
+                                      cert, form="impulse", impact_law=law,
+                                      attempts=[f"{LOOP_BACKEND}: certified"])
                 out.append(ImpactEvent(self.step.t0 + step * self.step.h, "step",
                                        dofs[d].copy(), c, result))
         return out
