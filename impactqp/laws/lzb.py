@@ -86,7 +86,7 @@ class LZB(ImpactLaw):
     ----------
     stiffness : float or (m,) array_like
         Kᵢ > 0 of each contact's compliance Fᵢ = Kᵢδᵢ^ηᵢ (N/m^ηᵢ); a scalar for all
-        contacts. :mod:`impactqp.model.physical_chains` computes Hertz stiffnesses.
+        contacts. :mod:`!impactqp.model.physical_chains` computes Hertz stiffnesses.
     exponent : float or (m,) array_like
         ηᵢ > 0: 3/2 for Hertz contact, 1 for a linear spring.
     restitution : float or (m,) array_like
