@@ -3,6 +3,7 @@ of the documentation lists every public name."""
 
 from __future__ import annotations
 
+import argparse
 import ast
 import builtins
 import importlib
@@ -145,3 +146,45 @@ def test_every_docstring_cross_reference_names_an_existing_object() -> None:
     bad = [ref for path in sorted(PACKAGE.rglob("*.py"))
            if path.name != "__main__.py" for ref in _stale_references(path)]
     assert bad == []
+
+
+DOCS = API.parent
+
+
+def _included(page: str) -> set[str]:
+    text = (DOCS / page).read_text(encoding="utf-8")
+    return set(re.findall(r"^\.\. literalinclude:: \.\./(\S+)$", text, flags=re.M))
+
+
+def test_gallery_shows_every_example_script() -> None:
+    scripts = {f"examples/{p.name}" for p in (DOCS.parent / "examples").glob("*.py")}
+    assert _included("gallery.rst") == scripts
+
+
+def test_file_formats_page_shows_every_sample_file() -> None:
+    samples = {f"examples/{p.name}" for p in (DOCS.parent / "examples").glob("*.*")
+               if p.suffix in (".toml", ".json")}
+    assert _included("files.rst") == samples
+
+
+def test_every_image_of_the_pages_is_committed() -> None:
+    for page in DOCS.glob("*.rst"):
+        for image in re.findall(r"^\.\. image:: (\S+)$", page.read_text(encoding="utf-8"),
+                                flags=re.M):
+            assert (DOCS / image).is_file(), (page.name, image)
+
+
+def test_command_line_page_shows_the_help_of_every_subcommand() -> None:
+    from impactqp.cli.main import build_parser
+
+    def commands(parser: argparse.ArgumentParser, prefix: str) -> set[str]:
+        found = {prefix}
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    found |= commands(sub, f"{prefix} {name}".strip())
+        return found
+
+    text = (DOCS / "cli.rst").read_text(encoding="utf-8")
+    shown = {m.strip() for m in re.findall(r"^\.\. impactqp-help::(.*)$", text, flags=re.M)}
+    assert shown == commands(build_parser(), "")
