@@ -1,12 +1,15 @@
 """Sphinx configuration of impactqp's documentation.
 
-Build with ``sphinx-build -W --keep-going -b html docs docs/_build/html`` after
-``pip install -e ".[docs]"``. The API reference is generated from the numpydoc docstrings of
-the public names (``impactqp.__all__``); the theory note docs/theory.md is read by myst-parser.
+Build with ``sphinx-build -n -W --keep-going -b html docs docs/_build/html`` after
+``pip install -e ".[docs]"`` (nitpicky, as CI does: every cross-reference must resolve).
+The API reference is generated from the numpydoc docstrings of the public names
+(``impactqp.__all__``); the theory note docs/theory.md is read by myst-parser; the command
+line's help texts are printed by its own parser (the ``impactqp-help`` directive below).
 """
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -49,3 +52,39 @@ myst_heading_anchors = 3
 html_theme = "alabaster"
 html_title = f"impactqp {release}"
 html_static_path: list[str] = []
+
+
+def _help_text(path: str) -> str:
+    """The ``--help`` text of ``impactqp`` (``path`` empty) or of a subcommand such as
+    ``"solve"`` or ``"plot S"``, exactly as the parser of impactqp.cli prints it."""
+    import argparse
+
+    from impactqp.cli.main import build_parser
+
+    os.environ["COLUMNS"] = "88"  # argparse wraps to the terminal; the page has a fixed width
+    parser = build_parser()
+    for name in path.split():
+        subparsers = next(a for a in parser._actions
+                          if isinstance(a, argparse._SubParsersAction))
+        parser = subparsers.choices[name]
+    return parser.format_help()
+
+
+def setup(app):
+    """``.. impactqp-help:: [SUBCOMMAND ...]`` renders the command line's own help text, so
+    the command-line page cannot drift from the parser."""
+    from docutils import nodes
+    from sphinx.util.docutils import SphinxDirective
+
+    class ImpactqpHelp(SphinxDirective):
+        optional_arguments = 1
+        final_argument_whitespace = True
+
+        def run(self) -> list:
+            text = _help_text(self.arguments[0] if self.arguments else "")
+            block = nodes.literal_block(text, text)
+            block["language"] = "text"
+            return [block]
+
+    app.add_directive("impactqp-help", ImpactqpHelp)
+    return {"parallel_read_safe": True}

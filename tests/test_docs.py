@@ -3,6 +3,11 @@ of the documentation lists every public name."""
 
 from __future__ import annotations
 
+import argparse
+import ast
+import builtins
+import importlib
+import importlib.util
 import inspect
 import re
 import warnings
@@ -70,3 +75,116 @@ def test_api_page_lists_every_public_name() -> None:
     listed = set(re.findall(r"^\.\. (?:autoclass|autofunction|data):: (\w+)$", text, flags=re.M))
     assert listed == set(iq.__all__)
     assert f":value: {iq.DEFAULT_TOL!r}" in text
+
+
+# Cross-references of docstrings: Sphinx checks those on the pages it renders (nitpicky in CI);
+# this checks every one in the sources, rendered or not, so a name left behind by a move fails.
+ROLE = re.compile(r":(?:py:)?(func|class|mod|data|attr|meth|exc|obj):`([^`<]+?)(?:\s*<([^>]+)>)?`")
+PACKAGE = Path(iq.__file__).resolve().parent
+
+
+def _resolve(dotted: str) -> bool:
+    """Does ``a.b.c`` name an importable module or an attribute chain below one?"""
+    parts = dotted.split(".")
+    for cut in range(len(parts), 0, -1):
+        try:
+            obj = importlib.import_module(".".join(parts[:cut]))
+        except ImportError:
+            continue
+        for name in parts[cut:]:
+            if not hasattr(obj, name):
+                return False
+            obj = getattr(obj, name)
+        return True
+    return False
+
+
+def _members(cls: type) -> set[str]:
+    """Names of a class, including the fields and slots a dataclass declares without values."""
+    names = set(dir(cls))
+    for klass in cls.__mro__:
+        names |= set(getattr(klass, "__annotations__", {}))
+    return names
+
+
+def _stale_references(path: Path) -> list[str]:
+    module_name = ".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+    module_name = module_name.removesuffix(".__init__")
+    module = importlib.import_module(module_name)
+    bad: list[str] = []
+
+    def check(text: str, classes: list[str], line: int) -> None:
+        for role, label, explicit in ROLE.findall(text):
+            target = (explicit or label).strip().lstrip("~!").strip("()")
+            if target.startswith("."):  # relative to this module's package
+                target = importlib.util.resolve_name(target, module.__package__)
+            if role == "mod" or target.startswith("impactqp."):
+                ok = _resolve(target)
+            else:
+                head, *rest = target.split(".")
+                scopes = [getattr(module, c, None) for c in reversed(classes)]
+                ok = any(isinstance(c, type) and head in _members(c) for c in scopes) \
+                    or hasattr(module, head) or hasattr(iq, head) or hasattr(builtins, head)
+                if ok and rest and hasattr(module, head):
+                    ok = _resolve(f"{module_name}.{target}")
+                ok = ok or ("." in target and _resolve(target))  # numpy.ndarray, ...
+            if not ok:
+                bad.append(f"{path.relative_to(PACKAGE.parent)}:{line}: :{role}:`{target}`")
+
+    def walk(node: ast.AST, classes: list[str]) -> None:
+        for child in ast.iter_child_nodes(node):
+            inner = classes + [child.name] if isinstance(child, ast.ClassDef) else classes
+            if isinstance(child, ast.Constant) and isinstance(child.value, str):
+                check(child.value, classes, child.lineno)
+            walk(child, inner)
+
+    walk(ast.parse(path.read_text(encoding="utf-8")), [])
+    return bad
+
+
+def test_every_docstring_cross_reference_names_an_existing_object() -> None:
+    bad = [ref for path in sorted(PACKAGE.rglob("*.py"))
+           if path.name != "__main__.py" for ref in _stale_references(path)]
+    assert bad == []
+
+
+DOCS = API.parent
+
+
+def _included(page: str) -> set[str]:
+    text = (DOCS / page).read_text(encoding="utf-8")
+    return set(re.findall(r"^\.\. literalinclude:: \.\./(\S+)$", text, flags=re.M))
+
+
+def test_gallery_shows_every_example_script() -> None:
+    scripts = {f"examples/{p.name}" for p in (DOCS.parent / "examples").glob("*.py")}
+    assert _included("gallery.rst") == scripts
+
+
+def test_file_formats_page_shows_every_sample_file() -> None:
+    samples = {f"examples/{p.name}" for p in (DOCS.parent / "examples").glob("*.*")
+               if p.suffix in (".toml", ".json")}
+    assert _included("files.rst") == samples
+
+
+def test_every_image_of_the_pages_is_committed() -> None:
+    for page in DOCS.glob("*.rst"):
+        for image in re.findall(r"^\.\. image:: (\S+)$", page.read_text(encoding="utf-8"),
+                                flags=re.M):
+            assert (DOCS / image).is_file(), (page.name, image)
+
+
+def test_command_line_page_shows_the_help_of_every_subcommand() -> None:
+    from impactqp.cli.main import build_parser
+
+    def commands(parser: argparse.ArgumentParser, prefix: str) -> set[str]:
+        found = {prefix}
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    found |= commands(sub, f"{prefix} {name}".strip())
+        return found
+
+    text = (DOCS / "cli.rst").read_text(encoding="utf-8")
+    shown = {m.strip() for m in re.findall(r"^\.\. impactqp-help::(.*)$", text, flags=re.M)}
+    assert shown == commands(build_parser(), "")

@@ -14,7 +14,8 @@ DEFAULT_TOL = 1e-9
 
 
 class ResidualChecks(ABC):
-    """Verdict shared by every certificate: each residual in :attr:`residuals` ≤ ``tol``."""
+    """Verdict shared by every certificate: each of its
+    :attr:`~impactqp.ResidualChecks.residuals` ≤ ``tol``."""
 
     tol: float
 

@@ -1,4 +1,4 @@
-"""Command-line entry point ``impactqp``: each subcommand lives in :mod:`impactqp.commands`."""
+"""Command-line entry point ``impactqp``: each subcommand lives in :mod:`impactqp.cli.commands`."""
 
 from __future__ import annotations
 

@@ -77,7 +77,7 @@ class ProblemFile:
     ----------
     problem : ImpactProblem
     law : str or None
-        A name of :data:`impactqp.laws.catalogue.NAMED_LAWS` (``"moreau"``, ``"newton"``,
+        A name of :data:`!impactqp.laws.catalogue.NAMED_LAWS` (``"moreau"``, ``"newton"``,
         ``"fremond"``, ``"sector"``, ``"reflection"``) or None when absent.
     coefficients : float, ndarray or None
         ε (Moreau), the eᵢ (Newton, an (m,) array) or Frémond's (m, m) matrix E.

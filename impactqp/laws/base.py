@@ -57,7 +57,7 @@ class ImpactLaw(ABC):
     Attributes
     ----------
     name : str
-        Short name (``"moreau"``), stored in :attr:`ImpactResult.law`.
+        Short name (``"moreau"``), stored in ``ImpactResult.law``.
     title : str
         Human name for messages.
     forms : tuple of str
@@ -69,7 +69,7 @@ class ImpactLaw(ABC):
         reports "no solution" for such a law.
     by_name : bool
         Problem and simulation files and the command line may name the law (its
-        coefficients, if any, under :attr:`coefficient_key`).
+        coefficients, if any, under ``coefficient_key``).
     coefficient_key, coefficient_symbol : str or None
         How files and the command line spell its coefficients (``"eps"``) and how reports
         print them (``"ε"``); None for a law without coefficients.
@@ -98,7 +98,7 @@ class ImpactLaw(ABC):
     @classmethod
     def from_coefficients(cls, coefficients: Any = None) -> ImpactLaw:
         """The law named in a file or on the command line, with its coefficients (None: the
-        law's defaults, or InputError when :attr:`needs_coefficients`)."""
+        law's defaults, or InputError when ``needs_coefficients``)."""
         if coefficients is None:
             if cls.needs_coefficients:
                 raise InputError(f"law {cls.name!r} needs its coefficients "
@@ -133,7 +133,7 @@ class ImpactLaw(ABC):
         the default accepts every problem."""
 
     def preferred_forms(self, problem: ImpactProblem) -> tuple[str, ...]:
-        """The law's forms to try, best first (:func:`impactqp.model.programs.preferred_forms`)."""
+        """The law's forms to try, best first (:func:`!impactqp.model.programs.preferred_forms`)."""
         return tuple(f for f in preferred_forms(problem) if f in self.forms)
 
     def program(self, problem: ImpactProblem, form: str) -> QuadraticProgram:
@@ -146,7 +146,7 @@ class ImpactLaw(ABC):
 
     def closed_form(self, problem: ImpactProblem) -> Answer | Any:
         """The answer of a closed-form law (``forms == ()``): an :class:`Answer`, a pair
-        (u⁺, Λ), or u⁺ alone, whose impulses :meth:`answer_of` then recovers."""
+        (u⁺, Λ), or u⁺ alone, whose impulses :meth:`~impactqp.ImpactLaw.answer_of` then recovers."""
         raise NotImplementedError(f"{self.title} is solved through programs")
 
     def answer_of(self, problem: ImpactProblem, output: Any) -> Any:

@@ -219,9 +219,9 @@ def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: s
                 *, tol: float = DEFAULT_TOL, n_jobs: int = 1) -> BatchResult:
     """``law`` for every row of ``U_minus`` on the structure of ``problem``.
 
-    Rows are processed in chunks of :data:`CHUNK_ROWS`, so memory beyond the input and the
+    Rows are processed in chunks of :data:`!CHUNK_ROWS`, so memory beyond the input and the
     output stays bounded. Moreau's law on a short chain (``"auto"`` or ``"isotonic"``) runs
-    column by column (:mod:`impactqp.laws.chain_rows`).
+    column by column (:mod:`!impactqp.laws.chain_rows`).
 
     Parameters
     ----------

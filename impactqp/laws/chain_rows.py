@@ -120,7 +120,7 @@ class ChainRows:
 
     def residuals(self, U: np.ndarray, Up: np.ndarray, Lam: np.ndarray) -> np.ndarray:
         """Moreau's residuals (docs/theory.md §8) of the rows, a (k, 6) array in the order of
-        :data:`RESIDUALS`, by the one definition of the chain certificate
+        :data:`impactqp.kernels.residuals.RESIDUALS`, by the one definition of the chain certificate
         (:func:`impactqp.kernels.residuals.chain_residuals`)."""
         return chain_residual_rows(U, Up, Lam, self.masses, self.inverse, self.scale,
                                    self.left, self.right, self.eps, self.eps, True)

@@ -5,7 +5,7 @@ Two elastic spheres pressed together by δ carry the Hertz force F = Kδ^(3/2) w
 
     K = (4/3) E* √R*,   1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂,   R* = R₁R₂/(R₁ + R₂).
 
-The builders return the chain problem of :func:`impactqp.model.builders.chain` (a striker
+The builders return the chain problem of :func:`~impactqp.chain` (a striker
 at v hitting resting, touching balls) together with these stiffnesses, ready for the LZB
 model (``LZB(chain.stiffness, exponent=chain.exponent)``). Defaults are the steel of the
 chain-of-balls example of Siconos: density 7780 kg/m³, E = 203 GPa, ν = 0.3.
@@ -110,7 +110,7 @@ class PhysicalChain:
     Attributes
     ----------
     problem : ImpactProblem
-        The free chain (:func:`impactqp.model.builders.chain`), u⁻ = (v, 0, …, 0).
+        The free chain (:func:`~impactqp.chain`), u⁻ = (v, 0, …, 0).
     stiffness : (N−1,) ndarray
         Hertz stiffness of each neighbour contact, N/m^(3/2).
     exponent : float

@@ -50,9 +50,10 @@ class ImpactStructure:
     W : (n, m) array_like or scipy.sparse matrix
         Generalized force directions, one column per closed contact; ``m = 0`` is allowed.
     chain : ChainInfo, optional
-        Marks W as the chain's directions (:func:`impactqp.model.builders.chain_directions`),
-        which lets chains use O(N) operators and the isotonic backend. The builders make a
-        :class:`~impactqp.model.chain_structure.ChainStructure` instead, which checks the
+        Marks W as the chain's directions
+        (:func:`!impactqp.model.chain_structure.chain_directions`), which lets chains use
+        O(N) operators and the isotonic backend. The builders make a
+        :class:`!impactqp.model.chain_structure.ChainStructure` instead, which checks the
         masses in O(N) and forms M and W only when they are asked for.
 
     Raises
@@ -205,7 +206,7 @@ class ImpactStructure:
     @cached_property
     def kernel_pack(self) -> np.ndarray:
         """M, Wᵀ, M⁻¹W, G and the contact scales packed for the compiled impact solve
-        (:func:`impactqp.kernels.impact.pack`; dense problems)."""
+        (:func:`!impactqp.kernels.impact.pack`; dense problems)."""
         return pack(self.dense_mass, np.ascontiguousarray(as_dense(self.W), dtype=float))
 
     @cached_property

@@ -53,9 +53,9 @@ class ImpactEvent:
         self.result = result
         self.settled = np.zeros(0, dtype=int)
 
-    u_minus = property(lambda self: self.result.problem.u_minus, doc="u⁻ on :attr:`dofs`.")
-    u_plus = property(lambda self: self.result.u_plus, doc="u⁺ on :attr:`dofs`.")
-    impulses = property(lambda self: self.result.impulses, doc="Λ on :attr:`contacts`.")
+    u_minus = property(lambda self: self.result.problem.u_minus, doc="u⁻ on ``dofs``.")
+    u_plus = property(lambda self: self.result.u_plus, doc="u⁺ on ``dofs``.")
+    impulses = property(lambda self: self.result.impulses, doc="Λ on ``contacts``.")
     certificate = property(lambda self: self.result.certificate,
                            doc="The law's recomputed certificate.")
     law = property(lambda self: self.result.law, doc="Name of the law that was solved.")

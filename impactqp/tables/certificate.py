@@ -1,8 +1,8 @@
 """Exact certificate of a piecewise-linear impact law on simplicial cones (docs/theory.md §7).
 
-Works on any object shaped like :class:`impactqp.sector.SectorTable` (``cones`` with
+Works on any object shaped like :class:`impactqp.tables.sector_table.SectorTable` (``cones`` with
 ``rays``/``Q``/``label``, ``G``, ``W``, ``mass``), or with a mass matrix ``M`` instead of
-``mass`` (unequal masses, :mod:`impactqp.reflection_table`).  Every check is vectorised over
+``mass`` (unequal masses, :mod:`impactqp.tables.reflection_table`).  Every check is vectorised over
 the cones, so the 40 320 cones of eight balls are certified in seconds.
 
 Checks (docs/theory.md §7, §6):
@@ -238,7 +238,7 @@ SectorCertificate = TableCertificate
 
 
 def certify_sector_table(table: Any, exact_energy: bool | None = None) -> TableCertificate:
-    """Run every docs/theory.md §7 check on ``table`` (a :class:`~impactqp.sector.SectorTable`).
+    """Run every docs/theory.md §7 check on ``table`` (a :class:`~impactqp.SectorTable`).
 
     Parameters
     ----------

@@ -6,7 +6,7 @@ applies the impulse ``Λ_i = −2γ_i/G_ii > 0``.  A wall is one more contact (d
 −e_N), so chains with one wall are handled too; between two walls T_C = {0} and no elastic
 law exists.
 
-When every angle of T_C is π/k_i (:mod:`impactqp.coxeter`) the reflections generate a finite
+When every angle of T_C is π/k_i (:mod:`impactqp.tables.coxeter`) the reflections generate a finite
 Coxeter group with T_C as chamber.  Reflecting at a violated contact (γ_i < 0) removes
 exactly one reflecting hyperplane of the group from those separating u from T_C, so every
 order of collisions stops after the same number of steps at the same velocity: the unique

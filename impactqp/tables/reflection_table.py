@@ -12,8 +12,8 @@ orthant), so on K_g
 
 The chambers of a finite reflection group tile the space, so the |group| cones cover
 γ-space with disjoint interiors.  The table has the interface of
-:class:`impactqp.sector.SectorTable` and is certified by
-:func:`impactqp.sector_certificate.certify_sector_table` (docs/theory.md §7).
+:class:`impactqp.tables.sector_table.SectorTable` and is certified by
+:func:`impactqp.tables.certificate.certify_sector_table` (docs/theory.md §7).
 """
 
 from __future__ import annotations
@@ -140,7 +140,7 @@ def reflection_law_table(masses: Any, *, left_wall: bool = False,
     ----------
     masses : (N,) array_like
         Ball masses; every angle of T_C must be π/k (e.g.
-        :func:`impactqp.coxeter.continuous_mass_ratios`).
+        :func:`~impactqp.continuous_mass_ratios`).
     left_wall, right_wall : bool
         At most one wall (a contact like any other).
 
@@ -152,7 +152,7 @@ def reflection_law_table(masses: Any, *, left_wall: bool = False,
     Raises
     ------
     SectorLawError
-        When an angle is not π/k (as :func:`impactqp.reflection_law.reflection_law`).
+        When an angle is not π/k (as :func:`~impactqp.reflection_law`).
     SectorTableTooLarge
         When the group has more than ``MAX_TABLE_ORDER`` elements (use reflection_law).
     """

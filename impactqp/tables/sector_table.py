@@ -7,7 +7,7 @@ is piecewise linear: every ordering π of the velocities is one simplicial cone
 ``K_π = {γ : H_π γ ≥ 0}`` of γ-space (dimension n−1), on which ``γ⁺ = Q_π γ⁻``.
 All matrices are derived from ``W``, a permutation matrix and the cumulative-sum
 lift; none is typed by hand.  The exact certificate (docs/theory.md §7) lives in
-:mod:`impactqp.sector_certificate` and is attached lazily as
+:mod:`impactqp.tables.certificate` and is attached lazily as
 ``SectorTable.certificate``.
 """
 
@@ -219,7 +219,7 @@ def sector_law_table(n_balls: int = 3, mass: float = 1.0) -> SectorTable:
     Raises
     ------
     SectorTableTooLarge
-        If ``n_balls > 8`` (use :func:`sector_gamma_map` instead).
+        If ``n_balls > 8`` (use :func:`!impactqp.tables.sector_table.sector_gamma_map` instead).
     SectorInputError
         If ``n_balls < 2`` or ``mass <= 0``.
     """

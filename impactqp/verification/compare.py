@@ -157,9 +157,9 @@ def compare_chain(chain: PhysicalChain, restitution: Any = 1.0, *, step: float |
     Parameters
     ----------
     chain : PhysicalChain
-        From :func:`impactqp.model.physical_chains.monodisperse_chain`,
-        :func:`~impactqp.model.physical_chains.tapered_chain` or
-        :func:`~impactqp.model.physical_chains.ball_chain`.
+        From :func:`~impactqp.monodisperse_chain`,
+        :func:`~impactqp.tapered_chain` or
+        :func:`~impactqp.ball_chain`.
     restitution : float or array_like
         LZB's energetic restitution per contact (1: elastic).
     step, rtol : optional

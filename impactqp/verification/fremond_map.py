@@ -44,7 +44,7 @@ def fremond_admissibility_map(problem: ImpactProblem, a_values: Any, b_values: A
     problem : ImpactProblem
         Supplies M and W.
     a_values, b_values : 1-D array_like
-        Grid of the two parameters of :func:`fremond_matrix`.
+        Grid of the two parameters of :func:`!impactqp.verification.fremond_map.fremond_matrix`.
     samples, seed : int
         The same seeded u⁻ are used for every cell.
     family : {"symmetric", "triangular"}

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 DEFAULT_TOL = 1e-7
-"""Tolerance on the dimensionless residuals of :class:`~impactqp.admissible.Membership`."""
+"""Tolerance on the dimensionless residuals of :class:`~impactqp.Membership`."""
 
 ADMISSIBILITY = ("kinematic", "kinetic", "energetic")
 CONDITIONS = ADMISSIBILITY + ("non_expansive", "law_error")

@@ -98,7 +98,7 @@ class LZB(ImpactLaw):
     ----------
     stiffness : float or (m,) array_like
         Kᵢ > 0 of each contact's compliance Fᵢ = Kᵢδᵢ^ηᵢ (N/m^ηᵢ); a scalar for all
-        contacts. :mod:`impactqp.model.physical_chains` computes Hertz stiffnesses.
+        contacts. :mod:`!impactqp.model.physical_chains` computes Hertz stiffnesses.
     exponent : float or (m,) array_like
         ηᵢ ∈ [1, 3]: 3/2 for Hertz contact, 1 for a linear spring (MIN_EXPONENT,
         MAX_EXPONENT: below 1 the force is not Lipschitz at contact, which the model's

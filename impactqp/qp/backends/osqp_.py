@@ -1,7 +1,7 @@
 """OSQP (operator splitting): l ≤ Ax ≤ u with u = +∞; OSQP's y is ≤ 0 on active lower bounds.
 
 OSQP's own polishing prints to stdout; impactqp polishes every answer itself instead
-(:mod:`impactqp.polish`).
+(:mod:`impactqp.qp.polish`).
 """
 
 from __future__ import annotations
