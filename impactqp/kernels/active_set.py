@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from .jit import inline_kernel, kernel
 
 SOLVED, NO_SOLUTION, ITERATION_LIMIT = 0, 1, 2
 """Status codes of :func:`lcp_psd`."""
@@ -76,7 +76,18 @@ def _solve_factored(L, idx, k, rhs, out):
     """out[idx[:k]] = G_PP⁻¹ rhs[idx[:k]] with G_PP = LLᵀ."""
     y = np.empty(k)
     for a in range(k):
-        s = rhs[idx[a]]
+        y[a] = rhs[idx[a]]
+    cholesky_solve(L, k, y)
+    for a in range(k):
+        out[idx[a]] = y[a]
+
+
+@inline_kernel
+def cholesky_solve(L, k, y):
+    """y ← (LLᵀ)⁻¹y for the leading k × k block of the lower factor L: forward, then backward
+    substitution (as LAPACK's potrs)."""
+    for a in range(k):
+        s = y[a]
         for b in range(a):
             s -= L[a, b] * y[b]
         y[a] = s / L[a, a]
@@ -85,8 +96,6 @@ def _solve_factored(L, idx, k, rhs, out):
         for b in range(a + 1, k):
             s -= L[b, a] * y[b]
         y[a] = s / L[a, a]
-    for a in range(k):
-        out[idx[a]] = y[a]
 
 
 @kernel

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .active_set import SOLVED, lcp_psd_work
+from .active_set import SOLVED, cholesky_solve, lcp_psd_work
 from .chain import project
 from .clusters import group, group_work
 from .jit import kernel
@@ -58,15 +58,8 @@ def _free_velocity(v, q, chol, K, c, shift, h, theta, linear, out, y):
         for j in range(n):
             kq += K[i, j] * q[j]
             kv += K[i, j] * v[j]
-        total = h * kq + (h * h * theta) * kv - h * c[i]
-        for j in range(i):
-            total -= chol[i, j] * y[j]
-        y[i] = total / chol[i, i]
-    for i in range(n - 1, -1, -1):
-        total = y[i]
-        for j in range(i + 1, n):
-            total -= chol[j, i] * y[j]
-        y[i] = total / chol[i, i]
+        y[i] = h * kq + (h * h * theta) * kv - h * c[i]
+    cholesky_solve(chol, n, y)
     for i in range(n):
         out[i] = v[i] - y[i]
 
