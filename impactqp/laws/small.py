@@ -66,6 +66,11 @@ def applies(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str) -> 
             and type(law) in _LAWS)
 
 
+def _certificate(names: tuple[str, ...], values: np.ndarray, tol: float) -> Certificate:
+    """The certificate of residuals the kernel already checked, built when first read."""
+    return Certificate(dict(zip(names, values.tolist())), tol)
+
+
 def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float,
                 start: float) -> ImpactResult | None:
     """The certified result by the compiled path, or None to go on to the general path."""
@@ -78,9 +83,9 @@ def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float,
                         tol, st.warm_support, out):
         return None
     up = out[:n]
-    values = dict(zip(RESIDUALS if moreau else RESIDUALS[:4], out[n + m:].tolist()))
+    names = RESIDUALS if moreau else RESIDUALS[:4]
     return ImpactResult(problem, law.name, law.coefficients_for(problem), up, out[n:n + m],
-                        "kernel", partial(Certificate, values, tol), form="impulse",
+                        "kernel", partial(_certificate, names, out[n + m:], tol), form="impulse",
                         z=partial(law.projection, problem, up) if moreau else None,
                         attempts=["kernel (compiled): certified"], impact_law=law,
                         solve_time=time.perf_counter() - start)
