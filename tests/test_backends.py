@@ -182,3 +182,42 @@ def test_large_programs_are_refused_by_size_before_anything_is_allocated(backend
     with pytest.raises(iq.BackendUnsuitableError, match=words):
         iq.moreau(p, 0.0, backend=backend)
     assert iq.moreau(p, 0.0).certificate.ok  # auto answers it
+
+
+def test_solver_options_reach_the_named_backend(monkeypatch):
+    from impactqp.qp.backends import clarabel_
+
+    seen = {}
+    original = clarabel_.settings_with
+
+    def spy(tol, options):
+        config = original(tol, options)
+        seen["max_iter"] = config.max_iter
+        return config
+
+    monkeypatch.setattr(clarabel_, "settings_with", spy)
+    p = iq.newtons_cradle(3)
+    r = iq.solve(p, iq.Moreau(1.0), backend="clarabel", options={"max_iter": 37})
+    assert seen["max_iter"] == 37 and r.certificate.ok
+    # a budget too small to converge is the user's choice: the certificate still decides
+    with pytest.raises(iq.CertificateError):
+        iq.solve(p, iq.Moreau(1.0), backend="osqp", options={"max_iter": 1, "polishing": False})
+
+
+@pytest.mark.parametrize("backend, options, words", [
+    ("clarabel", {"no_such_setting": 1}, "no setting 'no_such_setting'"),
+    ("osqp", {"no_such_setting": 1}, "no_such_setting"),
+    ("cvxpy", {"no_such_setting": 1}, "no_such_setting"),
+    ("kernel", {"max_iter": 3}, "takes no options"),
+    ("auto", {"max_iter": 3}, "name the backend"),
+    ("clarabel", [("max_iter", 3)], "must be a dict"),
+])
+def test_bad_solver_options_are_named(backend, options, words):
+    with pytest.raises(iq.InputError, match=words):
+        iq.solve(iq.newtons_cradle(3), iq.Moreau(1.0), backend=backend, options=options)
+
+
+def test_every_backend_says_which_options_it_takes():
+    listed = {b["name"]: b["options"] for b in iq.available_backends()}
+    assert listed["kernel"] == "" and "DefaultSettings" in listed["clarabel"]
+    assert all(isinstance(v, str) for v in listed.values())

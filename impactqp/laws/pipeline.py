@@ -22,6 +22,7 @@ from ..errors import (
     NoSolutionError,
 )
 from ..model.problem import ImpactProblem
+from ..qp import backends
 from ..qp.certified import solve_in_forms
 from ..qp.program import QPSolution
 from . import parallel, small
@@ -50,7 +51,7 @@ def _trivial(problem: ImpactProblem) -> Answer:
 
 
 def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
-          form: str = "auto", tol: float = DEFAULT_TOL,
+          form: str = "auto", tol: float = DEFAULT_TOL, options: dict | None = None,
           verbose: bool | int = False) -> ImpactResult:
     """Solve one impact with any impact law and return a certified result.
 
@@ -68,6 +69,11 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         Which program to solve, for laws that have several (they give the same u⁺).
     tol : float
         Tolerance of the recomputed certificate, in (0, 1).
+    options : dict, optional
+        Settings passed to the named backend's solver, on top of impactqp's tolerances:
+        Clarabel's ``DefaultSettings`` attributes, OSQP's setup settings, keywords of cvxpy's
+        ``Problem.solve`` or of the qpsolvers solver (``iq.available_backends()`` says what
+        each takes; the exact backends take none). The certificate still decides.
     verbose : bool or {0, 1, 2}
         Print impactqp's log of this solve on stderr: True or 1 refusals and fallbacks, 2
         also every backend attempt and certificate (the ``"impactqp"`` logger, see
@@ -95,12 +101,14 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
     """
     if verbose:
         with verbosity(verbose):
-            return solve(problem, law, backend, form=form, tol=tol)
+            return solve(problem, law, backend, form=form, tol=tol, options=options)
     start = time.perf_counter()
     tol = validate(problem, law, backend, form, tol)
+    if options is not None:
+        options = backends.check_options(backend, options)
     groups = parallel.collapsible(problem, law)
     if groups is not None:
-        return _collapsed(problem, law, groups, backend, form, tol, start)
+        return _collapsed(problem, law, groups, backend, form, tol, start, options)
     way = route(problem, law, backend, form)
     if way == "compiled":
         result = small.solve_small(problem, law, tol, start)
@@ -129,7 +137,7 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         return f, partial(law.program, problem, f), finish
 
     try:
-        out = solve_in_forms([stage(f) for f in forms], backend)
+        out = solve_in_forms([stage(f) for f in forms], backend, options)
     except NoSolutionError as exc:
         if law.always_solvable:  # a solution exists: failing to find it is the solvers'
             raise CertificateError(f"{law.title} has a solution for every u⁻, but no "
@@ -140,11 +148,12 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
 
 
 def _collapsed(problem: ImpactProblem, law: ImpactLaw, groups: parallel.Groups, backend: str,
-               form: str, tol: float, start: float) -> ImpactResult:
+               form: str, tol: float, start: float, options: dict | None) -> ImpactResult:
     """The impact with its parallel contacts collapsed (:mod:`.parallel`), its impulses split
     back and certified on the original problem."""
     reduced = solve(ImpactProblem.from_structure(groups.reduced, problem.u_minus),
-                    parallel.reduced_law(law, groups), backend, form=form, tol=tol)
+                    parallel.reduced_law(law, groups), backend, form=form, tol=tol,
+                    options=options)
     answer = parallel.expand(Answer(reduced.u_plus, reduced.impulses, reduced.z), groups)
     cert = law.certificate(problem, answer, tol)
     if not cert.ok:

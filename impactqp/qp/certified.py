@@ -25,6 +25,7 @@ from ..base.checks import ResidualChecks
 from ..errors import (
     BackendUnsuitableError,
     CertificateError,
+    InputError,
     NoSolutionError,
     SolverError,
     UnknownBackendError,
@@ -135,10 +136,12 @@ def plan(form: str, qp: QuadraticProgram, finish: Finish, backend: str) -> list[
 Stage = tuple[str, Callable[[], QuadraticProgram], Finish]
 
 
-def solve_in_forms(stages: Sequence[Stage], backend: str) -> Outcome:
+def solve_in_forms(stages: Sequence[Stage], backend: str,
+                   options: dict | None = None) -> Outcome:
     """Solve the first form (form, build the program, finish) that gives a certified answer;
     a program is built only when its form is reached (the impulse form of a long chain
-    would form its Delassus matrix for nothing).
+    would form its Delassus matrix for nothing). ``options`` go to the named backend's solver
+    (validated by :func:`~impactqp.qp.backends.check_options`).
 
     Raises
     ------
@@ -160,7 +163,7 @@ def solve_in_forms(stages: Sequence[Stage], backend: str) -> Outcome:
             LOG.info("%s form refused by %s: %s", form, backend, exc)
             continue
         try:
-            out = solve_certified(candidates, named=backend != "auto")
+            out = solve_certified(candidates, named=backend != "auto", options=options)
         except CertificateError as exc:
             failures.append(str(exc))
             _note(log, f"{form} form: {exc}", logging.INFO)
@@ -183,7 +186,7 @@ def _better(new: ResidualChecks, old: ResidualChecks) -> bool:
 
 
 def solve_certified(candidates: Sequence[Candidate], *, named: bool,
-                    tol: float = 1e-10) -> Outcome:
+                    tol: float = 1e-10, options: dict | None = None) -> Outcome:
     """Try each candidate until one answer passes its certificate.
 
     Raises
@@ -196,6 +199,7 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
         No candidate produced an answer within the certificate's tolerance.
     """
     log: list[str] = []
+    settings = {"options": options} if options else {}
     for cand in candidates:
         entry, sub = backends.parse_backend(cand.backend)
         try:
@@ -209,7 +213,9 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
             else normalize(cand.program)
         for attempt_tol in ((tol,) if entry.exact else (tol, tol * 1e-2)):
             try:
-                sol_unit = module.solve(unit, tol=attempt_tol, solver=sub)
+                sol_unit = module.solve(unit, tol=attempt_tol, solver=sub, **settings)
+            except InputError:  # the user's options: theirs to mend, not a solver failure
+                raise
             except (BackendUnsuitableError, UnknownBackendError) as exc:
                 if named:
                     raise

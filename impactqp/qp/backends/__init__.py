@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from functools import cache
 from types import ModuleType
 
-from ...errors import BackendUnsuitableError, UnknownBackendError
+from ...errors import BackendUnsuitableError, InputError, UnknownBackendError
 from ..program import QuadraticProgram
 
 FORMS = ("velocity", "impulse")
@@ -49,6 +49,8 @@ class Backend:
     scale_free : bool
         Its answer does not depend on the units of the program (relative tolerances only),
         so it needs no normalization (docs/theory.md §9).
+    options : str
+        What ``options=`` of :func:`impactqp.solve` sets for it ("" when it takes none).
     """
 
     name: str
@@ -60,6 +62,7 @@ class Backend:
     serves: str
     sub_solver: str = "none"
     scale_free: bool = False
+    options: str = ""
 
     @property
     def installed(self) -> bool:
@@ -77,16 +80,19 @@ REGISTRY: dict[str, Backend] = {b.name: b for b in (
     Backend("nnls", "nnls_", "numba", "numba", ("impulse",), True,
             "compiled NNLS on the Cholesky-scaled impulse form: dense, at most 400 contacts"),
     Backend("clarabel", "clarabel_", "clarabel", "clarabel", FORMS, False,
-            "Clarabel's own API (interior point), sparse"),
-    Backend("osqp", "osqp_", "osqp", "osqp", FORMS, False, "OSQP (operator splitting), sparse"),
+            "Clarabel's own API (interior point), sparse",
+            options="attributes of clarabel.DefaultSettings (max_iter, tol_gap_abs, ...)"),
+    Backend("osqp", "osqp_", "osqp", "osqp", FORMS, False, "OSQP (operator splitting), sparse",
+            options="OSQP settings of its setup (max_iter, eps_abs, rho, ...)"),
     Backend("cvxpy", "cvxpy_", "cvxpy", "cvxpy", FORMS, False,
             "any solver installed for cvxpy ('cvxpy:SOLVER'; default Clarabel)",
-            sub_solver="optional"),
+            sub_solver="optional",
+            options="keyword arguments of cvxpy's Problem.solve for the solver"),
     Backend("qpsolvers", "qpsolvers_", "qpsolvers", "qpsolvers (pip install 'impactqp[solvers]' "
             "adds daqp, piqp, ecos, quadprog)", FORMS, False,
             "any solver installed for qpsolvers ('qpsolvers:NAME', e.g. daqp, piqp, highs; "
             "'qpsolvers' alone: the best installed one for the program)",
-            sub_solver="optional"),
+            sub_solver="optional", options="keyword arguments of the qpsolvers solver"),
 )}
 
 QP_BACKENDS = tuple(REGISTRY)
@@ -152,6 +158,26 @@ def load(entry: Backend) -> ModuleType:
                                   f"install {entry.install}") from exc
 
 
+def check_options(backend: str, options: object) -> dict[str, object]:
+    """``options`` for ``backend`` as a dict (empty for None), or InputError: options need a
+    named backend that takes them (:attr:`Backend.options`), with string keys."""
+    if options is None:
+        return {}
+    if not isinstance(options, dict) or not all(isinstance(k, str) for k in options):
+        raise InputError(f"options must be a dict of solver settings by name, got "
+                         f"{type(options).__name__}")
+    if not options:
+        return {}
+    if backend == "auto":
+        raise InputError("options are settings of one solver: name the backend they are "
+                         "for (e.g. backend='clarabel'), not 'auto'")
+    entry, _ = parse_backend(backend)
+    if not entry.options:
+        takes = ", ".join(repr(b.name) for b in REGISTRY.values() if b.options)
+        raise InputError(f"backend {entry.name!r} takes no options (these do: {takes})")
+    return dict(options)
+
+
 def unsuitable(entry: Backend, qp: QuadraticProgram, form: str) -> str | None:
     """Why ``entry`` cannot solve ``qp`` (a program of ``form``), or None when it can."""
     if form not in entry.forms:
@@ -174,7 +200,9 @@ def available_backends() -> list[dict]:
     Returns
     -------
     list of dict
-        Keys ``name``, ``installed``, ``forms``, ``exact``, ``serves``, ``install``.
+        Keys ``name``, ``installed``, ``forms``, ``exact``, ``serves``, ``install`` and
+        ``options`` (what ``options=`` of :func:`impactqp.solve` sets, "" for none).
     """
     return [{"name": b.name, "installed": b.installed, "forms": b.forms, "exact": b.exact,
-             "serves": b.serves, "install": b.install} for b in REGISTRY.values()]
+             "serves": b.serves, "install": b.install, "options": b.options}
+            for b in REGISTRY.values()]

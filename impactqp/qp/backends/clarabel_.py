@@ -10,7 +10,7 @@ import clarabel
 import numpy as np
 import scipy.sparse as sp
 
-from ...errors import SolverError
+from ...errors import InputError, SolverError
 from ..program import QPSolution, QuadraticProgram
 
 _GOOD = {"Solved": "solved", "AlmostSolved": "solved_inaccurate"}
@@ -26,12 +26,28 @@ def settings(tol: float, max_iter: int = 200) -> clarabel.DefaultSettings:
     return s
 
 
-def run(P, q, A, b, cones, tol: float):
+def settings_with(tol: float, options: dict | None) -> clarabel.DefaultSettings:
+    """:func:`settings` with the user's ``options`` set on top (InputError for a name
+    Clarabel's settings do not have)."""
+    s = settings(tol)
+    for name, value in (options or {}).items():
+        if not hasattr(s, name):
+            known = ", ".join(n for n in dir(s) if not n.startswith("_"))
+            raise InputError(f"clarabel has no setting {name!r}; it has: {known}")
+        try:
+            setattr(s, name, value)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"clarabel setting {name}={value!r}: {exc}") from exc
+    return s
+
+
+def run(P, q, A, b, cones, tol: float, options: dict | None = None):
     """Run Clarabel on its own standard form; raise SolverError unless (almost) solved."""
     P = sp.triu(sp.csc_matrix(P), format="csc")
+    config = settings_with(tol, options)
     try:
         sol = clarabel.DefaultSolver(P, np.asarray(q, float), sp.csc_matrix(A),
-                                     np.asarray(b, float), cones, settings(tol)).solve()
+                                     np.asarray(b, float), cones, config).solve()
     except Exception as exc:  # Clarabel reports every failure as a bare Exception
         raise SolverError(f"clarabel failed: {exc}") from exc
     status = str(sol.status).split(".")[-1]
@@ -40,9 +56,10 @@ def run(P, q, A, b, cones, tol: float):
     return sol, _GOOD[status]
 
 
-def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
+def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None,
+          options: dict | None = None) -> QPSolution:
     A = sp.csc_matrix(qp.constraint_matrix())
     sol, status = run(qp.P, qp.c, -A, -qp.constraint_rhs(),
-                      [clarabel.NonnegativeConeT(qp.n_constraints)], tol)
+                      [clarabel.NonnegativeConeT(qp.n_constraints)], tol, options)
     return QPSolution(x=np.array(sol.x), y=np.array(sol.z), status=status, backend="clarabel",
                       iterations=int(sol.iterations))

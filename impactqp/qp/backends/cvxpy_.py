@@ -13,7 +13,7 @@ import weakref
 import cvxpy as cp
 import numpy as np
 
-from ...errors import SolverError, UnknownBackendError
+from ...errors import InputError, SolverError, UnknownBackendError
 from ..program import QPSolution, QuadraticProgram
 from . import tolerance_options
 
@@ -57,7 +57,8 @@ def _compiled(qp: QuadraticProgram, solver: str | None):
     return entry[0]
 
 
-def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
+def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None,
+          options: dict | None = None) -> QPSolution:
     if solver is not None and solver.upper() not in cp.installed_solvers():
         raise UnknownBackendError(f"backend 'cvxpy:{solver}': that solver is not installed "
                                   "for cvxpy; installed: "
@@ -66,7 +67,9 @@ def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None
     prob, x, c, con = _compiled(qp, name)
     c.value = np.asarray(qp.c, dtype=float)
     try:
-        prob.solve(solver=name, **tolerance_options(name, tol))
+        prob.solve(solver=name, **{**tolerance_options(name, tol), **(options or {})})
+    except TypeError as exc:  # a keyword the solver does not take
+        raise InputError(f"cvxpy ({name}) options {options}: {exc}") from exc
     except (cp.error.SolverError, ValueError) as exc:
         raise SolverError(f"cvxpy ({solver or 'default'}) failed: {exc}") from exc
     if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:

@@ -10,7 +10,7 @@ import numpy as np
 import osqp
 import scipy.sparse as sp
 
-from ...errors import SolverError
+from ...errors import InputError, SolverError
 from ..program import QPSolution, QuadraticProgram
 
 MAX_VARIABLES = 50_000
@@ -26,14 +26,21 @@ def unsuitable(qp: QuadraticProgram) -> str | None:
     return None
 
 
-def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
+def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None,
+          options: dict | None = None) -> QPSolution:
     P = sp.triu(sp.csc_matrix(qp.P), format="csc")
     A = sp.csc_matrix(qp.constraint_matrix())
     upper = np.full(qp.n_constraints, np.inf)
+    settings = {"verbose": False, "eps_abs": tol, "eps_rel": tol, "max_iter": 200000,
+                "polishing": False, **(options or {})}
     prob = osqp.OSQP()
     try:
-        prob.setup(P, np.asarray(qp.c, float), A, qp.constraint_rhs(), upper, verbose=False,
-                   eps_abs=tol, eps_rel=tol, max_iter=200000, polishing=False)
+        prob.setup(P, np.asarray(qp.c, float), A, qp.constraint_rhs(), upper, **settings)
+    except (TypeError, ValueError) as exc:  # a setting OSQP does not know or accept
+        if options:
+            raise InputError(f"osqp settings {options}: {exc}") from exc
+        raise SolverError(f"osqp failed: {exc}") from exc
+    try:
         res = prob.solve()
     except Exception as exc:
         raise SolverError(f"osqp failed: {exc}") from exc

@@ -7,7 +7,7 @@ import numpy as np
 import qpsolvers
 
 from ...base.arrays import as_dense
-from ...errors import BackendUnsuitableError, SolverError, UnknownBackendError
+from ...errors import BackendUnsuitableError, InputError, SolverError, UnknownBackendError
 from ..program import QPSolution, QuadraticProgram
 from . import tolerance_options
 from .exact import MAX_DENSE_VARIABLES
@@ -37,7 +37,8 @@ def best_solver(qp: QuadraticProgram) -> str:
                               "(pip install 'impactqp[solvers]' adds daqp, piqp, ecos, quadprog)")
 
 
-def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None) -> QPSolution:
+def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None,
+          options: dict | None = None) -> QPSolution:
     if solver is None:
         solver = best_solver(qp)
     if solver not in qpsolvers.available_solvers:
@@ -55,7 +56,10 @@ def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None
         P, G = as_dense(P), as_dense(G)
     problem = qpsolvers.Problem(P, np.asarray(qp.c, float), G, -qp.constraint_rhs())
     try:
-        sol = qpsolvers.solve_problem(problem, solver=solver, **tolerance_options(solver, tol))
+        sol = qpsolvers.solve_problem(problem, solver=solver,
+                                      **{**tolerance_options(solver, tol), **(options or {})})
+    except TypeError as exc:  # a keyword the solver does not take
+        raise InputError(f"qpsolvers:{solver} options {options}: {exc}") from exc
     except Exception as exc:  # solvers raise their own types; translate them
         raise SolverError(f"qpsolvers:{solver} failed: {exc}") from exc
     if sol.x is None or sol.z is None or not sol.found:
