@@ -77,7 +77,7 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
     verbose : bool or {0, 1, 2}
         Print impactqp's log of this solve on stderr: True or 1 refusals and fallbacks, 2
         also every backend attempt and certificate (the ``"impactqp"`` logger, see
-        :mod:`impactqp.base.log`).
+        :mod:`!impactqp.base.log`).
 
     Returns
     -------

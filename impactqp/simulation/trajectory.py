@@ -137,10 +137,7 @@ class Trajectory:
         Returns
         -------
         matplotlib.figure.Figure
-
-        See Also
-        --------
-        impactqp.simulation.pictures.plot : the parameters in full.
+            (``impactqp.simulation.pictures.plot`` documents the parameters in full.)
         """
         from . import pictures
 
@@ -154,10 +151,7 @@ class Trajectory:
         Returns
         -------
         matplotlib.animation.FuncAnimation
-
-        See Also
-        --------
-        impactqp.simulation.pictures.animate : the parameters in full.
+            (``impactqp.simulation.pictures.animate`` documents the parameters in full.)
         """
         from . import pictures
 

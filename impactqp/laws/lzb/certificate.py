@@ -38,7 +38,7 @@ class LZBCertificate(ResidualChecks):
     integration_tol : float
         Tolerance of the residuals the integration's accuracy decides (energy_balance,
         kinematic, potential_left): ``tol``, or more where the integration's own error
-        estimate is larger (:func:`integration_tolerance`, docs/theory.md §13).
+        estimate is larger (:func:`!integration_tolerance`, docs/theory.md §13).
     record : LZBRecord or None
         The integration (primary switches, steps, energies); None when nothing was integrated.
     """
