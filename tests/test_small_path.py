@@ -48,7 +48,7 @@ def test_compiled_path_matches_the_general_path(case) -> None:
 def test_compiled_path_at_every_velocity_scale(scale) -> None:
     p = iq.newtons_cradle(3, v=scale)
     r = iq.moreau(p, 1.0)
-    assert r.attempts == [COMPILED]
+    assert r.attempts[-1] == COMPILED  # in order-one units beyond 1e±100
     np.testing.assert_allclose(r.u_plus, np.array([-1, 2, 2]) / 3 * scale, rtol=1e-12)
     assert r.certificate.ok
     assert not small.applies(p, iq.SectorLaw(), "auto", "auto")

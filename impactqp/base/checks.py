@@ -12,6 +12,11 @@ from dataclasses import dataclass
 DEFAULT_TOL = 1e-9
 """Default tolerance of the dimensionless residuals of a certificate (docs/theory.md §8)."""
 
+UNIT_RANGE = (1e-100, 1e100)
+"""Velocity scales (largest |u⁻ᵢ|) worked with as given; beyond them, scale-free answers are
+computed in order-one units and scaled back (docs/theory.md §8): norms and products of
+1e±160 velocities leave the float range."""
+
 
 class ResidualChecks(ABC):
     """Verdict shared by every certificate: each of its

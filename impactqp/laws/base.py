@@ -75,6 +75,11 @@ class ImpactLaw(ABC):
         print them (``"ε"``); None for a law without coefficients.
     needs_coefficients : bool
         Naming the law requires its coefficients (they have no default).
+    homogeneous : bool
+        u⁻ ↦ (u⁺, Λ) is positively homogeneous of degree one (the laws of docs/theory.md
+        §3, §6, §10, §13): :func:`impactqp.solve` may then solve a problem whose velocities
+        are far from order one in order-one units and scale the answer back (docs/theory.md
+        §8).
     """
 
     name: ClassVar[str]
@@ -94,6 +99,7 @@ class ImpactLaw(ABC):
     coefficient_key: ClassVar[str | None] = None
     coefficient_symbol: ClassVar[str | None] = None
     needs_coefficients: ClassVar[bool] = False
+    homogeneous: ClassVar[bool] = False
 
     @classmethod
     def from_coefficients(cls, coefficients: Any = None) -> ImpactLaw:

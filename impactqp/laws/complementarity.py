@@ -43,6 +43,7 @@ class _ComplementarityLaw(ImpactLaw):
     """``0 ≤ Λ ⟂ GΛ + (I + E)γ⁻ ≥ 0``, solved in impulse form."""
 
     forms = ("impulse",)
+    homogeneous = True
 
     @abstractmethod
     def restitution(self, m: int) -> np.ndarray:

@@ -58,6 +58,7 @@ class Moreau(ImpactLaw):
     title = "Moreau's law"
     forms = ("velocity", "impulse")
     always_solvable = True
+    homogeneous = True
     by_name = True
     coefficient_key = "eps"
     coefficient_symbol = "ε"

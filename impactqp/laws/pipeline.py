@@ -14,12 +14,13 @@ from functools import partial
 
 import numpy as np
 
-from ..base.checks import DEFAULT_TOL
+from ..base.checks import DEFAULT_TOL, UNIT_RANGE
 from ..base.log import verbosity
 from ..errors import (
     BackendUnsuitableError,
     CertificateError,
     NoSolutionError,
+    OutOfRangeError,
 )
 from ..model.problem import ImpactProblem
 from ..qp import backends
@@ -106,6 +107,9 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
     tol = validate(problem, law, backend, form, tol)
     if options is not None:
         options = backends.check_options(backend, options)
+    scale = float(np.abs(problem.u_minus).max(initial=0.0))
+    if law.homogeneous and scale > 0 and not UNIT_RANGE[0] <= scale <= UNIT_RANGE[1]:
+        return _rescaled(problem, law, scale, backend, form, tol, options, start)
     groups = parallel.collapsible(problem, law)
     if groups is not None:
         return _collapsed(problem, law, groups, backend, form, tol, start, options)
@@ -145,6 +149,23 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         raise
     return _result(problem, law, out.answer, out.backend, out.checks, start, form=out.form,
                    attempts=out.attempts)
+
+
+def _rescaled(problem: ImpactProblem, law: ImpactLaw, scale: float, backend: str, form: str,
+              tol: float, options: dict | None, start: float) -> ImpactResult:
+    """The impact solved with u⁻ divided by ``scale`` (order one) and the answer scaled back:
+    for a homogeneous law u⁺ and Λ scale with u⁻ and the dimensionless certificate does not
+    change (docs/theory.md §8), while products of velocities 1e±160 would leave the floats."""
+    unit = solve(problem.with_u_minus(problem.u_minus / scale), law, backend, form=form,
+                 tol=tol, options=options)
+    with np.errstate(over="ignore"):
+        u_plus, impulses = unit.u_plus * scale, unit.impulses * scale
+    if not (np.isfinite(u_plus).all() and np.isfinite(impulses).all()):
+        raise OutOfRangeError(f"{law.title}: u⁺ or Λ ({max(np.abs(unit.u_plus).max(), 1.0):.3g}"
+                              f" × {scale:.3g} in the problem's units) overflows floats")
+    return _result(problem, law, Answer(u_plus, impulses, None), unit.backend,
+                   unit.certificate, start, form=unit.form,
+                   attempts=[f"solved in units of u⁻/{scale:.3g}", *unit.attempts])
 
 
 def _collapsed(problem: ImpactProblem, law: ImpactLaw, groups: parallel.Groups, backend: str,

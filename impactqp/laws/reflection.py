@@ -58,6 +58,7 @@ class ReflectionLaw(ImpactLaw):
     title = "the reflection law"
     closed_form_backend = "reflections"
     always_solvable = True
+    homogeneous = True
 
     def check(self, problem: ImpactProblem) -> None:
         check_reflection_problem(problem)

@@ -126,6 +126,7 @@ class SectorLaw(ImpactLaw):
     title = "the sector law"
     closed_form_backend = "sort"
     always_solvable = True
+    homogeneous = True
 
     def check(self, problem: ImpactProblem) -> None:
         check_sector_problem(problem)

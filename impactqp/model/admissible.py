@@ -22,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import as_vector, check_tol
-from ..base.checks import DEFAULT_TOL, NamedChecks
+from ..base.checks import DEFAULT_TOL, UNIT_RANGE, NamedChecks
 from ..errors import InputError
 from ..kernels.nnls import solve_nnls
 from ..qp.backends.clarabel_ import run as run_clarabel
@@ -143,6 +143,10 @@ class AdmissibleSet:
         u = p.u_minus
         if st.m == 0 or not np.any(u):
             return u.copy(), np.zeros_like(u)
+        scale = float(np.abs(u).max())
+        if not UNIT_RANGE[0] <= scale <= UNIT_RANGE[1]:  # z scales with u⁻: order-one units
+            z = p.with_u_minus(u / scale).admissible_set().moreau_split()[0] * scale
+            return z, u - z
         build = {"velocity": lambda: velocity_program(p),
                  "impulse": lambda: impulse_program(p, p.gamma_minus, 1.0)}
 

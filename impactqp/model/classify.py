@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from ..base.arrays import as_vector
-from ..errors import InputError
+from ..base.checks import UNIT_RANGE
+from ..errors import InputError, OutOfRangeError
 from .admissible import best_impulses
 from .problem import ImpactProblem
 
@@ -73,16 +74,29 @@ def classify(problem: ImpactProblem, u_plus: Any) -> Classification:
     ------
     InputError
         ``problem`` is not an ImpactProblem or ``u_plus`` is not a finite (n,) vector.
+    OutOfRangeError
+        The intensity or the impulses do not fit in floats (the other invariants would).
     """
     if not isinstance(problem, ImpactProblem):
         raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
     u = as_vector("u_plus", u_plus, problem.n_dof)
+    scale = max(float(np.abs(problem.u_minus).max(initial=0.0)),
+                float(np.abs(u).max(initial=0.0)))
+    if scale > 0 and not UNIT_RANGE[0] <= scale <= UNIT_RANGE[1]:
+        # every invariant but the intensity and Λ is scale-free: classify in order-one units
+        unit = classify(problem.with_u_minus(problem.u_minus / scale), u / scale)
+        intensity, impulses = unit.intensity * scale, unit.impulses * scale
+        if not (np.isfinite(intensity) and np.isfinite(impulses).all()):
+            raise OutOfRangeError(f"the impact's intensity ({unit.intensity:.3g} × "
+                                  f"{scale:.3g}) or its impulses overflow floats")
+        return replace(unit, intensity=intensity, impulses=impulses)
     z, zp = problem.moreau_split
     du = u - problem.u_minus
     lam, res = best_impulses(problem, du)
     intensity = problem.norm(du)
-    lam_norm = np.linalg.norm(lam)
-    topology = lam / lam_norm if lam_norm > 0 else np.full_like(lam, np.nan)
+    peak = float(np.abs(lam).max(initial=0.0))  # Λ/max|Λᵢ| first: ‖Λ‖² may underflow
+    topology = (lam / peak) / np.linalg.norm(lam / peak) if peak > 0 else \
+        np.full_like(lam, np.nan)
     direction = _unit(problem, du)
     moreau_dir = _unit(problem, -zp)
     zp2 = problem.norm(zp) ** 2

@@ -143,6 +143,13 @@ class LZB(ImpactLaw):
         self.energy_target = None if energy_target is None else \
             as_real("energy_target", energy_target, positive=True)
 
+
+    @property
+    def homogeneous(self) -> bool:
+        """One exponent for every contact: only then does the impact scale with u⁻ (with
+        several, the stiffness ratios weigh differently at other energies; docs/theory.md
+        §13)."""
+        return bool(np.all(np.asarray(self.exponent) == np.ravel(self.exponent)[0]))
     def contact_laws(self, m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(Kᵢ, ηᵢ, eᵢ) spread over ``m`` contacts."""
         return (_per_contact("stiffness", self.stiffness, m),
