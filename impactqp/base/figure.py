@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError, OptionalDependencyError
+from .outputs import output_file
 
 FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 DPI = 100
@@ -61,5 +62,5 @@ def figure_format(path: str | Path) -> str:
 def save_figure(fig: Any, path: str | Path) -> Path:
     """Write ``fig`` in the format of the suffix of ``path``, without time stamps."""
     fmt = figure_format(path)
-    fig.savefig(path, format=fmt, metadata=_NO_DATES[fmt])
+    fig.savefig(output_file(path), format=fmt, metadata=_NO_DATES[fmt])
     return Path(path)

@@ -15,6 +15,7 @@ import numpy as np
 import tomli_w
 
 from ..base.arrays import as_dense
+from ..base.outputs import output_file
 from ..errors import InputError
 from ..model.problem import ImpactProblem
 from .files import COEFFICIENT_KEYS, VERSION, file_format, problem_from_dict
@@ -89,7 +90,7 @@ def save_problem(problem: ImpactProblem, path: str | Path, *, law: str | None = 
     Path
         The path written.
     """
-    path = Path(path)
+    path = output_file(path)
     fmt = file_format(path)
     data = problem_to_dict(problem, law=law, coefficients=coefficients, u_plus=u_plus)
     text = to_json(data) if fmt == "json" else to_toml(data)

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from ..base.outputs import output_file
 from ..errors import InputError
 from ..laws.base import ImpactLaw
 from .impacts import ImpactEvent
@@ -194,6 +195,7 @@ class Trajectory:
         suffix = path.suffix.lower()
         if suffix not in FORMATS:
             raise InputError(f"trajectory file must end in one of {FORMATS}, got {path.name!r}")
+        output_file(path)
         if suffix == ".npz":
             meta = json.dumps({"scheme": self.scheme, "law": repr(self.law),
                                "settings": self.settings})

@@ -33,6 +33,8 @@ from typing import Any
 
 import numpy as np
 
+from ...base.arrays import as_real
+from ...base.outputs import output_file
 from ...errors import InputError, ProblemFileError
 from ...laws.base import ImpactLaw
 from ...laws.catalogue import NAMED_LAWS, law_named
@@ -208,7 +210,13 @@ def run(args: argparse.Namespace) -> int:
     if sim.get("scheme", "moreau-jean") not in SCHEMES:
         raise ProblemFileError(f"simulation.scheme must be one of {SCHEMES}, got "
                                f"{sim['scheme']!r}")
-    bar = _Bar(float(sim.get("t0", 0.0)), float(sim["t_end"]), not args.quiet)
+    if "t_end" not in sim:
+        raise ProblemFileError(f"{args.file}: [simulation] needs t_end (or pass --t-end)")
+    t0, t_end = as_real("simulation.t0", sim.get("t0", 0.0)), as_real("simulation.t_end",
+                                                                       sim["t_end"])
+    if args.out:
+        output_file(args.out)  # refused before the run, not after it
+    bar = _Bar(t0, t_end, not args.quiet)
     try:
         trajectory = simulate(system, law, progress=bar, **sim)
     finally:
