@@ -247,3 +247,39 @@ def test_plot_S_of_a_file_with_two_candidates(tmp_path, capsys):
     root = Path(__file__).resolve().parent.parent
     assert main(["plot", "S", str(root / "examples" / "cradle.toml"), "--out", str(out)]) == 0
     _check_file(out, "png")
+
+
+def test_benchmark_plot_has_one_legend_per_kind_and_one_colour_per_solver():
+    from matplotlib.colors import to_rgba
+
+    from benchmarks import report
+
+    root = Path(__file__).resolve().parent.parent
+    rows = report.read_rows(root / "benchmarks" / "reference" / "results.csv")
+    fig = report.plot_figure(rows)
+    try:
+        legends = [leg for ax in fig.axes if (leg := ax.get_legend()) is not None]
+        titles = [leg.get_title().get_text() for leg in legends]
+        assert titles == [title for title, _ in report.PANELS]
+        entries = [[t.get_text() for t in leg.get_texts()] for leg in legends]
+        plotted = {r["method"] for r in rows if report._panel(r["method"], r["group"])
+                   is not None and r["median_s"] is not None}
+        assert sorted(sum(entries, [])) == sorted(plotted | {"iq:auto (for comparison)"})
+        assert max(map(len, entries)) <= 12  # no legend of 27 series
+        own, via, raw = entries
+        assert all(m.startswith("iq:") for m in own + via)
+        assert all(not m.startswith("iq:") or "comparison" in m for m in raw)
+        # a solver keeps its colour from column to column
+        colour = {t.get_text(): to_rgba(h.get_color())
+                  for leg in legends for t, h in zip(leg.get_texts(), leg.legend_handles)}
+        assert colour["iq:clarabel"] == colour["raw:clarabel"]
+        assert colour["iq:qpsolvers:daqp"] == colour["raw:qpsolvers:daqp"]
+        for names in entries:  # within a column, no two methods look alike
+            looks = {(colour[n], h.get_marker(), h.get_linestyle()) for n, h in
+                     zip(names, next(leg for leg in legends if leg.get_texts()[0].get_text()
+                                     == names[0]).legend_handles)}
+            assert len(looks) == len(names)
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
