@@ -54,6 +54,21 @@ def aggregate(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return rows
 
 
+NUMERIC = ("size", "instances", "ran", "ok", "success_rate", "median_s", "p90_s",
+           "max_error", "peak_mb", "output_mb")
+
+
+def read_rows(path: Path) -> list[dict[str, Any]]:
+    """The rows of a results.csv written by :func:`write_all` (numbers as floats, empty cells
+    as None), e.g. to redraw :func:`plot` from ``benchmarks/reference/results.csv``."""
+    with open(path, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    for row in rows:
+        for key in NUMERIC:
+            row[key] = float(row[key]) if row.get(key) not in (None, "") else None
+    return rows
+
+
 def fmt_time(seconds: float | None) -> str:
     if seconds is None:
         return "—"
@@ -327,8 +342,19 @@ def summary_markdown(rows: list[dict], meta: dict) -> str:
 
 
 #: the columns of the figure: which method groups share a panel
-PANELS = (("impactqp", ("impactqp", "batch")), ("raw solvers and peers", ("raw", "peer")))
-PALETTE = [*(f"C{i}" for i in range(10)), "black", "darkgoldenrod"]
+PANELS = (("impactqp's own algorithms", ("impactqp", "batch")),
+          ("impactqp through a QP solver", ("impactqp",)),
+          ("raw solvers and the Siconos peer", ("raw", "peer")))
+"""Columns of the plot: a title and the method groups it draws (:func:`_panel` splits the
+impactqp group between the first two)."""
+VIA_SOLVER = ("clarabel", "osqp", "cvxpy", "qpsolvers")
+"""Names that mark an impactqp method as going through an external QP solver."""
+SOLVER_COLORS = {"clarabel": "C0", "osqp": "C1", "cvxpy": "C2", "daqp": "C3", "piqp": "C4",
+                 "highs": "C5", "isotonic": "C6", "lemke": "C7", "pgs": "C8", "enum": "C9"}
+"""One colour per solver, the same in every column (iq:clarabel and raw:clarabel alike)."""
+OWN_COLORS = ["black", "darkgoldenrod", "saddlebrown", "teal", "slateblue", "olivedrab",
+              "firebrick", "dimgray"]
+"""Colours of impactqp's own algorithms, in order of appearance (none is a solver's)."""
 MARKERS = "os^vDPX*h<>p"
 LINESTYLES = {"impactqp": "-", "batch": "-", "raw": "--", "peer": ":"}
 REFERENCE = "iq:auto"  # also drawn in the raw-solver panels, for comparison
@@ -344,24 +370,50 @@ def _size_label(size: float) -> str:
     return power if abs(mantissa - 1) < 1e-9 else f"{mantissa:g}·{power}"
 
 
+def _panel(method: str, group: str) -> int | None:
+    """The column of :data:`PANELS` that draws a method, None for groups not plotted."""
+    if group in ("raw", "peer"):
+        return 2
+    if group == "impactqp" and any(name in method for name in VIA_SOLVER):
+        return 1
+    return 0 if group in ("impactqp", "batch") else None
+
+
 def _styles(rows: list[dict]) -> dict[str, dict[str, Any]]:
-    """Colour, marker and line style per method, distinct within each panel column."""
+    """Colour, marker and line style per method: the colour names the solver (the same in
+    every column), the line style the kind (solid impactqp, dashed raw, dotted peer), and
+    no two methods share colour and marker."""
     group_of = {r["method"]: r["group"] for r in rows}
     styles: dict[str, dict[str, Any]] = {}
-    for _, groups in PANELS:
-        members = [m for m in group_of if group_of[m] in groups]
-        for i, method in enumerate(members):
-            # colours cycle fastest, the marker shifts each cycle: pairs never repeat
-            styles[method] = {"color": PALETTE[i % len(PALETTE)],
-                              "marker": MARKERS[(i + i // len(PALETTE)) % len(MARKERS)],
-                              "ls": LINESTYLES.get(group_of[method], "-")}
+    taken: set[tuple[str, str]] = set()
+    own = iter(OWN_COLORS * (len(group_of) // len(OWN_COLORS) + 1))
+    for i, method in enumerate(group_of):
+        color = next((c for name, c in SOLVER_COLORS.items() if name in method), None) \
+            or next(own)
+        k = i
+        while (color, MARKERS[k % len(MARKERS)]) in taken and k < i + len(MARKERS):
+            k += 1
+        marker = MARKERS[k % len(MARKERS)]
+        taken.add((color, marker))
+        styles[method] = {"color": color, "marker": marker,
+                          "ls": LINESTYLES.get(group_of[method], "-")}
     return styles
 
 
 def plot(rows: list[dict], path: Path) -> None:
-    """Log-log median time vs size: one row per family, impactqp's paths on the left, raw
-    solvers and the Siconos peer on the right (with iq:auto repeated there for comparison);
-    every method has its own colour and marker, ticks only at the measured sizes."""
+    """Write :func:`plot_figure` of ``rows`` to ``path`` (PNG)."""
+    fig = plot_figure(rows)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def plot_figure(rows: list[dict]) -> Any:
+    """Log-log median time vs size: one row per family, one column per kind of method
+    (:data:`PANELS`: impactqp's own algorithms, impactqp through a QP solver, raw solvers
+    and the Siconos peer, with iq:auto repeated there for comparison). Each column has its
+    own legend above it, naming only its methods; a solver has one colour in every column;
+    ticks only at the measured sizes. Returns the pyplot Figure (the caller closes it).
+    """
     from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 
     fams = [f for f in SIZE_LABEL if f not in RUN_FAMILIES and any(r["family"] == f
@@ -369,36 +421,34 @@ def plot(rows: list[dict], path: Path) -> None:
     if not fams:
         fig = plt.figure(figsize=(6, 1.5))
         fig.text(0.5, 0.5, "no measurements", ha="center", va="center")
-        fig.savefig(path, dpi=90)
-        plt.close(fig)
-        return
+        return fig
     styles = _styles(rows)
-    fig, axes = plt.subplots(len(fams), len(PANELS), figsize=(12, 2.9 * len(fams) + 1.6),
+    fig, axes = plt.subplots(len(fams), len(PANELS), figsize=(15, 2.9 * len(fams) + 0.4),
                              squeeze=False, layout="constrained")
     handles: list[dict[str, Any]] = [{} for _ in PANELS]
     for row, family in enumerate(fams):
         fam = [r for r in rows if r["family"] == family and r["median_s"] is not None]
         sizes = sorted({r["size"] for r in fam})
-        for col, (title, groups) in enumerate(PANELS):
+        for col, (title, _) in enumerate(PANELS):
             ax = axes[row, col]
             methods = [m for m in dict.fromkeys(r["method"] for r in fam)
-                       if next(r["group"] for r in fam if r["method"] == m) in groups]
+                       if _panel(m, next(r["group"] for r in fam if r["method"] == m)) == col]
             if not methods:
                 ax.axis("off")
                 continue
-            if col > 0 and any(r["method"] == REFERENCE for r in fam):
+            if col == 2 and any(r["method"] == REFERENCE for r in fam):
                 methods.append(REFERENCE)
             for method in methods:
                 pts = sorted((r["size"], r["median_s"], r["success_rate"]) for r in fam
                              if r["method"] == method)
                 x, y, _ = zip(*pts)
                 style = dict(styles[method])
-                if method == REFERENCE and col > 0:
+                reference = method == REFERENCE and col == 2
+                if reference:
                     style.update(lw=2.5, alpha=0.35, ls="-")
                 (line,) = ax.plot(x, y, markersize=4, **style)
-                label = f"{method} (for comparison)" if col > 0 and method == REFERENCE \
-                    else method
-                handles[col].setdefault(label, line)
+                handles[col].setdefault(f"{method} (for comparison)" if reference else method,
+                                        line)
                 bad = [(a, b) for a, b, s in pts if s != 1]
                 if bad:
                     ax.plot(*zip(*bad), "x", color=style["color"], markersize=9, mew=1.5)
@@ -409,16 +459,21 @@ def plot(rows: list[dict], path: Path) -> None:
             ax.xaxis.set_major_formatter(NullFormatter())
             ax.set_xticks(sizes, [_size_label(s) for s in sizes],
                           rotation=30 if len(sizes) > 5 else 0)
-            ax.yaxis.set_minor_formatter(NullFormatter())
+            low, high = ax.get_ylim()
+            if np.floor(np.log10(high)) > np.ceil(np.log10(low)):  # ≥ 2 labelled decades
+                ax.yaxis.set_minor_formatter(NullFormatter())
             ax.grid(True, which="major", alpha=0.3)
             ax.set_xlabel(SIZE_LABEL[family])
-    for (title, _), col_handles, loc in zip(PANELS, handles, ("left", "right")):
-        if col_handles:
-            fig.legend(list(col_handles.values()), list(col_handles), loc=f"outside lower {loc}",
-                       ncol=3, fontsize=8, title=title, title_fontsize=9, frameon=False)
-    fig.suptitle("Moreau impact: median solve time (× = some runs failed or inaccurate)")
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    for col, ((title, _), col_handles) in enumerate(zip(PANELS, handles)):
+        if col_handles:  # above the column's first panel, naming only the column's methods
+            top = next(ax for ax in axes[:, col] if ax.axison)
+            top.legend(list(col_handles.values()), list(col_handles), loc="lower center",
+                       bbox_to_anchor=(0.5, 1.12), ncol=2, fontsize=8, title=title,
+                       title_fontsize=9, frameon=False)
+    fig.suptitle("Moreau impact: median solve time (× = some runs failed or inaccurate)\n"
+                 "colour: the solver, the same in every column; line: solid impactqp, dashed "
+                 "raw solver, dotted peer")
+    return fig
 
 
 def write_all(records: list[dict], out_dir: Path, meta: dict) -> list[dict]:

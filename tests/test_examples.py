@@ -1,7 +1,10 @@
-"""Every script in examples/ runs as a stranger would run it and prints what it promises."""
+"""Every script in examples/ runs as a stranger would run it, prints what it promises, and
+writes only into the folder it prints (never into the working directory or the clone)."""
 
 from __future__ import annotations
 
+import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -17,25 +20,69 @@ EXPECTED = {
                              "masses (1, 2, 1), callable: VIOLATED",
                              "worst counterexample (non_expansive"],
     "benchmark_run.py": ["# impactqp benchmark — suite `smoke`", "## Targets"],
+    "lzb_comparison.py": ["3 balls, u⁻ = (1, 0, …, 0) m/s", "10 balls"],
+    "simulate_cradle.py": ["cradle.gif"],
 }
 
+WRITES = {
+    "benchmark_run.py": {"results.csv", "results.json", "summary.md", "plot.png"},
+    "lzb_comparison.py": {"lzb_comparison.png"},
+    "simulate_cradle.py": {"bouncing_ball_energy.png", "cradle_positions.png", "cradle.gif"},
+}
+"""The files each writing example leaves in the folder it prints last."""
 
 SCRIPTS = sorted(p.name for p in EXAMPLES.glob("*.py"))
 
 
+def _run(name: str, cwd: Path, *args: str) -> subprocess.CompletedProcess:
+    done = subprocess.run([sys.executable, str(EXAMPLES / name), *args], capture_output=True,
+                          text=True, timeout=180, cwd=cwd)
+    assert done.returncode == 0, done.stderr
+    return done
+
+
+def _printed_folder(stdout: str) -> Path:
+    match = re.search(r"written to (.+)$", stdout.strip().splitlines()[-1])
+    assert match, stdout
+    return Path(match.group(1))
+
+
 def test_the_documented_examples_exist():
-    assert set(EXPECTED) <= set(SCRIPTS)
+    assert set(EXPECTED) == set(SCRIPTS) and set(WRITES) <= set(SCRIPTS)
+
+
+def _repository_state() -> str:
+    root = EXAMPLES.parent
+    if not (root / ".git").exists() or shutil.which("git") is None:
+        return ""
+    return subprocess.run(["git", "status", "--porcelain", "--untracked-files=all"], cwd=root,
+                          capture_output=True, text=True).stdout
 
 
 @pytest.mark.parametrize("name", SCRIPTS)
 def test_example_runs(name, tmp_path):
-    """Every script runs from a foreign working directory and prints something; the
-    documented ones print their key lines and leave nothing behind."""
-    done = subprocess.run([sys.executable, str(EXAMPLES / name)], capture_output=True,
-                          text=True, timeout=120, cwd=tmp_path)
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.strip()
-    for line in EXPECTED.get(name, []):
+    """Every script runs from a foreign working directory, prints its key lines and leaves
+    nothing behind there; one that writes files names its folder last, and that folder (a new
+    temporary one by default) holds exactly what it promised."""
+    before = _repository_state()
+    done = _run(name, tmp_path)
+    for line in EXPECTED[name]:
         assert line in done.stdout, (line, done.stdout)
-    if name in EXPECTED:
-        assert not list(tmp_path.iterdir())  # nothing left behind in the working directory
+    assert not list(tmp_path.iterdir())  # nothing left behind in the working directory
+    assert _repository_state() == before  # nor in the clone (docs/figures untouched)
+    if name in WRITES:
+        folder = _printed_folder(done.stdout)
+        try:
+            assert folder.is_absolute() and not folder.is_relative_to(EXAMPLES.parent)
+            assert {p.name for p in folder.iterdir()} == WRITES[name]
+        finally:
+            shutil.rmtree(folder)
+
+
+@pytest.mark.parametrize("name", sorted(set(WRITES) - {"benchmark_run.py"}))
+def test_example_writes_where_it_is_told(name, tmp_path):
+    """``--out DIR`` puts the files in DIR (created), and nowhere else."""
+    done = _run(name, tmp_path, "--out", "figs")
+    assert _printed_folder(done.stdout) == Path("figs")
+    assert [p.name for p in tmp_path.iterdir()] == ["figs"]
+    assert {p.name for p in (tmp_path / "figs").iterdir()} == WRITES[name]

@@ -188,3 +188,98 @@ def test_sector_axes_name_their_metric():
     draw_sectors(sector_picture(), ax)
     assert "G⁻¹-orthonormal" in ax.get_xlabel() and "G⁻¹-orthonormal" in ax.get_ylabel()
     assert "60°" in ax.get_title()
+
+
+def _candidate_marks(ax, labels):
+    legend = {h.get_label(): h for h in ax.get_legend().legend_handles}
+    marks = [next(v for k, v in legend.items() if k.startswith(label)) for label in labels]
+    return legend, marks
+
+
+def test_every_candidate_has_its_own_marker_and_names_its_angle():
+    from matplotlib.colors import to_rgba
+    from matplotlib.figure import Figure
+
+    p = iq.newtons_cradle(3)
+    # two candidates at 0° and 30°, the first on Moreau's ε = 1 mark
+    cands = {"moreau": iq.moreau(p, eps=1.0).u_plus, "file": [0.0, 0.0, 1.0],
+             "again": [0.0, 0.0, 1.0]}
+    pic = plane_picture(p, cands)
+    ax = Figure().add_subplot()
+    draw_plane(pic, ax)
+    legend, marks = _candidate_marks(ax, list(cands))
+    assert len(legend) == 5 + len(cands)
+    styles = {(m.get_marker(), to_rgba(m.get_color())) for m in marks}
+    assert len(styles) == len(cands)  # no two share a look
+    assert all(m.get_marker() not in ("o", "s", "None", None) for m in marks)  # not ε, not u⁻
+    labels = [m.get_label() for m in marks]
+    assert "α = 0.0°" in labels[0] and "α = 30.0°" in labels[1] and "α = 30.0°" in labels[2]
+    # the α values are in the legend, not written over the picture
+    assert not any("α" in t.get_text() for t in ax.texts)
+    # a candidate drawn over another leaves the one below visible: only the first is filled
+    assert [m.get_markerfacecolor() == "none" for m in marks] == [False, True, True]
+    # the arcs of equal angles lie on circles of their own
+    radii = [np.linalg.norm(c.arc[0] - pic.u_minus) for c in pic.candidates]
+    assert len({round(r, 9) for r in radii}) == len(cands)
+
+
+def test_the_legend_lies_outside_the_picture(tmp_path):
+    from matplotlib.figure import Figure
+
+    ax = Figure().add_subplot()
+    draw_plane(plane_picture(iq.newtons_cradle(3), {"sector": [0.0, 0.0, 1.0]}), ax)
+    ax.figure.canvas.draw()
+    box = ax.get_legend().get_window_extent()
+    assert box.y1 <= ax.get_window_extent().y0  # below the axes, over nothing drawn
+
+
+def test_candidate_styles_are_distinct():
+    from impactqp.figures.plots import candidate_style
+
+    looks = {(s["marker"], s["color"]) for s in map(candidate_style, range(42))}
+    assert len(looks) == 42
+
+
+def test_plot_S_of_a_file_with_two_candidates(tmp_path, capsys):
+    from impactqp.cli.main import main
+
+    out = tmp_path / "S.png"
+    root = Path(__file__).resolve().parent.parent
+    assert main(["plot", "S", str(root / "examples" / "cradle.toml"), "--out", str(out)]) == 0
+    _check_file(out, "png")
+
+
+def test_benchmark_plot_has_one_legend_per_kind_and_one_colour_per_solver():
+    from matplotlib.colors import to_rgba
+
+    from benchmarks import report
+
+    root = Path(__file__).resolve().parent.parent
+    rows = report.read_rows(root / "benchmarks" / "reference" / "results.csv")
+    fig = report.plot_figure(rows)
+    try:
+        legends = [leg for ax in fig.axes if (leg := ax.get_legend()) is not None]
+        titles = [leg.get_title().get_text() for leg in legends]
+        assert titles == [title for title, _ in report.PANELS]
+        entries = [[t.get_text() for t in leg.get_texts()] for leg in legends]
+        plotted = {r["method"] for r in rows if report._panel(r["method"], r["group"])
+                   is not None and r["median_s"] is not None}
+        assert sorted(sum(entries, [])) == sorted(plotted | {"iq:auto (for comparison)"})
+        assert max(map(len, entries)) <= 12  # no legend of 27 series
+        own, via, raw = entries
+        assert all(m.startswith("iq:") for m in own + via)
+        assert all(not m.startswith("iq:") or "comparison" in m for m in raw)
+        # a solver keeps its colour from column to column
+        colour = {t.get_text(): to_rgba(h.get_color())
+                  for leg in legends for t, h in zip(leg.get_texts(), leg.legend_handles)}
+        assert colour["iq:clarabel"] == colour["raw:clarabel"]
+        assert colour["iq:qpsolvers:daqp"] == colour["raw:qpsolvers:daqp"]
+        for names in entries:  # within a column, no two methods look alike
+            looks = {(colour[n], h.get_marker(), h.get_linestyle()) for n, h in
+                     zip(names, next(leg for leg in legends if leg.get_texts()[0].get_text()
+                                     == names[0]).legend_handles)}
+            assert len(looks) == len(names)
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)

@@ -33,7 +33,9 @@ class Candidate:
     """A post-impact velocity drawn in the plane, with its angle α to Moreau's half-line
     (docs/theory.md §4).
 
-    ``arc`` is a circular arc around u⁻ from Moreau's direction to the candidate's.
+    ``arc`` is a circular arc around u⁻ from Moreau's direction to the candidate's; the
+    k-th candidate's arc has radius (0.3 + 0.08 k) times the energy circle's, so that the
+    arcs of two candidates never lie on top of each other.
     """
 
     label: str
@@ -162,7 +164,7 @@ def plane_picture(problem: ImpactProblem, candidates: Mapping[str, ArrayLike] | 
     marks = {eps: coords(u_m + (1.0 + eps) * (z - u_m)) for eps in MOREAU_EPS}
     moreau_dir = x_z - x_minus
     drawn = []
-    for label, u in (candidates or {}).items():
+    for i, (label, u) in enumerate((candidates or {}).items()):
         u = as_vector(f"candidate {label!r}", u, st.n)
         x = coords(u)
         off = problem.norm(u - origin - basis @ x) / problem.velocity_scale
@@ -175,7 +177,8 @@ def plane_picture(problem: ImpactProblem, candidates: Mapping[str, ArrayLike] | 
         else:
             cos = d @ moreau_dir / (np.linalg.norm(d) * np.linalg.norm(moreau_dir))
             alpha = float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
-            arc = _arc(x_minus, 0.3 * radius, moreau_dir, d)
+            # each candidate's arc on a circle of its own, so that equal angles stay apart
+            arc = _arc(x_minus, (0.3 + 0.08 * i) * radius, moreau_dir, d)
         drawn.append(Candidate(label, x, alpha, arc))
     return PlanePicture(origin=origin, basis=basis, radius=radius, half_width=h,
                         u_minus=x_minus, z=x_z, circle=circle,

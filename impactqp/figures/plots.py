@@ -27,9 +27,27 @@ from ..model.problem import ImpactProblem
 from ..tables.sector_table import sector_velocity_map
 from .geometry2d import PlanePicture, Wedge, plane_picture, sector_picture
 
-COLORS = {"reaction": ("#d6e6f4", "tab:blue"), "tangent": "tab:orange", "S": "#74c476",
-          "candidate": "crimson"}
+COLORS = {"reaction": ("#d6e6f4", "tab:blue"), "tangent": "tab:orange", "S": "#74c476"}
 """Fill and edge colours of the regions of :func:`draw_plane`."""
+
+CANDIDATE_MARKERS = ("*", "D", "P", "X", "^", "v", "p")
+CANDIDATE_COLORS = ("crimson", "#6a3d9a", "#e7298a", "#8c510a", "#01665e", "#525252")
+"""Markers and colours of the candidates of :func:`draw_plane`: the k-th candidate takes
+marker k mod 7 and colour k mod 6, so no two of the first 42 candidates look alike, and none
+takes the colours of the regions or of Moreau's half-line."""
+
+
+def candidate_style(k: int) -> dict[str, Any]:
+    """The matplotlib line style of the k-th candidate of :func:`draw_plane`.
+
+    The first is a large filled star; the others are hollow and smaller, so a candidate
+    drawn on top of another (two laws giving the same u⁺) leaves the one below visible.
+    """
+    color = CANDIDATE_COLORS[k % len(CANDIDATE_COLORS)]
+    if k == 0:
+        return {"marker": CANDIDATE_MARKERS[0], "color": color, "ms": 15, "ls": "none"}
+    return {"marker": CANDIDATE_MARKERS[k % len(CANDIDATE_MARKERS)], "color": color,
+            "mfc": "none", "mew": 2.0, "ms": 9, "ls": "none"}
 
 
 def _edges(polygon: np.ndarray, half_width: float) -> np.ndarray:
@@ -51,6 +69,10 @@ def draw_plane(picture: PlanePicture, ax: Any, title: str = "",
                plane: str = "the plane u⁻ + range(M⁻¹W)") -> None:
     """Draw S, u⁻ + N, T_C, the energy circle, Moreau's half-line and the candidates
     (docs/theory.md §5).
+
+    Each candidate has a marker and a colour of its own (:func:`candidate_style`), its arc
+    from Moreau's half-line on a radius of its own, and its legend entry names it with its
+    angle α; the legend lies below the axes, so no text is written over the picture.
 
     Parameters
     ----------
@@ -80,8 +102,9 @@ def draw_plane(picture: PlanePicture, ax: Any, title: str = "",
     ax.plot(*picture.moreau_line.T, color="black", lw=1.4, zorder=3)
     for eps, x in picture.moreau_marks.items():
         ax.plot(*x, "o", color="black", ms=5, zorder=4)
-        ax.annotate(f"ε = {eps:g}" + (" (z)" if eps == 0 else ""), x, xytext=(-8, 0),
-                    textcoords="offset points", ha="right", va="center", fontsize=9)
+        ax.annotate(f"ε = {eps:g}" + (" (z)" if eps == 0 else ""), x, xytext=(-12, 0),
+                    textcoords="offset points", ha="right", va="center", fontsize=9,
+                    zorder=6, bbox={"fc": "white", "ec": "none", "pad": 0.5})
     ax.plot(*picture.u_minus, "s", color="black", ms=6, zorder=4)
     ax.annotate("u⁻", picture.u_minus, xytext=(6, 4), textcoords="offset points", fontsize=11)
     handles = [
@@ -93,24 +116,26 @@ def draw_plane(picture: PlanePicture, ax: Any, title: str = "",
         Line2D([], [], color="black", lw=1.4, marker="o", ms=4,
                label="Moreau's half-line (ε marked)"),
     ]
-    color = COLORS["candidate"]
-    for cand in picture.candidates:
-        (star,) = ax.plot(*cand.point, "*", color=color, ms=13, zorder=5, label=cand.label)
-        handles.append(star)
+    for k, cand in enumerate(picture.candidates):
+        style = candidate_style(k)
+        alpha = ("α undefined: u⁺ = u⁻" if np.isnan(cand.alpha_deg)
+                 else f"α = {cand.alpha_deg:.1f}°")
+        (mark,) = ax.plot(*cand.point, zorder=5 + 0.01 * k, label=f"{cand.label} ({alpha})",
+                          **style)
+        handles.append(mark)
         if len(cand.arc):
-            ax.plot(*cand.arc.T, color=color, lw=1.2, zorder=4)
-            ax.plot(*np.array([picture.u_minus, cand.point]).T, color=color, lw=0.9, ls=":",
-                    zorder=4)
-            mid = cand.arc[len(cand.arc) // 2]
-            ax.annotate(f"α = {cand.alpha_deg:.1f}°", mid, xytext=(4, -10),
-                        textcoords="offset points", color=color, fontsize=10)
+            ax.plot(*cand.arc.T, color=style["color"], lw=1.2, zorder=4)
+            ax.plot(*np.array([picture.u_minus, cand.point]).T, color=style["color"], lw=0.9,
+                    ls=":", zorder=4)
     ax.set_xlim(-h, h)
     ax.set_ylim(-h, h)
     ax.set_aspect("equal")
     ax.set_xlabel(f"x₁: M-orthonormal coordinate in {plane}, ⊥ Moreau's half-line",
                   fontsize=9)
     ax.set_ylabel(f"x₂: M-orthonormal coordinate in {plane}, along u⁻ − z", fontsize=9)
-    ax.legend(handles=handles, loc="upper left", fontsize=8, framealpha=0.95)
+    # below the axes: the α of each candidate is read there, never written over the picture
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2,
+              fontsize=8, frameon=False)
     ax.set_title(title, fontsize=10)
 
 
@@ -167,7 +192,8 @@ def plot_S(problem: ImpactProblem, path: str | Path,
     path : str or Path
         Output file; the format follows the suffix (``.png``, ``.svg`` or ``.pdf``).
     candidates : mapping of label → (n,) array_like, optional
-        Post-impact velocities to mark, each with its angle to Moreau's half-line.
+        Post-impact velocities to mark, each with a marker of its own; the legend names
+        each with its angle α to Moreau's half-line.
     title : str
         Figure title (default: what S is).
     plane : str
@@ -187,7 +213,7 @@ def plot_S(problem: ImpactProblem, path: str | Path,
     """
     figure_format(path)
     picture = plane_picture(problem, candidates)
-    fig = new_figure()
+    fig = new_figure(6.4, 7.4)
     draw_plane(picture, fig.add_subplot(), title or "S = (u⁻ + N) ∩ T_C ∩ B(0, ‖u⁻‖) in the "
                "plane u⁻ + range(M⁻¹W)", plane=plane)
     return save_figure(fig, path)
