@@ -263,7 +263,9 @@ def test_benchmark_plot_has_one_legend_per_kind_and_one_colour_per_solver():
         assert titles == [title for title, _ in report.PANELS]
         entries = [[t.get_text() for t in leg.get_texts()] for leg in legends]
         plotted = {r["method"] for r in rows if report._panel(r["method"], r["group"])
-                   is not None and r["median_s"] is not None}
+                   is not None and r["median_s"] is not None
+                   and r["family"] in report.SIZE_LABEL
+                   and r["family"] not in report.RUN_FAMILIES}
         assert sorted(sum(entries, [])) == sorted(plotted | {"iq:auto (for comparison)"})
         assert max(map(len, entries)) <= 12  # no legend of 27 series
         own, via, raw = entries
