@@ -89,3 +89,30 @@ def test_grazing_impacts_are_found(m, k, c, v0):
     tr = iq.simulate(system, iq.Newton(1.0), 3.5 * t1, scheme="event-driven")
     np.testing.assert_allclose([e.time for e in tr.events], t1 * np.arange(1, 4), rtol=1e-8)
     assert tr.q.min() > -1e-12 * c / k  # never inside the wall
+
+
+@pytest.mark.parametrize("scale", [1e-9, 1e-3, 1e3, 1e6])
+def test_the_same_motion_in_other_units_has_the_same_events(scale):
+    """A ball dropped from q₀ = s under the same g: lengths scale by s, times by √s,
+    velocities by √s; the default thresholds follow the system's own scales."""
+    unit = iq.simulate(iq.bouncing_ball(q0=1.0), iq.Newton(0.9), 10.0,
+                       scheme="event-driven")
+    scaled = iq.simulate(iq.bouncing_ball(q0=scale), iq.Newton(0.9), 10.0 * np.sqrt(scale),
+                         scheme="event-driven")
+    assert len(scaled.events) == len(unit.events) > 100
+    np.testing.assert_allclose(scaled.impact_times / np.sqrt(scale), unit.impact_times,
+                               rtol=1e-12)
+    assert scaled.certified
+
+
+@pytest.mark.parametrize("length", [1e-3, 1e3])
+def test_a_cradle_in_other_length_units_has_the_same_events(length):
+    """Newton's cradle with lengths (amplitude and pendulum) in other units: the same
+    impacts at the same times (the period √(L/g) scales with L)."""
+    unit = iq.simulate(iq.cradle_system(3, amplitude=0.1), iq.SectorLaw(), 3.0,
+                       scheme="event-driven")
+    other = iq.simulate(iq.cradle_system(3, amplitude=0.1 * length, length=length,
+                                         gravity=9.81 * length), iq.SectorLaw(), 3.0,
+                        scheme="event-driven")
+    np.testing.assert_allclose(other.impact_times, unit.impact_times, rtol=1e-9)
+    np.testing.assert_allclose(other.q[-1] / length, unit.q[-1], rtol=1e-7, atol=1e-12)

@@ -45,6 +45,12 @@ initial force component), and, at the start of a phase, when unloaded (λᵢ = 0
 apart faster than 1e-12·F·Gᵢᵢ (a thousand times less than the acceleration at that release,
 so that a released contact is not held again)."""
 
+GAP_TOL = 1e-10
+"""Default closing tolerance of a gap, relative to the system's length scale."""
+
+REST_VELOCITY = 1e-7
+"""Default rest velocity of a closed contact, relative to the system's velocity scale."""
+
 MAX_STALL = 1000
 """Events in a row, each within 1e-12 (relative) of the last, before the run is abandoned."""
 
@@ -71,7 +77,8 @@ class _Recorder:
 
 def event_driven(system: LinearSystem, law: ImpactLaw, t_end: float, h: float | None = None,
                  *, t0: float = 0.0, backend: str = "auto", tol: float = DEFAULT_TOL,
-                 gap_tol: float = 1e-10, rest_velocity: float = 1e-7, method: str = "DOP853",
+                 gap_tol: float | None = None, rest_velocity: float | None = None,
+                 method: str = "DOP853",
                  rtol: float = 1e-12, atol: float = 1e-14, max_events: int = 100_000,
                  keep_events: bool = True,
                  progress: Callable[[float], None] | None = None) -> Trajectory:
@@ -91,10 +98,12 @@ def event_driven(system: LinearSystem, law: ImpactLaw, t_end: float, h: float | 
         Initial time.
     backend, tol : str, float
         Passed to :func:`impactqp.solve`.
-    gap_tol : float
-        A contact whose gap is at most this (length units) counts as closed at an event.
-    rest_velocity : float
-        A closed contact separating slower than this (velocity units) is settled.
+    gap_tol : float, optional
+        A contact whose gap is at most this (length units) counts as closed at an event;
+        default 10⁻¹⁰ L, L the system's own length scale (:func:`motion_scales`).
+    rest_velocity : float, optional
+        A closed contact separating slower than this (velocity units) is settled; default
+        10⁻⁷ V, V the system's own velocity scale (:func:`motion_scales`).
     method, rtol, atol : str, float, float
         :func:`scipy.integrate.solve_ivp` settings of the smooth phases (unused under a
         constant force, whose phases are exact).
@@ -128,6 +137,9 @@ def event_driven(system: LinearSystem, law: ImpactLaw, t_end: float, h: float | 
     acc_tol = 1e-3 * lift_threshold * system.structure.delassus_diagonal \
         if system.n_contacts else 0.0
     max_step = _max_step(system)
+    length, speed = motion_scales(system, t_end - t0)
+    gap_tol = GAP_TOL * length if gap_tol is None else gap_tol
+    rest_velocity = REST_VELOCITY * speed if rest_velocity is None else rest_velocity
     g = system.gaps(system.q0)
     if np.any(g < -gap_tol):
         worst = int(np.argmin(g))
@@ -236,6 +248,31 @@ def _exact_flight(t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, t_eval:
     tau = t_event - t
     y_event = np.concatenate([q + v * tau + (0.5 * a * tau) * tau, v + tau * a])
     return _Flight(times, y, 1, [np.array([t_event])], [y_event[None, :]])
+
+
+def motion_scales(system: LinearSystem, span: float) -> tuple[float, float]:
+    """(L, V): the length and velocity scales of the system's own motion, which the default
+    event thresholds are relative to, so that the same motion in other units has the same
+    events (docs/theory.md §14).
+
+    L is the largest initial gap; V the largest of the initial contact speeds and √(2LA),
+    A the largest initial contact acceleration |Hᵀ M⁻¹ f| (the speed of falling through L).
+    Where the gaps are all closed, L = V²/A (or V·span without acceleration); where nothing
+    moves or pushes, 1.
+    """
+    if system.n_contacts == 0:
+        return 1.0, 1.0
+    q0, v0 = system.q0, system.v0
+    gap = float(np.abs(system.gaps(q0)).max())
+    speed = float(np.abs(system.contact_velocities(v0)).max())
+    accel = system.structure.solve_mass(system.force_at(0.0, q0, v0))
+    push = float(np.abs(system.contact_velocities(accel)).max())
+    if gap > 0:
+        speed = max(speed, float(np.sqrt(2.0 * gap * push)))
+        return gap, speed if speed > 0 else gap / span
+    if speed > 0:
+        return (speed * speed / push if push > 0 else speed * span), speed
+    return 1.0, 1.0
 
 
 def _max_step(system: LinearSystem) -> float:

@@ -83,7 +83,8 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
         Called with the simulated time now and then.
     **options
         Moreau–Jean: ``record_every`` (int), ``keep_events`` (bool). Event-driven:
-        ``gap_tol`` (1e-10), ``rest_velocity`` (1e-7), ``method`` ("DOP853"), ``rtol``
+        ``gap_tol`` (1e-10 of the system's length scale), ``rest_velocity`` (1e-7 of its
+        velocity scale), ``method`` ("DOP853"), ``rtol``
         (1e-12), ``atol`` (1e-14), ``max_events`` (100000), ``keep_events``.
 
     Returns
