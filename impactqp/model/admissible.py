@@ -51,7 +51,8 @@ class Membership:
     energetic : float
         (‖u‖² − ‖u⁻‖²)₊ / ‖u⁻‖².
     impulses : ndarray
-        A Λ ≥ 0 that best explains u − u⁻.
+        A Λ ≥ 0 that best explains u − u⁻ (inf where Λ is beyond the float range: the
+        verdict, computed in order-one units, does not depend on it).
     method : str
         ``"exact"`` or ``"optimizer"``.
     distance : float or None
@@ -201,7 +202,8 @@ class AdmissibleSet:
         kinematic = float(max(0.0, -np.min(gamma / (s * V), initial=0.0)))
         energetic = max(0.0, float(st.kinetic_norms(un) / V) ** 2 - 1.0)
         kinetic = res / V
-        lam = lam * c
+        with np.errstate(over="ignore"):  # the verdict is scale-free; impulses beyond the
+            lam = lam * c                 # floats are reported as inf
         if method == "exact":
             tol = DEFAULT_TOL if tol is None else tol
             member = bool(max(kinetic, kinematic, energetic) <= tol)

@@ -85,7 +85,8 @@ def classify(problem: ImpactProblem, u_plus: Any) -> Classification:
     if scale > 0 and not UNIT_RANGE[0] <= scale <= UNIT_RANGE[1]:
         # every invariant but the intensity and Λ is scale-free: classify in order-one units
         unit = classify(problem.with_u_minus(problem.u_minus / scale), u / scale)
-        intensity, impulses = unit.intensity * scale, unit.impulses * scale
+        with np.errstate(over="ignore"):
+            intensity, impulses = unit.intensity * scale, unit.impulses * scale
         if not (np.isfinite(intensity) and np.isfinite(impulses).all()):
             raise OutOfRangeError(f"the impact's intensity ({unit.intensity:.3g} × "
                                   f"{scale:.3g}) or its impulses overflow floats")
