@@ -107,7 +107,7 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
     tol = validate(problem, law, backend, form, tol)
     if options is not None:
         options = backends.check_options(backend, options)
-    scale = float(np.abs(problem.u_minus).max(initial=0.0))
+    scale = problem.peak_minus
     if law.homogeneous and scale > 0 and not UNIT_RANGE[0] <= scale <= UNIT_RANGE[1]:
         return _rescaled(problem, law, scale, backend, form, tol, options, start)
     groups = parallel.collapsible(problem, law)

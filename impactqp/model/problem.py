@@ -76,6 +76,12 @@ class ImpactProblem:
         return 0.5 * self.norm(u) ** 2
 
     @cached_property
+    def peak_minus(self) -> float:
+        """max |u⁻ᵢ|, kept: whether u⁻ is within the range worked in as given
+        (:data:`impactqp.base.checks.UNIT_RANGE`, docs/theory.md §8)."""
+        return float(np.abs(self.u_minus).max(initial=0.0))
+
+    @cached_property
     def norm_minus(self) -> float:
         """‖u⁻‖ (kinetic norm, no overflow or underflow), kept: the certificates' unit V
         (docs/theory.md §8)."""
