@@ -43,6 +43,8 @@ SOCP_ROUNDS = 30
 """Most SOCPs of the fixed point on s = μ‖u_T‖."""
 NEWTON_STEPS = 60
 """Most Newton steps of the polish."""
+NEWTON_FROM = 1e-3
+"""Error ‖F‖/‖q‖ below which the SOCP route tries Newton (from farther it tends to stall)."""
 NSGS_SWEEPS = 20000
 """Most sweeps of the projected Gauss–Seidel."""
 NSGS_SHORT = 100
@@ -139,8 +141,7 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
         except SolverError as exc:
             failures.append(f"{method}: {exc}")
             continue
-        r, its_newton = _newton(data, r, tol)
-        r = project_cones(r, data.mu, data.d)  # r in the cones, exactly, last
+        r, its_newton, _ = _newton(data, r, tol)  # r in the cones, exactly, last
         u = problem.velocity(r)
         cert = certify_friction(problem, r, u, tol=tol)
         if cert.ok:
@@ -186,29 +187,32 @@ def _socp(P: sp.csc_matrix, c: np.ndarray, mu: np.ndarray, d: int) -> np.ndarray
 
 def _socp_route(data: _Data, r0: np.ndarray, tol: float) -> tuple[np.ndarray, int]:
     """The fixed point of SOCPs on s = μ‖u_T‖e_n and the skew part of W (lagged), halving
-    the change of s when the error grows; stops near the tolerance or when it stalls."""
+    the change of s when the error grows; from an error of :data:`NEWTON_FROM` on, Newton
+    is tried each time the error has fallen tenfold, and its answer returned if it passes."""
     W, q, mu, d = data.W, data.q, data.mu, data.d
     P = sp.csc_matrix(0.5 * (W + W.T))
     skew = 0.5 * (W - W.T)
     r = r0.copy()
     s = _lag(data, r)
     best_r, best_err = r, data.error(r)
+    tried = NEWTON_FROM * 10.0
     rounds = 0
     for _ in range(SOCP_ROUNDS):
         rounds += 1
         r_new = _socp(P, q + skew @ r + s, mu, d)
         err = data.error(r_new)
         if err < best_err:
-            if err > 0.5 * best_err and best_err < 1e-3:
-                best_r, best_err = r_new, err
-                break  # stalling: leave the rest to Newton
             best_r, best_err = r_new, err
             r, s = r_new, _lag(data, r_new)
         else:
             s = 0.5 * (s + _lag(data, r_new))  # damped
             r = 0.5 * (r + r_new)
-        if best_err <= tol:
-            break
+        if best_err <= 0.1 * tried:
+            tried = best_err
+            r_pol, steps, ok = _newton(data, best_r, tol)
+            rounds += steps
+            if ok:
+                return r_pol, rounds
     return best_r, rounds
 
 
@@ -226,20 +230,28 @@ def _nsgs_route(data: _Data, r0: np.ndarray, tol: float,
     return r, int(sweeps)
 
 
-def _newton(data: _Data, r: np.ndarray, tol: float) -> tuple[np.ndarray, int]:
+def _newton(data: _Data, r: np.ndarray, tol: float) -> tuple[np.ndarray, int, bool]:
     """Semismooth Newton on F(r) = r − P_K(r − ũ(Wr + q)): minimum-norm least-squares steps
-    J Δ = −F (J singular where W is rank-deficient) and backtracking on ‖F‖."""
+    J Δ = −F (J singular where W is rank-deficient) and backtracking on ‖F‖.
+
+    Returns P_K(r) (r projected onto the cones), the steps done, and whether that projected
+    r is within tol/2: Newton goes on past ‖F‖ ≤ tol/2 until it is (projecting moves r by up
+    to ‖F‖, hence u by up to ‖W‖‖F‖)."""
     W, q, mu, d = data.W, data.q, data.mu, data.d
     n = r.size
     m = mu.size
-    target = 0.25 * tol * data.qn
     u = W @ r + q
     F = natural_map(r, u, mu, d)
     f = float(np.linalg.norm(F))
     steps = 0
-    for steps in range(1, NEWTON_STEPS + 1):
-        if f <= target:
-            return r, steps - 1
+    while True:
+        if f <= 0.5 * tol * data.qn:
+            rp = project_cones(r, mu, d)
+            if data.error(rp) <= 0.5 * tol:
+                return rp, steps, True
+        if steps == NEWTON_STEPS:
+            break
+        steps += 1
         x = r - modified_velocity(u, mu, d)
         DP = projection_jacobian(x, mu, d)
         DU = modified_velocity_jacobian(u, mu, d)
@@ -257,6 +269,6 @@ def _newton(data: _Data, r: np.ndarray, tol: float) -> tuple[np.ndarray, int]:
                 break
             t *= 0.5
         else:
-            return r, steps  # no descent: stalled
+            break  # no descent: stalled
         r, u, F, f = r_try, u_try, F_try, f_try
-    return r, steps
+    return project_cones(r, mu, d), steps, False
