@@ -223,6 +223,49 @@ def test_natural_map_vanishes_at_a_solution_only() -> None:
     assert np.linalg.norm(natural_map(r, u + [0.0, 0.0, 0.1], mu, 3)) > 1e-3
 
 
+def _soc_projection(x: np.ndarray) -> np.ndarray:
+    """Projection onto the second-order cone {‖x_T‖ ≤ x_n} (μ = 1) by its spectral
+    decomposition: x = λ₁c₁ + λ₂c₂, λ = x_n ∓ ‖x_T‖, c = ½(1, ∓x_T/‖x_T‖), negative λ dropped."""
+    out = np.empty_like(x)
+    for c, v in enumerate(x):
+        t = np.linalg.norm(v[1:])
+        w = v[1:] / t if t > 0 else np.zeros(v.size - 1)
+        parts = [(v[0] - t, np.r_[0.5, -0.5 * w]), (v[0] + t, np.r_[0.5, 0.5 * w])]
+        out[c] = sum(max(lam, 0.0) * vec for lam, vec in parts)
+    return out
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_certificate_error_against_a_spectral_computation(d: int) -> None:
+    """ABH of the compiled certificate against numpy with the spectral SOC projection
+    (μ = 1), at a certified answer and at perturbed ones."""
+    problem = random_problem(7, d, 1.0, seed=20 + d, skew=0.05)
+    res = iq.solve_friction(problem, backend="clarabel")
+    rng = np.random.default_rng(1)
+    for r in [res.r] + [res.r + 1e-3 * rng.standard_normal(res.r.size) for _ in range(5)]:
+        u = (problem.W @ r + problem.q).reshape(-1, d)
+        ut = u.copy()
+        ut[:, 0] += np.linalg.norm(u[:, 1:], axis=1)
+        F = r.reshape(-1, d) - _soc_projection(r.reshape(-1, d) - ut)
+        abh = np.linalg.norm(F) / np.linalg.norm(problem.q)
+        cert = certify_friction(problem, r)
+        assert cert.error == pytest.approx(abh, rel=1e-9, abs=1e-15)
+        assert cert.ok == (abh <= 1e-8 and cert.residuals["cone"] <= 1e-8)
+
+
+def test_zero_free_velocity_gives_zero_reaction() -> None:
+    problem = iq.FrictionContactProblem(np.eye(6), np.zeros(6), 0.5)
+    for backend in BACKENDS:
+        res = iq.solve_friction(problem, backend=backend)
+        assert res.certificate.ok and not res.r.any() and not res.u.any()
+
+
+def test_result_fields() -> None:
+    res = iq.solve_friction(random_problem(3, 3, 0.5, seed=1), backend="clarabel")
+    assert res.backend == "clarabel+newton" and res.iterations >= 1 and res.solve_time > 0
+    assert res.error == res.certificate.error
+
+
 # --- bad inputs ---------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("args, kwargs, error", [
