@@ -104,7 +104,9 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     ----------
     problem : FrictionContactProblem
     backend : {"auto", "clarabel", "nsgs"}
-        The method (see :data:`FRICTION_BACKENDS`).
+        ``clarabel``: the fixed point of SOCPs, then Newton; ``nsgs``: projected
+        Gauss–Seidel, then Newton; ``auto``: 100 NSGS sweeps, then the SOCP route, then a
+        long NSGS, each warm-started from the best answer so far.
     tol : float
         Tolerance of the certificate: ‖F‖/‖q‖ ≤ tol among others.
 

@@ -89,16 +89,16 @@ class FrictionCertificate(ResidualChecks):
     """The recomputed checks of one candidate answer (r, u) of a
     :class:`FrictionContactProblem` (docs/theory.md §15).
 
-    Accepted when each of :attr:`residuals` is within ``tol``:
+    Accepted when each of its ``residuals`` is within ``tol``:
 
     - natural_map: ‖r − P_K(r − ũ)‖ / ‖q‖ with u = W r + q recomputed (Acary–Brémond–Huber's
       error, the acceptance figure);
     - velocity: ‖u − (W r + q)‖ / ‖q‖ of the u given with r;
     - cone: ‖r − P_K(r)‖ / ‖r‖, r in the friction cones.
 
-    Reported beside them (:attr:`reported`), not part of the verdict: ``siconos_error``
+    Reported beside them (``reported``), not part of the verdict: ``siconos_error``
     ‖F‖/max(‖q‖, ‖r‖, ‖u‖), ``penetration`` ‖(−u_n)₊‖/‖q‖ (ũ ∈ K*_μ reduces to u_n ≥ 0)
-    and ``complementarity`` Σ_c |r_c·ũ_c| / (‖r‖‖q‖).
+    and ``complementarity`` ``Σ_c |r_c·ũ_c| / (‖r‖‖q‖)``.
 
     Parameters
     ----------
