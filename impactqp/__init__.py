@@ -46,6 +46,7 @@ from .laws.batch import BatchResult, moreau_batch, sector_law_batch, solve_batch
 from .laws.catalogue import available_backends
 from .laws.certificate import Certificate, SectorLawCertificate
 from .laws.complementarity import Fremond, Newton
+from .laws.friction import FrictionResult, solve_friction
 from .laws.functions import fremond, moreau, newton, reflection_law, sector_law
 from .laws.lzb import LZB, LZBAnswer, LZBCertificate, LZBRecord
 from .laws.moreau import Moreau
@@ -56,6 +57,7 @@ from .laws.sector import SectorLaw
 from .model.admissible import AdmissibleSet, Membership
 from .model.builders import chain, newtons_cradle, random_impact
 from .model.classify import Classification, classify
+from .model.friction import FrictionCertificate, FrictionContactProblem
 from .model.physical_chains import (
     PhysicalChain,
     ball_chain,
@@ -90,6 +92,7 @@ except PackageNotFoundError:  # running from a source tree that was never instal
 __all__ = [
     "AdmissibleSet", "Answer", "BackendUnsuitableError", "BatchResult", "Certificate",
     "CertificateError", "ChainInfo", "Classification", "Counterexample", "DEFAULT_TOL", "Fremond",
+    "FrictionCertificate", "FrictionContactProblem", "FrictionResult",
     "ImpactError", "ImpactEvent", "ImpactLaw", "ImpactProblem", "ImpactResult", "ImpactStructure",
     "InputError", "IntegrationBudgetError", "LCPResult", "LZB", "LZBAnswer", "LZBCertificate",
     "LZBRecord", "LawComparison", "LawOutcome", "LawReport", "LinearForce", "LinearSystem",
@@ -105,5 +108,5 @@ __all__ = [
     "hertz_stiffness", "load_problem", "monodisperse_chain", "moreau", "moreau_batch", "newton",
     "newtons_cradle", "random_impact", "reflection_law", "reflection_law_table", "save_problem",
     "sector_law", "sector_law_batch", "sector_law_table", "simulate", "solve", "solve_batch",
-    "solve_lcp", "sphere_mass", "tapered_chain", "verify_law",
+    "solve_friction", "solve_lcp", "sphere_mass", "tapered_chain", "verify_law",
 ]

@@ -1,0 +1,229 @@
+"""Coulomb friction of local contact problems: the one definition of the projection onto the
+friction cone, of De Saxcé's modified velocity, of the natural map and of their derivatives,
+and a projected Gauss–Seidel over the contacts (docs/theory.md §15).
+
+Vectors are flat, d entries per contact (d = 2 or 3), the normal first: contact c occupies
+``[c·d, c·d + d)``. K_μ = {r : ‖r_T‖ ≤ μ r_n} is the Coulomb cone and its projection has a
+closed form, the same for the 3-D cone and the planar wedge (d = 2): with t = ‖x_T‖,
+
+- x itself when t ≤ μ x_n,
+- 0 when μ t ≤ −x_n (x is in the polar cone),
+- otherwise a·(1, μ x_T/t) with a = (x_n + μ t)/(1 + μ²).
+
+A NaN anywhere fails every comparison and falls into the last case, where it propagates.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import inline_kernel, kernel
+
+
+@inline_kernel
+def tangent_norm(x, k, d):
+    """‖x_T‖ of the contact starting at index ``k``."""
+    t2 = 0.0
+    for j in range(1, d):
+        t2 += x[k + j] * x[k + j]
+    return np.sqrt(t2)
+
+
+@inline_kernel
+def project_contact(x, mu, k, d, out):
+    """``out[k:k+d]`` = P_{K_μ}(``x[k:k+d]``) by the closed form of the module's docstring."""
+    xn = x[k]
+    t = tangent_norm(x, k, d)
+    if t <= mu * xn:
+        for j in range(d):
+            out[k + j] = x[k + j]
+    elif mu * t <= -xn:
+        for j in range(d):
+            out[k + j] = 0.0
+    else:
+        a = (xn + mu * t) / (1.0 + mu * mu)
+        out[k] = a
+        for j in range(1, d):
+            out[k + j] = mu * a * x[k + j] / t
+
+
+@kernel
+def project_cones(x, mu, d):
+    """P_{K_μ}(x) contact by contact (μ one coefficient per contact)."""
+    out = np.empty_like(x)
+    for c in range(mu.size):
+        project_contact(x, mu[c], c * d, d, out)
+    return out
+
+
+@inline_kernel
+def modified_contact(u, mu, k, d, out):
+    """``out[k:k+d]`` = ũ = u + μ‖u_T‖e_n (De Saxcé's modified velocity) of one contact."""
+    out[k] = u[k] + mu * tangent_norm(u, k, d)
+    for j in range(1, d):
+        out[k + j] = u[k + j]
+
+
+@kernel
+def modified_velocity(u, mu, d):
+    """ũ = u + μ‖u_T‖e_n contact by contact."""
+    ut = np.empty_like(u)
+    for c in range(mu.size):
+        modified_contact(u, mu[c], c * d, d, ut)
+    return ut
+
+
+@kernel
+def natural_map(r, u, mu, d):
+    """F = r − P_{K_μ}(r − ũ) contact by contact, ũ = u + μ‖u_T‖e_n."""
+    ut = modified_velocity(u, mu, d)
+    x = np.empty_like(u)
+    F = np.empty_like(u)
+    for i in range(r.size):
+        x[i] = r[i] - ut[i]
+    for c in range(mu.size):
+        project_contact(x, mu[c], c * d, d, F)
+    for i in range(r.size):
+        F[i] = r[i] - F[i]
+    return F
+
+
+@kernel
+def certificate_sums(r, u, mu, d):
+    """The sums of the certificate of docs/theory.md §15, in one pass over the contacts:
+    (‖F‖², Σ_c |r_c·ũ_c|, Σ_c (−u_n,c)₊², ‖r − P_{K_μ}(r)‖²)."""
+    F = natural_map(r, u, mu, d)
+    pr = project_cones(r, mu, d)
+    ut = modified_velocity(u, mu, d)
+    f2 = 0.0
+    comp = 0.0
+    pen = 0.0
+    cone = 0.0
+    for c in range(mu.size):
+        k = c * d
+        dot = 0.0
+        for j in range(d):
+            dot += r[k + j] * ut[k + j]
+        comp += abs(dot)
+        neg = -u[k] if u[k] < 0.0 else (u[k] - u[k])  # keeps a NaN
+        pen += neg * neg
+    for i in range(r.size):
+        f2 += F[i] * F[i]
+        cone += (r[i] - pr[i]) * (r[i] - pr[i])
+    return f2, comp, pen, cone
+
+
+@kernel
+def projection_jacobian(x, mu, d):
+    """An element of the (Clarke) Jacobian of P_{K_μ} at x, one d × d block per contact
+    (the derivative of the closed form; on a kink, the branch the closed form takes)."""
+    m = mu.size
+    J = np.zeros((m, d, d))
+    for c in range(m):
+        k = c * d
+        m_ = mu[c]
+        xn = x[k]
+        t = tangent_norm(x, k, d)
+        if t <= m_ * xn:
+            for j in range(d):
+                J[c, j, j] = 1.0
+        elif m_ * t <= -xn:
+            continue
+        else:
+            s = 1.0 / (1.0 + m_ * m_)
+            a = (xn + m_ * t) * s
+            J[c, 0, 0] = s
+            for j in range(1, d):
+                w = x[k + j] / t
+                J[c, 0, j] = s * m_ * w
+                J[c, j, 0] = s * m_ * w
+                for i in range(1, d):
+                    wi = x[k + i] / t
+                    J[c, j, i] = m_ * m_ * s * w * wi - m_ * a / t * w * wi
+                J[c, j, j] += m_ * a / t
+    return J
+
+
+@kernel
+def modified_velocity_jacobian(u, mu, d):
+    """The derivative of u ↦ ũ = u + μ‖u_T‖e_n, one d × d block per contact (the row of
+    e_n gains μ u_Tᵀ/‖u_T‖; nothing where u_T = 0)."""
+    m = mu.size
+    J = np.zeros((m, d, d))
+    for c in range(m):
+        k = c * d
+        for j in range(d):
+            J[c, j, j] = 1.0
+        t = tangent_norm(u, k, d)
+        if t > 0.0:
+            for j in range(1, d):
+                J[c, 0, j] = mu[c] * u[k + j] / t
+    return J
+
+
+@kernel
+def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
+    """Projected Gauss–Seidel over the contacts (docs/theory.md §15), updating ``r`` in place.
+
+    Each contact's local problem (the others held) is solved by the projected fixed point
+    r_c ← P_{K_μ}(r_c − ρ ũ_c) with ρ = 1/‖W_cc‖_F; the sweeps stop when ‖F‖ ≤ tol·‖q‖.
+    Returns (sweeps done, ‖F‖/‖q‖ at the end).
+    """
+    m = mu.size
+    n = r.size
+    qn = np.sqrt(np.sum(q * q))
+    if qn == 0.0:
+        qn = 1.0
+    u = np.empty(n)
+    x = np.empty(d)
+    rc = np.empty(d)
+    uc = np.empty(d)
+    mc = np.empty(d)
+    base = np.empty(d)  # q_c + Σ_{j≠c} W_cj r_j
+    err = np.inf
+    for sweep in range(max_sweeps):
+        for c in range(m):
+            k = c * d
+            rho = 0.0
+            for i in range(d):
+                for j in range(d):
+                    rho += W[k + i, k + j] * W[k + i, k + j]
+            rho = 1.0 / np.sqrt(rho) if rho > 0.0 else 1.0
+            for i in range(d):
+                v = q[k + i]
+                for j in range(n):
+                    v += W[k + i, j] * r[j]
+                for j in range(d):
+                    v -= W[k + i, k + j] * r[k + j]
+                base[i] = v
+                rc[i] = r[k + i]
+            for _ in range(local_iters):
+                for i in range(d):
+                    v = base[i]
+                    for j in range(d):
+                        v += W[k + i, k + j] * rc[j]
+                    uc[i] = v
+                modified_contact(uc, mu[c], 0, d, mc)
+                for i in range(d):
+                    x[i] = rc[i] - rho * mc[i]
+                change = 0.0
+                size = 0.0
+                project_contact(x, mu[c], 0, d, mc)
+                for i in range(d):
+                    change += (mc[i] - rc[i]) ** 2
+                    size += mc[i] * mc[i]
+                    rc[i] = mc[i]
+                if change <= 1e-30 * (size + 1e-300):
+                    break
+            for i in range(d):
+                r[k + i] = rc[i]
+        for i in range(n):
+            v = q[i]
+            for j in range(n):
+                v += W[i, j] * r[j]
+            u[i] = v
+        F = natural_map(r, u, mu, d)
+        err = np.sqrt(np.sum(F * F)) / qn
+        if err <= tol:
+            return sweep + 1, err
+    return max_sweeps, err

@@ -1,0 +1,181 @@
+"""Local frictional contact problems (FCLib's local form) and their certificate
+(docs/theory.md §15).
+
+Find r and u = W r + q such that, for every contact c, r_c ∈ K_μc ⟂ ũ_c ∈ K*_μc with
+ũ_c = u_c + μ_c‖u_T,c‖e_n (De Saxcé's form of Coulomb's law). W is used as given (never its
+symmetric part); the formulas are those of :mod:`impactqp.kernels.friction`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..base.arrays import as_array, as_count, as_matrix, check_tol
+from ..base.checks import ResidualChecks
+from ..errors import InputError, ShapeError
+from ..kernels.friction import certificate_sums
+
+__all__ = ["FrictionCertificate", "FrictionContactProblem", "certify_friction"]
+
+
+class FrictionContactProblem:
+    """The local frictional contact problem u = W r + q, r_c ∈ K_μc ⟂ ũ_c ∈ K*_μc
+    (docs/theory.md §15).
+
+    Parameters
+    ----------
+    W : (d·m, d·m) ndarray or scipy.sparse matrix
+        The Delassus operator, used as given (not assumed symmetric).
+    q : (d·m,) array
+        The free velocity.
+    mu : float or (m,) array
+        Friction coefficients, each ≥ 0.
+    contact_dim : int
+        d = 3 (normal, two tangents) or 2 (normal, one tangent, in the plane).
+
+    Raises
+    ------
+    InputError, ShapeError, NonFiniteError
+        A d other than 2 or 3, shapes that do not fit, NaN or infinity, a negative μ.
+    """
+
+    def __init__(self, W, q, mu, *, contact_dim: int = 3) -> None:
+        d = as_count("contact_dim", contact_dim)
+        if d not in (2, 3):
+            raise InputError(f"contact_dim must be 2 or 3, got {d}")
+        W = as_matrix("W", W)
+        q = as_array("q", q, ndim=1)
+        n = q.size
+        if n == 0 or n % d:
+            raise ShapeError(f"q must hold contact_dim = {d} entries per contact (at least "
+                             f"one contact), got {n} entries")
+        if W.ndim != 2 or W.shape != (n, n):
+            raise ShapeError(f"W must have shape ({n}, {n}) to match q, got {W.shape}")
+        m = n // d
+        mu = as_array("mu", mu)
+        if mu.ndim == 0:
+            mu = np.full(m, float(mu))
+        if mu.shape != (m,):
+            raise ShapeError(f"mu must be one number or one per contact ({m},), got "
+                             f"shape {mu.shape}")
+        if (mu < 0).any():
+            raise InputError(f"mu must be ≥ 0, got {mu[mu < 0][0]} at contact "
+                             f"{int(np.argmax(mu < 0))}")
+        self.W = W
+        self.q = q
+        self.mu = mu
+        self.contact_dim = d
+        self.n_contacts = m
+
+    def velocity(self, r: np.ndarray) -> np.ndarray:
+        """u = W r + q."""
+        return np.asarray(self.W @ r).ravel() + self.q
+
+    def dense_W(self) -> np.ndarray:
+        """W as a dense float array."""
+        return self.W.toarray() if sp.issparse(self.W) else self.W
+
+    def __repr__(self) -> str:
+        return (f"FrictionContactProblem(n_contacts={self.n_contacts}, "
+                f"contact_dim={self.contact_dim})")
+
+
+@dataclass(frozen=True)
+class FrictionCertificate(ResidualChecks):
+    """The recomputed checks of one candidate answer (r, u) of a
+    :class:`FrictionContactProblem` (docs/theory.md §15).
+
+    Accepted when each of its ``residuals`` is within ``tol``:
+
+    - natural_map: ‖r − P_K(r − ũ)‖ / ‖q‖ with u = W r + q recomputed (Acary–Brémond–Huber's
+      error, the acceptance figure);
+    - velocity: ‖u − (W r + q)‖ / ‖q‖ of the u given with r;
+    - cone: ‖r − P_K(r)‖ / ‖r‖, r in the friction cones.
+
+    Reported beside them (``reported``), not part of the verdict: ``siconos_error``
+    ‖F‖/max(‖q‖, ‖r‖, ‖u‖), ``penetration`` ‖(−u_n)₊‖/‖q‖ (ũ ∈ K*_μ reduces to u_n ≥ 0)
+    and ``complementarity`` ``Σ_c |r_c·ũ_c| / (‖r‖‖q‖)``.
+
+    Parameters
+    ----------
+    values : dict
+        The accepted residuals by name.
+    reported : dict
+        The figures reported beside them.
+    tol : float
+        Tolerance every accepted residual must meet.
+    extras : dict, optional
+        Anything a solver reports beside the residuals.
+    """
+
+    values: dict
+    reported: dict
+    tol: float
+    extras: dict = field(default_factory=dict)
+
+    @property
+    def residuals(self) -> dict[str, float]:
+        return dict(self.values)
+
+    @property
+    def error(self) -> float:
+        """The acceptance figure ‖F‖/‖q‖ (ABH)."""
+        return self.values["natural_map"]
+
+    def summary(self) -> str:
+        """One line: the verdict, the tolerance, the residuals and the reported figures."""
+        extra = ", ".join(f"{k}={v:.1e}" for k, v in self.reported.items())
+        return f"{super().summary()}; reported: {extra}"
+
+
+def _ratio(num: float, den: float) -> float:
+    """num/den for the certificate: 0 when num is 0, NaN as +inf."""
+    if num == 0.0:
+        return 0.0
+    v = num / den if den > 0.0 else math.inf
+    return v if v == v else math.inf
+
+
+def certify_friction(problem: FrictionContactProblem, r, u=None, *,
+                     tol: float = 1e-8) -> FrictionCertificate:
+    """Recompute the certificate of a candidate reaction ``r`` (and velocity ``u``).
+
+    Parameters
+    ----------
+    problem : FrictionContactProblem
+    r : (d·m,) array
+        The candidate reaction.
+    u : (d·m,) array, optional
+        The candidate velocity; its distance to W r + q is the ``velocity`` residual (0 when
+        not given). Every other figure uses u = W r + q recomputed.
+    tol : float
+        Tolerance of the residuals.
+    """
+    tol = check_tol(tol)
+    n = problem.q.size
+    r = as_array("r", r, ndim=1, allow_nonfinite=True)
+    if r.shape != (n,):
+        raise ShapeError(f"r must have shape ({n},), got {r.shape}")
+    u_w = problem.velocity(r)
+    qn = float(np.linalg.norm(problem.q))
+    q_scale = qn if qn > 0.0 else 1.0
+    consistency = 0.0
+    if u is not None:
+        u = as_array("u", u, ndim=1, allow_nonfinite=True)
+        if u.shape != (n,):
+            raise ShapeError(f"u must have shape ({n},), got {u.shape}")
+        consistency = _ratio(float(np.linalg.norm(u - u_w)), q_scale)
+    f2, comp, pen, cone = certificate_sums(r, u_w, problem.mu, problem.contact_dim)
+    fn = math.sqrt(f2)
+    rn = float(np.linalg.norm(r))
+    un = float(np.linalg.norm(u_w))
+    values = {"natural_map": _ratio(fn, q_scale), "velocity": consistency,
+              "cone": _ratio(math.sqrt(cone), rn)}
+    reported = {"siconos_error": _ratio(fn, max(qn, rn, un)),
+                "penetration": _ratio(math.sqrt(pen), q_scale),
+                "complementarity": _ratio(comp, rn * q_scale)}
+    return FrictionCertificate(values, reported, tol)
