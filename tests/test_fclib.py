@@ -309,3 +309,26 @@ def test_save_refuses(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="problem.q holds non-finite"):
         save_fclib(problem, tmp_path / "nan.hdf5")
     assert not (tmp_path / "nan.hdf5").exists()
+
+
+def test_damaged_files_are_refused_by_name(tmp_path: Path) -> None:
+    """Truncated and byte-flipped copies of a shipped file: each either loads (the bytes hit
+    unused space or a value that stays valid) or is a ProblemFileError, never h5py's own
+    exception; at least the truncated ones are refused."""
+    source = (DATA / "LMGC_GlobalFrictionContactProblem00046.hdf5").read_bytes()
+    rng = np.random.default_rng(3)
+    path = tmp_path / "damaged.hdf5"
+    refused = 0
+    for k in range(80):
+        data = bytearray(source[:int(rng.integers(0, len(source) // 2))] if k < 20 else source)
+        for _ in range(0 if k < 20 else int(rng.integers(1, 10))):
+            data[int(rng.integers(0, len(data)))] = int(rng.integers(0, 256))
+        path.write_bytes(bytes(data))
+        try:
+            problem = load_fclib(path)
+        except ProblemFileError:
+            refused += 1
+            continue
+        assert np.all(np.isfinite(problem.W.data)) and np.all(np.isfinite(problem.q))
+        assert np.all(problem.mu >= 0)
+    assert refused >= 20

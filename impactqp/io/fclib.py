@@ -46,8 +46,8 @@ REDUCTION_BLOCK = 256
 array to n × 256 floats)."""
 
 REDUCTION_RTOL = 1e-8
-"""Largest relative residual ‖M Y − H‖/(‖M‖‖Y‖) accepted for Y = M⁻¹H; above it M is taken
-as singular (the reduced W would not be Hᵀ M⁻¹ H)."""
+"""Largest componentwise backward error |M Y − H| ≤ rtol·(|M||Y| + |H|) accepted for
+Y = M⁻¹H; above it M is taken as singular (the reduced W would not be Hᵀ M⁻¹ H)."""
 
 MIXED_PARTS = {"fclib_local": ("V", "R", "vectors/s"), "fclib_global": ("G", "vectors/b")}
 
@@ -180,19 +180,22 @@ def _reduce(reader: _Reader, M: sp.csc_matrix, H: sp.csc_matrix,
     except RuntimeError as exc:
         raise reader.error(name, f"is singular ({exc}); the global problem cannot be reduced "
                                  "to W = Hᵀ M⁻¹ H") from None
-    scale = spla.norm(M)
+    magnitude = abs(M)
     blocks = []
     rhs = sp.hstack([H, sp.csc_matrix(f.reshape(-1, 1))], format="csc")
     for start in range(0, rhs.shape[1], REDUCTION_BLOCK):
         B = rhs[:, start:start + REDUCTION_BLOCK].toarray()
-        Y = lu.solve(B)
-        residual = np.linalg.norm(M @ Y - B)
-        if not (np.all(np.isfinite(Y))
-                and residual <= REDUCTION_RTOL * max(scale * np.linalg.norm(Y), 1e-300)):
-            raise reader.error(name, f"is singular or too ill-conditioned to reduce the global "
-                                     f"problem (relative residual of M⁻¹H {residual:.1e})")
-        blocks.append(sp.csc_matrix(H.T @ Y))
+        with np.errstate(over="ignore", invalid="ignore"):
+            Y = lu.solve(B)
+            # componentwise (Oettli–Prager) backward error of the solve
+            excess = np.abs(M @ Y - B) - REDUCTION_RTOL * (magnitude @ np.abs(Y) + np.abs(B))
+            if not (np.all(np.isfinite(Y)) and np.all(excess <= 0)):
+                raise reader.error(name, "is singular or too ill-conditioned to reduce the "
+                                         "global problem (M⁻¹H does not solve M Y = H)")
+            blocks.append(sp.csc_matrix(H.T @ Y))
     reduced = sp.hstack(blocks, format="csc")
+    if not np.all(np.isfinite(reduced.data)):
+        raise reader.error(name, "Hᵀ M⁻¹ H or Hᵀ M⁻¹ f overflows the floats; rescale the problem")
     return sp.csc_matrix(reduced[:, :-1]), reduced[:, -1].toarray().ravel()
 
 
@@ -212,6 +215,19 @@ def _global(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int
     mu = reader.mu(root, contacts)
     W, Hf = _reduce(reader, M, H, f)
     return W, Hf + w, mu, d
+
+
+def _read(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]:
+    handle = reader.handle
+    root = next((r for r in ("fclib_local", "fclib_global") if r in handle), None)
+    if root is None:
+        raise ProblemFileError(f"{reader.path}: neither /fclib_local nor /fclib_global; not an "
+                               "FCLib problem file")
+    mixed = [part for part in MIXED_PARTS[root] if f"{root}/{part}" in handle]
+    if mixed:
+        raise reader.error(f"{root}/{mixed[0]}", "mixed problems (extra equality multipliers) "
+                                                 "are not supported")
+    return _local(reader) if root == "fclib_local" else _global(reader)
 
 
 def load_fclib(path: str | Path) -> FrictionContactProblem:
@@ -253,16 +269,12 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
     except OSError as exc:
         raise ProblemFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
     with handle:
-        reader = _Reader(path, handle)
-        root = next((r for r in ("fclib_local", "fclib_global") if r in handle), None)
-        if root is None:
-            raise ProblemFileError(f"{path}: neither /fclib_local nor /fclib_global; not an "
-                                   "FCLib problem file")
-        mixed = [part for part in MIXED_PARTS[root] if f"{root}/{part}" in handle]
-        if mixed:
-            raise reader.error(f"{root}/{mixed[0]}", "mixed problems (extra equality "
-                                                     "multipliers) are not supported")
-        W, q, mu, d = _local(reader) if root == "fclib_local" else _global(reader)
+        try:
+            W, q, mu, d = _read(_Reader(path, handle))
+        except ProblemFileError:
+            raise
+        except (OSError, RuntimeError, KeyError, ValueError) as exc:  # h5py on a damaged file
+            raise ProblemFileError(f"{path}: damaged HDF5 file ({exc})") from None
     try:
         return FrictionContactProblem(W, q, mu, contact_dim=d)
     except InputError as exc:
