@@ -39,6 +39,7 @@ from .errors import (
     SolverError,
     UnknownBackendError,
 )
+from .io.fclib import load_fclib, save_fclib
 from .io.files import ProblemFile, load_problem
 from .io.save import save_problem
 from .laws.base import Answer, ImpactLaw
@@ -109,4 +110,5 @@ __all__ = [
     "newtons_cradle", "random_impact", "reflection_law", "reflection_law_table", "save_problem",
     "sector_law", "sector_law_batch", "sector_law_table", "simulate", "solve", "solve_batch",
     "solve_friction", "solve_lcp", "sphere_mass", "tapered_chain", "verify_law",
+    "load_fclib", "save_fclib",
 ]

@@ -1,0 +1,345 @@
+"""FCLib files: frictional contact problems in HDF5, read and written with h5py.
+
+FCLib (Acary, Brémond, Huber et al.) stores one problem per file, in one of two forms:
+
+- ``/fclib_local``: the local problem u = W r + q (``W``, ``vectors/q``, ``vectors/mu``,
+  ``spacedim``), read as it is;
+- ``/fclib_global``: M v = H r + f, u = Hᵀ v + w (``M``, ``H``, ``vectors/f``, ``vectors/w``,
+  ``vectors/mu``, ``spacedim``), reduced to the local problem by eliminating v:
+  W = Hᵀ M⁻¹ H, q = Hᵀ M⁻¹ f + w. This is the Delassus matrix and free contact velocity of
+  docs/theory.md §1 with H in the role of the force directions and M⁻¹f in that of u⁻.
+
+Per contact the d = ``spacedim`` (2 or 3) entries are the normal first, then the tangents;
+μ has one entry per contact. A matrix is a group ``nzmax, m, n, nz, p, i, x`` in the
+CSparse layout: ``nz = -1`` compressed columns (``p`` the n + 1 column pointers, ``i`` the
+row indices), ``nz = -2`` compressed rows (``p`` the m + 1 row pointers, ``i`` the column
+indices), ``nz ≥ 0`` a triplet of ``nz`` entries (``i`` the row, ``p`` the column of each;
+duplicates add up, as in CSparse). Mixed problems (``V``, ``R``, ``s`` or ``G``, ``b``: extra
+equality multipliers) are refused, as are rolling-friction files.
+
+Reading is strict: a path that is not a regular file, a file that is not HDF5, missing or
+mis-typed datasets, sizes that do not fit together, indices out of range, non-finite numbers,
+negative μ and a singular M are refused with a :class:`~impactqp.errors.ProblemFileError`
+that names the file and the dataset. Dimensions above :data:`MAX_FCLIB_DIM` are refused before
+anything is allocated.
+"""
+
+from __future__ import annotations
+
+import stat
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..base.outputs import output_file
+from ..errors import InputError, OptionalDependencyError, ProblemFileError
+from ..model.friction import FrictionContactProblem
+
+MAX_FCLIB_DIM = 1_000_000
+"""Largest row or column count of a matrix in an FCLib file (degrees of freedom, d·contacts)."""
+
+REDUCTION_BLOCK = 256
+"""Columns of H solved at a time in the global-to-local reduction (bounds the dense work
+array to n × 256 floats)."""
+
+REDUCTION_RTOL = 1e-8
+"""Largest componentwise backward error |M Y − H| ≤ rtol·(|M||Y| + |H|) accepted for
+Y = M⁻¹H; above it M is taken as singular (the reduced W would not be Hᵀ M⁻¹ H)."""
+
+MIXED_PARTS = {"fclib_local": ("V", "R", "vectors/s"), "fclib_global": ("G", "vectors/b")}
+
+
+def _h5py() -> Any:
+    try:
+        import h5py
+    except ImportError:
+        raise OptionalDependencyError("FCLib files need h5py: pip install h5py") from None
+    return h5py
+
+
+class _Reader:
+    """Datasets of one open FCLib file, each checked and named in every error."""
+
+    def __init__(self, path: Path, handle: Any) -> None:
+        self.path = path
+        self.handle = handle
+
+    def error(self, name: str, what: str) -> ProblemFileError:
+        return ProblemFileError(f"{self.path}: /{name}: {what}")
+
+    def dataset(self, name: str) -> np.ndarray:
+        obj = self.handle.get(name)
+        if obj is None:
+            raise self.error(name, "missing (an FCLib file needs it)")
+        if not hasattr(obj, "dtype"):
+            raise self.error(name, "is a group, expected a dataset")
+        try:
+            return np.asarray(obj[()])
+        except (OSError, TypeError, ValueError) as exc:
+            raise self.error(name, f"cannot be read ({exc})") from None
+
+    def integer(self, name: str) -> int:
+        data = self.dataset(name)
+        if data.dtype.kind not in "iu" or data.size != 1 or data.ndim > 1:
+            raise self.error(name, f"must hold one integer, got dtype {data.dtype} and shape "
+                                   f"{data.shape}")
+        return int(data.reshape(-1)[0])
+
+    def indices(self, name: str, length: int, bound: int) -> np.ndarray:
+        data = self.dataset(name)
+        if data.dtype.kind not in "iu" or data.ndim != 1:
+            raise self.error(name, f"must be a vector of integers, got dtype {data.dtype} and "
+                                   f"shape {data.shape}")
+        if data.size < length:
+            raise self.error(name, f"has {data.size} entries, needs at least {length}")
+        data = data[:length].astype(np.int64)
+        if length and (data.min() < 0 or data.max() >= bound):
+            raise self.error(name, f"indices must lie in [0, {bound}), found "
+                                   f"{data.min()}..{data.max()}")
+        return data
+
+    def floats(self, name: str, length: int, *, exact: bool = True) -> np.ndarray:
+        data = self.dataset(name)
+        if data.dtype.kind not in "fiu" or data.ndim != 1:
+            raise self.error(name, f"must be a vector of numbers, got dtype {data.dtype} and "
+                                   f"shape {data.shape}")
+        if data.size < length or (exact and data.size != length):
+            raise self.error(name, f"has {data.size} entries, expected {length}")
+        data = data[:length].astype(float)
+        if not np.all(np.isfinite(data)):
+            raise self.error(name, f"holds {int(np.sum(~np.isfinite(data)))} non-finite "
+                                   "number(s) (NaN or infinity)")
+        return data
+
+    def matrix(self, name: str) -> sp.csc_matrix:
+        """The sparse matrix stored in group ``name`` (CSparse layout, see the module doc)."""
+        m, n, nz = (self.integer(f"{name}/{key}") for key in ("m", "n", "nz"))
+        for key, value in (("m", m), ("n", n)):
+            if not 0 <= value <= MAX_FCLIB_DIM:
+                raise self.error(f"{name}/{key}", f"{value} is outside [0, {MAX_FCLIB_DIM}]")
+        if nz >= 0:
+            rows = self.indices(f"{name}/i", nz, m)
+            cols = self.indices(f"{name}/p", nz, n)
+            values = self.floats(f"{name}/x", nz, exact=False)
+            return sp.csc_matrix((values, (rows, cols)), shape=(m, n))
+        if nz not in (-1, -2):
+            raise self.error(f"{name}/nz", f"{nz} is not a storage FCLib knows (-1 compressed "
+                                           "columns, -2 compressed rows, ≥ 0 triplet)")
+        outer, inner = (n, m) if nz == -1 else (m, n)
+        pointers = self.indices(f"{name}/p", outer + 1, np.iinfo(np.int64).max)
+        if pointers[0] != 0 or np.any(np.diff(pointers) < 0):
+            raise self.error(f"{name}/p", "pointers must start at 0 and never decrease")
+        count = int(pointers[-1])
+        index = self.indices(f"{name}/i", count, inner)
+        values = self.floats(f"{name}/x", count, exact=False)
+        kind = sp.csc_matrix if nz == -1 else sp.csr_matrix
+        return sp.csc_matrix(kind((values, index, pointers), shape=(m, n)))
+
+    def spacedim(self, root: str) -> int:
+        d = self.integer(f"{root}/spacedim")
+        if d not in (2, 3):
+            raise self.error(f"{root}/spacedim", f"must be 2 or 3, got {d}")
+        return d
+
+    def mu(self, root: str, contacts: int) -> np.ndarray:
+        mu = self.floats(f"{root}/vectors/mu", contacts)
+        if np.any(mu < 0):
+            raise self.error(f"{root}/vectors/mu", "friction coefficients must be ≥ 0, found "
+                                                   f"{mu.min()}")
+        return mu
+
+
+def _contacts(reader: _Reader, name: str, size: int, d: int) -> int:
+    if size % d:
+        raise reader.error(name, f"{size} rows or columns do not split into contacts of "
+                                 f"dimension {d}")
+    return size // d
+
+
+def _local(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]:
+    root = "fclib_local"
+    d = reader.spacedim(root)
+    W = reader.matrix(f"{root}/W")
+    if W.shape[0] != W.shape[1]:
+        raise reader.error(f"{root}/W", f"must be square, got {W.shape}")
+    contacts = _contacts(reader, f"{root}/W", W.shape[0], d)
+    q = reader.floats(f"{root}/vectors/q", W.shape[0])
+    return W, q, reader.mu(root, contacts), d
+
+
+def _reduce(reader: _Reader, M: sp.csc_matrix, H: sp.csc_matrix,
+            f: np.ndarray) -> tuple[sp.csc_matrix, np.ndarray]:
+    """Hᵀ M⁻¹ H and Hᵀ M⁻¹ f, with M⁻¹ applied by one sparse LU and checked column block by
+    column block (docs/theory.md §1: the Delassus matrix and the free contact velocity)."""
+    name = "fclib_global/M"
+    try:
+        lu = spla.splu(M)
+    except RuntimeError as exc:
+        raise reader.error(name, f"is singular ({exc}); the global problem cannot be reduced "
+                                 "to W = Hᵀ M⁻¹ H") from None
+    magnitude = abs(M)
+    blocks = []
+    rhs = sp.hstack([H, sp.csc_matrix(f.reshape(-1, 1))], format="csc")
+    for start in range(0, rhs.shape[1], REDUCTION_BLOCK):
+        B = rhs[:, start:start + REDUCTION_BLOCK].toarray()
+        with np.errstate(over="ignore", invalid="ignore"):
+            Y = lu.solve(B)
+            # componentwise (Oettli–Prager) backward error of the solve
+            excess = np.abs(M @ Y - B) - REDUCTION_RTOL * (magnitude @ np.abs(Y) + np.abs(B))
+            if not (np.all(np.isfinite(Y)) and np.all(excess <= 0)):
+                raise reader.error(name, "is singular or too ill-conditioned to reduce the "
+                                         "global problem (M⁻¹H does not solve M Y = H)")
+            blocks.append(sp.csc_matrix(H.T @ Y))
+    reduced = sp.hstack(blocks, format="csc")
+    if not np.all(np.isfinite(reduced.data)):
+        raise reader.error(name, "Hᵀ M⁻¹ H or Hᵀ M⁻¹ f overflows the floats; rescale the problem")
+    return sp.csc_matrix(reduced[:, :-1]), reduced[:, -1].toarray().ravel()
+
+
+def _global(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]:
+    root = "fclib_global"
+    d = reader.spacedim(root)
+    M = reader.matrix(f"{root}/M")
+    if M.shape[0] != M.shape[1]:
+        raise reader.error(f"{root}/M", f"must be square, got {M.shape}")
+    H = reader.matrix(f"{root}/H")
+    if H.shape[0] != M.shape[0]:
+        raise reader.error(f"{root}/H", f"must have {M.shape[0]} rows (those of M), got "
+                                        f"{H.shape[0]}")
+    contacts = _contacts(reader, f"{root}/H", H.shape[1], d)
+    f = reader.floats(f"{root}/vectors/f", M.shape[0])
+    w = reader.floats(f"{root}/vectors/w", H.shape[1])
+    mu = reader.mu(root, contacts)
+    W, Hf = _reduce(reader, M, H, f)
+    return W, Hf + w, mu, d
+
+
+def _read(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]:
+    handle = reader.handle
+    root = next((r for r in ("fclib_local", "fclib_global") if r in handle), None)
+    if root is None:
+        raise ProblemFileError(f"{reader.path}: neither /fclib_local nor /fclib_global; not an "
+                               "FCLib problem file")
+    mixed = [part for part in MIXED_PARTS[root] if f"{root}/{part}" in handle]
+    if mixed:
+        raise reader.error(f"{root}/{mixed[0]}", "mixed problems (extra equality multipliers) "
+                                                 "are not supported")
+    return _local(reader) if root == "fclib_local" else _global(reader)
+
+
+def load_fclib(path: str | Path) -> FrictionContactProblem:
+    """Read a frictional contact problem from an FCLib HDF5 file.
+
+    A local problem (``/fclib_local``) is returned as stored; a global one
+    (``/fclib_global``: M v = H r + f, u = Hᵀ v + w) is reduced to the local form
+    u = W r + q with W = Hᵀ M⁻¹ H and q = Hᵀ M⁻¹ f + w (docs/theory.md §1). A file holding
+    both is read as local.
+
+    Parameters
+    ----------
+    path : str or Path
+        An FCLib file (``.hdf5``).
+
+    Returns
+    -------
+    FrictionContactProblem
+        W as a scipy.sparse CSC matrix, q, μ (one per contact) and ``contact_dim`` (FCLib's
+        ``spacedim``).
+
+    Raises
+    ------
+    ProblemFileError
+        Not a regular file, not HDF5, neither problem group, a mixed problem (``V``/``R`` or
+        ``G``/``b``), a missing or malformed dataset, non-finite numbers, negative μ or a
+        singular M; the message names the file and the dataset.
+    """
+    if not isinstance(path, (str, Path)):
+        raise ProblemFileError(f"path must be a str or Path, got {type(path).__name__}")
+    path = Path(path)
+    h5py = _h5py()
+    try:
+        if not stat.S_ISREG(path.stat().st_mode):
+            raise ProblemFileError(f"{path}: not a regular file")
+        if not h5py.is_hdf5(path):
+            raise ProblemFileError(f"{path}: not an HDF5 file (FCLib problems are HDF5)")
+        handle = h5py.File(path, "r")
+    except OSError as exc:
+        raise ProblemFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    with handle:
+        try:
+            W, q, mu, d = _read(_Reader(path, handle))
+        except ProblemFileError:
+            raise
+        except (OSError, RuntimeError, KeyError, ValueError) as exc:  # h5py on a damaged file
+            raise ProblemFileError(f"{path}: damaged HDF5 file ({exc})") from None
+    try:
+        return FrictionContactProblem(W, q, mu, contact_dim=d)
+    except InputError as exc:
+        raise ProblemFileError(f"{path}: {exc}") from exc
+
+
+def _write_int(group: Any, name: str, value: int) -> None:
+    group.create_dataset(name, data=np.array([value], dtype=np.int32))
+
+
+def save_fclib(problem: FrictionContactProblem, path: str | Path) -> Path:
+    """Write a local frictional contact problem as an FCLib HDF5 file (``/fclib_local``).
+
+    W is stored in compressed columns (``nz = -1``), as FCLib and Siconos read it; the file
+    is replaced if it exists. :func:`load_fclib` reads back W, q and μ bit for bit.
+
+    Parameters
+    ----------
+    problem : FrictionContactProblem
+        The problem u = W r + q; W dense or scipy.sparse.
+    path : str or Path
+        Where to write (``.hdf5``).
+
+    Returns
+    -------
+    Path
+        The path written.
+
+    Raises
+    ------
+    InputError
+        ``problem`` is not a FrictionContactProblem, holds non-finite numbers, or ``path``
+        exists and is not a regular file.
+    """
+    if not isinstance(problem, FrictionContactProblem):
+        raise InputError(f"problem must be a FrictionContactProblem, got "
+                         f"{type(problem).__name__}")
+    W = sp.csc_matrix(problem.W, dtype=float)
+    W.sort_indices()
+    q = np.asarray(problem.q, dtype=float)
+    mu = np.asarray(problem.mu, dtype=float)
+    for name, values in (("W", W.data), ("q", q), ("mu", mu)):
+        if not np.all(np.isfinite(values)):
+            raise InputError(f"problem.{name} holds non-finite numbers; FCLib files hold "
+                             "finite ones")
+    path = output_file(path)
+    h5py = _h5py()
+    try:
+        with h5py.File(path, "w") as handle:
+            root = handle.create_group("fclib_local")
+            _write_int(root, "spacedim", problem.contact_dim)
+            group = root.create_group("W")
+            for key, value in (("nzmax", W.nnz), ("m", W.shape[0]), ("n", W.shape[1]),
+                               ("nz", -1)):
+                _write_int(group, key, value)
+            group.create_dataset("p", data=W.indptr.astype(np.int32))
+            group.create_dataset("i", data=W.indices.astype(np.int32))
+            group.create_dataset("x", data=W.data)
+            vectors = root.create_group("vectors")
+            vectors.create_dataset("q", data=q)
+            vectors.create_dataset("mu", data=mu)
+            info = root.create_group("info")
+            info.create_dataset("title", data=np.bytes_("impactqp"))
+            info.create_dataset("description", data=np.bytes_("written by impactqp.save_fclib"))
+            info.create_dataset("math_info", data=np.bytes_(""))
+    except OSError as exc:
+        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
+    return path
