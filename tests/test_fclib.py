@@ -7,16 +7,15 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import h5py  # a dependency of impactqp
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
-h5py = pytest.importorskip("h5py")
-
-import impactqp as iq  # noqa: E402
-from impactqp.errors import InputError, ProblemFileError  # noqa: E402
-from impactqp.io.fclib import load_fclib, save_fclib  # noqa: E402
-from impactqp.model.friction import FrictionContactProblem  # noqa: E402
+import impactqp as iq
+from impactqp.errors import InputError, ProblemFileError
+from impactqp.io.fclib import load_fclib, save_fclib
+from impactqp.model.friction import FrictionContactProblem
 
 DATA = Path(__file__).resolve().parent / "data" / "fclib"
 
@@ -332,3 +331,16 @@ def test_damaged_files_are_refused_by_name(tmp_path: Path) -> None:
         assert np.all(np.isfinite(problem.W.data)) and np.all(np.isfinite(problem.q))
         assert np.all(problem.mu >= 0)
     assert refused >= 20
+
+
+@pytest.mark.parametrize("name", ["Box_Stacks-i0122-82-5.hdf5",
+                                  "LMGC_100_PR_PerioBox-i00361-60-03000.hdf5",
+                                  "LMGC_GlobalFrictionContactProblem00046.hdf5"])
+def test_shipped_problems_are_solved_and_certified(name):
+    """The small FCLib problems of Siconos' test data (global ones reduced) are solved by
+    the default route to ABH ≤ 1e-8, the certificate recomputed from (W, q, μ, r) alone."""
+    problem = iq.load_fclib(DATA / name)
+    result = iq.solve_friction(problem, tol=1e-8)
+    assert result.certificate.ok and result.error <= 1e-8
+    u = problem.W @ result.r + problem.q
+    np.testing.assert_allclose(result.u, u, atol=1e-8 * np.linalg.norm(problem.q))
