@@ -77,8 +77,9 @@ class ImpactProblem:
 
     @cached_property
     def peak_minus(self) -> float:
-        """max |u⁻ᵢ|, kept: whether u⁻ is within the range worked in as given
-        (:data:`impactqp.base.checks.UNIT_RANGE`, docs/theory.md §8)."""
+        """The largest magnitude of the entries of u⁻, kept: whether u⁻ is within the
+        range worked in as given (:data:`!impactqp.base.checks.UNIT_RANGE`,
+        docs/theory.md §8)."""
         return float(np.abs(self.u_minus).max(initial=0.0))
 
     @cached_property
