@@ -15,7 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import as_array, as_count, as_matrix, check_tol
-from ..base.checks import ResidualChecks
+from ..base.checks import NamedChecks
 from ..errors import InputError, ShapeError
 from ..kernels.friction import certificate_sums
 
@@ -85,7 +85,7 @@ class FrictionContactProblem:
 
 
 @dataclass(frozen=True)
-class FrictionCertificate(ResidualChecks):
+class FrictionCertificate(NamedChecks):
     """The recomputed checks of one candidate answer (r, u) of a
     :class:`FrictionContactProblem` (docs/theory.md §15).
 
@@ -104,22 +104,16 @@ class FrictionCertificate(ResidualChecks):
     ----------
     values : dict
         The accepted residuals by name.
-    reported : dict
-        The figures reported beside them.
     tol : float
         Tolerance every accepted residual must meet.
+    reported : dict
+        The figures reported beside them.
     extras : dict, optional
         Anything a solver reports beside the residuals.
     """
 
-    values: dict
-    reported: dict
-    tol: float
+    reported: dict = field(default_factory=dict)
     extras: dict = field(default_factory=dict)
-
-    @property
-    def residuals(self) -> dict[str, float]:
-        return dict(self.values)
 
     @property
     def error(self) -> float:
@@ -178,4 +172,4 @@ def certify_friction(problem: FrictionContactProblem, r, u=None, *,
     reported = {"siconos_error": _ratio(fn, max(qn, rn, un)),
                 "penetration": _ratio(math.sqrt(pen), q_scale),
                 "complementarity": _ratio(comp, rn * q_scale)}
-    return FrictionCertificate(values, reported, tol)
+    return FrictionCertificate(values, tol, reported)

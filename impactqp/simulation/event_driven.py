@@ -137,7 +137,7 @@ def event_driven(system: LinearSystem, law: ImpactLaw, t_end: float, h: float | 
     acc_tol = 1e-3 * lift_threshold * system.structure.delassus_diagonal \
         if system.n_contacts else 0.0
     max_step = _max_step(system)
-    length, speed = motion_scales(system, t_end - t0)
+    length, speed = motion_scales(system, t0, t_end - t0)
     gap_tol = GAP_TOL * length if gap_tol is None else gap_tol
     rest_velocity = REST_VELOCITY * speed if rest_velocity is None else rest_velocity
     g = system.gaps(system.q0)
@@ -250,13 +250,14 @@ def _exact_flight(t: float, q: np.ndarray, v: np.ndarray, a: np.ndarray, t_eval:
     return _Flight(times, y, 1, [np.array([t_event])], [y_event[None, :]])
 
 
-def motion_scales(system: LinearSystem, span: float) -> tuple[float, float]:
+def motion_scales(system: LinearSystem, t0: float, span: float) -> tuple[float, float]:
     """(L, V): the length and velocity scales of the system's own motion, which the default
     event thresholds are relative to, so that the same motion in other units has the same
     events (docs/theory.md §14).
 
     L is the largest initial gap; V the largest of the initial contact speeds and √(2LA),
-    A the largest initial contact acceleration |Hᵀ M⁻¹ f| (the speed of falling through L).
+    A the largest initial contact acceleration |Hᵀ M⁻¹ f(t0)| (the speed of falling through
+    L).
     Where the gaps are all closed, L = V²/A (or V·span without acceleration); where nothing
     moves or pushes, 1.
     """
@@ -265,7 +266,7 @@ def motion_scales(system: LinearSystem, span: float) -> tuple[float, float]:
     q0, v0 = system.q0, system.v0
     gap = float(np.abs(system.gaps(q0)).max())
     speed = float(np.abs(system.contact_velocities(v0)).max())
-    accel = system.structure.solve_mass(system.force_at(0.0, q0, v0))
+    accel = system.structure.solve_mass(system.force_at(t0, q0, v0))
     push = float(np.abs(system.contact_velocities(accel)).max())
     if gap > 0:
         speed = max(speed, float(np.sqrt(2.0 * gap * push)))
