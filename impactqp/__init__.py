@@ -47,6 +47,7 @@ from .laws.batch import BatchResult, moreau_batch, sector_law_batch, solve_batch
 from .laws.catalogue import available_backends
 from .laws.certificate import Certificate, SectorLawCertificate
 from .laws.complementarity import Fremond, Newton
+from .laws.coulomb import Coulomb
 from .laws.friction import FrictionResult, solve_friction
 from .laws.functions import fremond, moreau, newton, reflection_law, sector_law
 from .laws.lzb import LZB, LZBAnswer, LZBCertificate, LZBRecord
@@ -92,7 +93,8 @@ except PackageNotFoundError:  # running from a source tree that was never instal
 
 __all__ = [
     "AdmissibleSet", "Answer", "BackendUnsuitableError", "BatchResult", "Certificate",
-    "CertificateError", "ChainInfo", "Classification", "Counterexample", "DEFAULT_TOL", "Fremond",
+    "CertificateError", "ChainInfo", "Classification", "Coulomb", "Counterexample",
+    "DEFAULT_TOL", "Fremond",
     "FrictionCertificate", "FrictionContactProblem", "FrictionResult",
     "ImpactError", "ImpactEvent", "ImpactLaw", "ImpactProblem", "ImpactResult", "ImpactStructure",
     "InputError", "IntegrationBudgetError", "LCPResult", "LZB", "LZBAnswer", "LZBCertificate",
