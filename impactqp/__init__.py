@@ -60,6 +60,7 @@ from .model.admissible import AdmissibleSet, Membership
 from .model.builders import chain, newtons_cradle, random_impact
 from .model.classify import Classification, classify
 from .model.friction import FrictionCertificate, FrictionContactProblem
+from .model.friction_builders import point_on_plane, sphere_on_plane, two_spheres
 from .model.physical_chains import (
     PhysicalChain,
     ball_chain,
@@ -112,5 +113,5 @@ __all__ = [
     "newtons_cradle", "random_impact", "reflection_law", "reflection_law_table", "save_problem",
     "sector_law", "sector_law_batch", "sector_law_table", "simulate", "solve", "solve_batch",
     "solve_friction", "solve_lcp", "sphere_mass", "tapered_chain", "verify_law",
-    "load_fclib", "save_fclib",
+    "load_fclib", "save_fclib", "point_on_plane", "sphere_on_plane", "two_spheres",
 ]
