@@ -211,7 +211,8 @@ class ImpactLaw(ABC):
 
     def admissible_set(self, problem: ImpactProblem) -> AdmissibleSet:
         """The admissible set the law's answers on ``problem`` are judged against
-        (docs/theory.md §2; a frictional law passes its friction coefficients, §16)."""
+        (docs/theory.md §2; a frictional law passes its friction coefficients,
+        docs/theory.md §16)."""
         return problem.admissible_set()
 
     def residuals(self, structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,

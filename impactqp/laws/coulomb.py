@@ -94,6 +94,10 @@ class Coulomb(ImpactLaw):
 
     Notes
     -----
+    A solution exists when W has independent columns, and for μ = 0 with one e (Moreau's
+    law); not always otherwise (μ = 0 with unequal eᵢ is local Newton), so an answer that
+    no method certifies is a CertificateError, never a claim that none exists.
+
     A problem with frictionless contacts (``contact_dim = 1``) is refused: it has no
     tangent columns, and ``iq.Newton(e)`` is the law there (the same as Coulomb's with
     μ = 0 on the normal problem).
@@ -102,7 +106,7 @@ class Coulomb(ImpactLaw):
     name = "coulomb"
     title = "Coulomb's law"
     closed_form_backend = "solve_friction"
-    always_solvable = True
+    always_solvable = False  # μ = 0 with unequal eᵢ is local Newton, which may have none
     homogeneous = True
     frictional = True
 

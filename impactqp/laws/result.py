@@ -126,8 +126,8 @@ class ImpactResult:
     @cached_property
     def admissible(self) -> Membership:
         """Whether u⁺ ∈ S (exact test, docs/theory.md §2; with the law's friction cones for
-        frictional contacts, §16), with its residuals: the physical verdict, separate from
-        the certificate."""
+        frictional contacts, docs/theory.md §16), with its residuals: the physical verdict,
+        separate from the certificate."""
         law = self.impact_law
         S = self.problem.admissible_set() if law is None else law.admissible_set(self.problem)
         return S.contains(self.u_plus)

@@ -50,7 +50,7 @@ def sample_u_minus(problem: ImpactProblem, samples: int, rng: np.random.Generato
     With frictional contacts only the normal velocities are constrained (W's normal
     columns, docs/theory.md §16).
     """
-    problem = problem.normal_problem()  # consistency concerns the normals (§16)
+    problem = problem.normal_problem()  # only the normals (docs/theory.md §16)
     st = problem.structure
     W = as_dense(st.W)
     L = np.linalg.cholesky(as_dense(st.M)) if st.sparse else st.cholesky_factor
