@@ -308,6 +308,8 @@ def test_bad_input_named_errors() -> None:
         frictionless.admissible_set(mu=0.1)
     with pytest.raises(iq.InputError):
         p.admissible_set(mu=0.1).project([0.0, 0.0])
+    with pytest.raises(iq.InputError, match="normal_problem"):
+        iq.classify(p, iq.solve(p, iq.Coulomb(0.1)).u_plus)
     with pytest.raises(iq.InputError):
         iq.sphere_on_plane(-1.0, 0.5, [1.0, -1.0, 0.0])
     with pytest.raises(iq.ShapeError):
@@ -316,6 +318,15 @@ def test_bad_input_named_errors() -> None:
         iq.two_spheres([1.0], [0.5, 0.5], np.zeros(6))
     with pytest.raises(iq.NonFiniteError):
         iq.point_on_plane(1.0, [np.nan, -1.0])
+
+
+def test_problem_files_refuse_frictional_problems(tmp_path) -> None:
+    p = iq.point_on_plane(1.0, [1.0, -1.0])
+    with pytest.raises(iq.InputError, match="contact_dim"):
+        iq.save_problem(p, tmp_path / "p.json")
+    iq.save_problem(p.normal_problem(), tmp_path / "p.json")
+    np.testing.assert_array_equal(iq.load_problem(tmp_path / "p.json").problem.W,
+                                  p.W[:, ::2])
 
 
 def test_normal_problem_and_frictionless_default_unchanged() -> None:

@@ -23,7 +23,13 @@ from .files import COEFFICIENT_KEYS, VERSION, file_format, problem_from_dict
 
 def problem_to_dict(problem: ImpactProblem, *, law: str | None = None, coefficients: Any = None,
                     u_plus: Any = None) -> dict[str, Any]:
-    """The file content of a problem as plain lists and numbers (validated by a re-read)."""
+    """The file content of a problem as plain lists and numbers (validated by a re-read).
+    Problem files hold frictionless problems: a frictional one (``contact_dim`` > 1) is an
+    InputError rather than a file that reads back without its friction."""
+    if problem.contact_dim > 1:
+        raise InputError(f"problem files hold frictionless problems; this one has "
+                         f"contact_dim = {problem.contact_dim} (save "
+                         "problem.normal_problem(), or M, W and u⁻ yourself)")
     data: dict[str, Any] = {"version": VERSION}
     info = problem.chain
     if info is not None:
