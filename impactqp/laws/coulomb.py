@@ -121,6 +121,7 @@ class Coulomb(ImpactLaw):
             raise InputError(f"method must be one of {', '.join(FRICTION_BACKENDS)}, got "
                              f"{method!r}")
         self.method = method
+        self._per_contact: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
     # --- coefficients -----------------------------------------------------------------
     @property
@@ -129,8 +130,12 @@ class Coulomb(ImpactLaw):
         return self.mu, self.restitution
 
     def per_contact(self, m: int) -> tuple[np.ndarray, np.ndarray]:
-        """(μ, e) as one entry per contact for ``m`` contacts (ShapeError when a per-contact
-        array has another length)."""
+        """(μ, e) as one entry per contact for ``m`` contacts, read-only and kept per m (the
+        law is immutable); ShapeError or RestitutionError when a per-contact array has
+        another length."""
+        found = self._per_contact.get(m)
+        if found is not None:
+            return found
         mu = friction_coefficients(self.mu, m)
         e = self.restitution
         if e.ndim == 0:
@@ -138,6 +143,9 @@ class Coulomb(ImpactLaw):
         elif e.shape != (m,):
             raise RestitutionError(f"restitution must be one number or one per contact "
                                    f"({m},), got shape {e.shape}")
+        mu.setflags(write=False)
+        e.setflags(write=False)
+        self._per_contact[m] = mu, e
         return mu, e
 
     def coefficients_for(self, problem: ImpactProblem) -> tuple[np.ndarray, np.ndarray]:
