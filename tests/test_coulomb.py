@@ -269,6 +269,28 @@ def test_verify_law_on_coulomb_and_on_a_law_leaving_the_cone() -> None:
         iq.verify_law(always_sticks, p, samples=40)
 
 
+def coupled_contact(seed: int):
+    """One planar frictional contact whose G couples the normal and the tangent."""
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((3, 3))
+    return iq.ImpactProblem(A @ A.T / 3 + 0.2 * np.eye(3), rng.standard_normal((3, 2)),
+                            np.zeros(3), contact_dim=2)
+
+
+def test_no_restitution_never_gains_energy_and_restitution_may() -> None:
+    p = coupled_contact(2)
+    assert abs(p.delassus[0, 1]) > 0.1
+    calm = iq.verify_law(iq.Coulomb(1.0, 0.0), p, samples=60)
+    assert calm.violations["energetic"] == calm.violations["kinetic"] == 0
+    lively = iq.verify_law(iq.Coulomb(1.0, 1.0), p, samples=60)
+    assert lively.violations["energetic"] > 0 and lively.violations["kinetic"] == 0
+    found = lively.counterexamples["energetic"]
+    result = iq.solve(p.with_u_minus(found.u_minus), iq.Coulomb(1.0, 1.0))
+    assert result.ok  # a certified answer of the law ...
+    assert result.energy_after > result.energy_before * 1.01  # ... that gains energy
+    assert not result.admissible and result.admissible.failed() == ["energetic"]
+
+
 # --- bad input ------------------------------------------------------------------------------------
 
 def test_bad_input_named_errors() -> None:
