@@ -182,6 +182,34 @@ def test_mass_scale_invariance(c) -> None:
                                atol=1e-10 * np.abs(base.impulses).max())
 
 
+def test_contact_column_scale_invariance() -> None:
+    p = random_frictional(7, 2, 3, seed=6)
+    law = iq.Coulomb([0.3, 0.8], 0.4)
+    base = iq.solve(p, law)
+    d = np.repeat([1e-3, 50.0], 3)  # a contact's three columns scaled together
+    scaled = iq.solve(iq.ImpactProblem(p.M, p.W * d, p.u_minus, contact_dim=3), law)
+    np.testing.assert_allclose(scaled.u_plus, base.u_plus, rtol=1e-8,
+                               atol=1e-10 * np.abs(base.u_plus).max())
+    np.testing.assert_allclose(scaled.impulses * d, base.impulses, rtol=1e-7,
+                               atol=1e-9 * np.abs(base.impulses).max())
+
+
+@pytest.mark.parametrize("mu, e", [(0.05, 0.5), (0.3, 0.5), (2.0, 0.0)])
+def test_two_spheres_match_the_closed_form(mu, e) -> None:
+    """In contact coordinates G is diagonal for spheres: the normal velocity is restituted
+    and the slip is stopped or reduced by μ(1+e)|γ⁻ₙ| G_tt/G_nn, G_nn = 1/m₁ + 1/m₂,
+    G_tt = G_nn + R₁²/I₁ + R₂²/I₂."""
+    m, R = np.array([1.0, 3.0]), np.array([0.5, 0.2])
+    p = iq.two_spheres(m, R, [1.0, 0.3, 2.0, -1.0, 0.5, 0.0], normal=[1.0, 0.2])
+    g_nn = (1 / m).sum()
+    g_tt = g_nn + (R ** 2 / (0.4 * m * R ** 2)).sum()
+    gn, gt = p.gamma_minus
+    assert gn < 0
+    slip = max(0.0, abs(gt) - mu * (1 + e) * -gn * g_tt / g_nn) * np.sign(gt)
+    np.testing.assert_allclose(iq.solve(p, iq.Coulomb(mu, e)).gamma_plus, [-e * gn, slip],
+                               rtol=1e-9, atol=1e-10)
+
+
 def test_batch_equals_single_solves() -> None:
     p = iq.sphere_on_plane(2.0, 0.5, [1.0, -1.0, 0.0])
     law = iq.Coulomb(0.3, 0.5)

@@ -14,6 +14,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..base.arrays import as_array
 from ..errors import CertificateError, InputError, RestitutionError
@@ -37,13 +38,16 @@ tolerance still decides whether the answer is returned."""
 
 
 def local_problem(structure: ImpactStructure, u_minus: np.ndarray, mu: np.ndarray,
-                  restitution: np.ndarray) -> tuple[FrictionContactProblem, float]:
-    """The local problem of a frictional impact in impactqp's units (docs/theory.md §16).
+                  restitution: np.ndarray) -> tuple[FrictionContactProblem, np.ndarray]:
+    """The local problem of a frictional impact in each contact's own units
+    (docs/theory.md §8, §16).
 
-    Returns (problem, κ): the problem U = (G/κ) r + q with r = κΛ, G = WᵀM⁻¹W,
-    q = Wᵀu⁻ + e∘γ⁻_n on the normal rows, and κ the largest diagonal entry of G, so that
-    its reaction is measured in velocity units and the natural-map error does not depend
-    on the mass unit (docs/theory.md §8, §16).
+    Returns (problem, s): with G = WᵀM⁻¹W, q = Wᵀu⁻ + e∘γ⁻_n on the normal rows and
+    sᵢ = √G_nn of the contact of entry i, the problem Ũ = G̃ r + q̃ with G̃ = D G D,
+    q̃ = D q and D = diag(1/s): the contacts' columns scaled by 1/s_c, which changes no
+    cone, so its reaction r = sΛ solves the impact's problem U = GΛ + q, Ũ = DU. Velocities
+    are measured in contact units and r is a velocity, so the natural-map error does not
+    depend on the unit of mass or on the length of the columns.
 
     Parameters
     ----------
@@ -56,8 +60,14 @@ def local_problem(structure: ImpactStructure, u_minus: np.ndarray, mu: np.ndarra
     d = structure.contact_dim
     q = np.array(structure.Wt_times(u_minus), dtype=float)
     q[::d] *= 1.0 + restitution
-    kappa = float(structure.delassus_diagonal.max())
-    return FrictionContactProblem(structure.delassus / kappa, q, mu, contact_dim=d), kappa
+    s = np.repeat(np.sqrt(structure.delassus_diagonal[::d]), d)
+    G = structure.delassus
+    if sp.issparse(G):
+        D = sp.diags(1.0 / s)
+        G = sp.csc_matrix(D @ G @ D)
+    else:
+        G = G / np.outer(s, s)
+    return FrictionContactProblem(G, q / s, mu, contact_dim=d), s
 
 
 def _coefficient(name: str, value: Any) -> np.ndarray:
@@ -167,9 +177,10 @@ class Coulomb(ImpactLaw):
         """S with the law's friction cones (docs/theory.md §16)."""
         return problem.admissible_set(mu=self.per_contact(problem.n_contacts)[0])
 
-    def local_problem(self, problem: ImpactProblem) -> tuple[FrictionContactProblem, float]:
-        """The local problem of this impact and its unit κ (:func:`local_problem`): its
-        reaction r is κΛ."""
+    def local_problem(self, problem: ImpactProblem) -> tuple[FrictionContactProblem,
+                                                             np.ndarray]:
+        """The local problem of this impact in contact units and the units s
+        (:func:`local_problem`): its reaction r is sΛ."""
         self.check(problem)
         return local_problem(problem.structure, problem.u_minus,
                              *self.per_contact(problem.n_contacts))
@@ -178,12 +189,12 @@ class Coulomb(ImpactLaw):
     def closed_form(self, problem: ImpactProblem) -> Answer:
         """Solve the local problem (:func:`~impactqp.solve_friction`) and recover
         u⁺ = u⁻ + M⁻¹WΛ."""
-        local, kappa = self.local_problem(problem)
+        local, units = self.local_problem(problem)
         try:
             found = solve_friction(local, backend=self.method, tol=SOLVE_TOL)
         except CertificateError:
             found = solve_friction(local, backend=self.method, tol=LOOSE_TOL)
-        impulses = found.r / kappa
+        impulses = found.r / units
         u_plus = problem.u_minus + problem.structure.impulse_velocity(impulses)
         return Answer(u_plus, impulses, None)
 
@@ -191,9 +202,10 @@ class Coulomb(ImpactLaw):
     def residuals(self, structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
                   impulses: np.ndarray) -> dict[str, Any]:
         """The momentum residual every law shares and the friction checks of the local
-        problem recomputed from Λ (docs/theory.md §16): ``natural_map`` ‖F(κΛ)‖/‖q‖ and
-        ``cone`` (Λ in the friction cones) of the reduced problem, and ``non_penetration``
-        ‖(−U_n)₊‖/‖q‖ of the Newton-shifted normal velocity of u⁺ itself."""
+        problem recomputed from Λ (docs/theory.md §16): ``natural_map`` ‖F(sΛ)‖/‖q̃‖ and
+        ``cone`` (Λ in the friction cones) of the reduced problem in contact units, and
+        ``non_penetration`` ‖(−U_n/s)₊‖/‖q̃‖ of the Newton-shifted normal velocity of u⁺
+        itself."""
         U_minus, U_plus, impulses = normalized_rows(U_minus, U_plus, impulses)
         momentum = impact_residuals(structure, U_minus, U_plus, impulses)[1]["momentum"]
         if np.ndim(U_minus) == 1:
@@ -210,11 +222,11 @@ class Coulomb(ImpactLaw):
             return dict.fromkeys(FRICTION_RESIDUALS, 0.0)
         mu, e = self.per_contact(structure.n_contacts)
         d = structure.contact_dim
-        local, kappa = local_problem(structure, u_minus, mu, e)
+        local, units = local_problem(structure, u_minus, mu, e)
         with np.errstate(over="ignore", invalid="ignore"):
-            checks = certify_friction(local, kappa * impulses).values
-            shifted_normal = structure.Wt_times(u_plus)[::d] + \
-                e * structure.Wt_times(u_minus)[::d]
+            checks = certify_friction(local, units * impulses).values
+            shifted_normal = (structure.Wt_times(u_plus)[::d] +
+                              e * structure.Wt_times(u_minus)[::d]) / units[::d]
             q_norm = float(np.linalg.norm(local.q))
             penetration = float(np.linalg.norm(np.minimum(shifted_normal, 0.0)))
         return {"natural_map": checks["natural_map"], "cone": checks["cone"],

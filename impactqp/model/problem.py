@@ -23,7 +23,8 @@ class ImpactProblem:
         Mass matrix, symmetric positive definite (the kinetic metric).
     W : (n, d·m) array_like or scipy.sparse matrix
         Generalized force directions of the closed contacts, ``contact_dim = d`` columns per
-        contact (the normal first, then the tangents); no columns means no contact.
+        contact: the normal first, then the tangents, the velocities of the contact point
+        along an orthonormal frame (docs/theory.md §16); no columns means no contact.
     u_minus : (n,) array_like
         Pre-impact generalized velocity. Kinematically inconsistent values (a closed contact
         already separating, γ⁻ᵢ > 0) are legal.
