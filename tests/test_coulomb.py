@@ -264,11 +264,30 @@ def test_membership_exact_and_optimizer_agree() -> None:
     assert iq.solve(p, large).admissible.member  # in its own S
 
 
-def test_membership_rank_deficient_uses_the_cone_program() -> None:
-    # a 2-D box resting on two corners: 4 impulse columns for 3 degrees of freedom
+def box_on_two_corners(u_minus):
+    """A unit square (x, y, θ) landing flat on two corners: 4 impulse columns for 3 degrees
+    of freedom, W of rank 3."""
     M = np.diag([1.0, 1.0, 1.0 / 6.0])
     W = np.array([[0.0, 1.0, 0.0, 1.0], [1.0, 0.0, 1.0, 0.0], [-0.5, 0.5, 0.5, 0.5]])
-    p = iq.ImpactProblem(M, W, [1.0, -1.0, 0.0], contact_dim=2)
+    return iq.ImpactProblem(M, W, u_minus, contact_dim=2)
+
+
+@pytest.mark.parametrize("mu", [0.1, 0.5, 2.0])
+def test_rank_deficient_two_methods_agree_and_stick_or_slide(mu) -> None:
+    p = box_on_two_corners([1.0, -1.0, 0.3])
+    a = iq.solve(p, iq.Coulomb(mu, 0.3, method="clarabel"))
+    b = iq.solve(p, iq.Coulomb(mu, 0.3, method="nsgs"))
+    np.testing.assert_allclose(a.u_plus, b.u_plus, rtol=1e-8, atol=1e-9)
+    # by hand: both corners restituted fix v_y⁺ = 0.3 and ω⁺ = −0.09 whatever the friction;
+    # the corners share the slip s = vₓ + ω/2, which the horizontal impulse T changes one for
+    # one once ω⁺ is fixed: s⁺ = 1 + T − 0.045, with |T| ≤ μ(Λ_n1 + Λ_n2) = 1.3μ
+    vx, vy, w = a.u_plus
+    assert vy == pytest.approx(0.3, abs=1e-9) and w == pytest.approx(-0.09, abs=1e-9)
+    assert vx + 0.5 * w == pytest.approx(max(0.0, 0.955 - 1.3 * mu), abs=1e-9)
+
+
+def test_membership_rank_deficient_uses_the_cone_program() -> None:
+    p = box_on_two_corners([1.0, -1.0, 0.0])
     assert not p.structure.full_column_rank
     result = iq.solve(p, iq.Coulomb(0.3, 0.0))
     member = result.admissible
