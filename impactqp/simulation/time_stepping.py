@@ -13,14 +13,19 @@ uses:
    ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k``), giving v_{k+1} = u⁺;
 4. q_{k+1} = q_k + h((1 − θ)v_k + θv_{k+1}).
 
-Two loops run these steps. The compiled loop (:func:`impactqp.kernels.moreau_jean.run`)
-takes a run when :func:`compiled_applies` says so: a built-in complementarity law (Moreau,
-Newton, Frémond, by exact type), a constant or linear force, ``backend="auto"`` and a system
-small enough to be held dense. Every other run — a callable force, any other law (the sector
-and reflection laws, LZB, a user's law), a named backend, a large system — takes the Python
-loop, which solves each cluster through :func:`impactqp.solve`. A step whose compiled
-certificate fails is solved again by the Python loop's step (which raises what it raises),
-and the compiled loop resumes after it.
+Three loops run these steps, chosen by :func:`route`. A
+:class:`~impactqp.laws.coulomb.Coulomb` law on a system with ``contact_dim`` 2 or 3 takes
+the frictional loop: the Python loop with
+:class:`~impactqp.simulation.friction_step.FrictionStep` as its step (docs/theory.md §17); a
+Coulomb law on a frictionless system, another law on a frictional system, or
+``compiled=True`` with Coulomb are refused by name. The compiled loop
+(:func:`impactqp.kernels.moreau_jean.run`) takes a run when :func:`compiled_applies` says
+so: a built-in complementarity law (Moreau, Newton, Frémond, by exact type), a constant or
+linear force, ``backend="auto"`` and a system small enough to be held dense. Every other
+run — a callable force, any other law (the sector and reflection laws, LZB, a user's law),
+a named backend, a large system — takes the Python loop, which solves each cluster through
+:func:`impactqp.solve`. A step whose compiled certificate fails is solved again by the
+Python loop's step (which raises what it raises), and the compiled loop resumes after it.
 """
 
 from __future__ import annotations
@@ -38,12 +43,14 @@ from ..kernels.residuals import RESIDUALS
 from ..laws.base import ImpactLaw
 from ..laws.certificate import Certificate
 from ..laws.complementarity import Fremond, Newton
+from ..laws.coulomb import Coulomb
 from ..laws.moreau import Moreau
 from ..laws.result import ImpactResult
 from ..model.problem import ImpactProblem
 from ..model.residuals import restitution_matrix
 from ..model.structure import ImpactStructure
 from .clusters import ClusterCache
+from .friction_step import FrictionEvent, FrictionStep, check_friction_backend
 from .impacts import ImpactEvent, ImpactSolver
 from .step_law import MoreauJeanStep
 from .system import LinearSystem
@@ -110,6 +117,38 @@ def compiled_applies(system: LinearSystem, law: ImpactLaw, backend: str) -> bool
             and 0 < system.n_contacts <= MAX_COMPILED and system.n_dof <= MAX_COMPILED)
 
 
+def route(system: LinearSystem, law: ImpactLaw, backend: str, compiled: bool | None) -> str:
+    """Which loop runs (the module docstring's rule): ``"friction"``, ``"compiled"`` or
+    ``"python"``.
+
+    Raises
+    ------
+    InputError
+        Coulomb's law on a frictionless system (``contact_dim`` 1) or with ``compiled=True``
+        or a backend solve_friction does not take; another law on a frictional system;
+        ``compiled=True`` for a run outside :func:`compiled_applies`.
+    """
+    frictional = isinstance(law, Coulomb)
+    if frictional != (system.contact_dim > 1):
+        if frictional:
+            raise InputError("Coulomb friction needs a system with contact_dim=2 or 3 (H "
+                             "holding the normal and then the tangents of each contact)")
+        raise InputError(f"a system with contact_dim = {system.contact_dim} has friction "
+                         f"columns: simulate it with iq.Coulomb(mu, restitution), or build "
+                         f"it with contact_dim=1 from the normal columns for {law!r}")
+    if frictional:
+        if compiled:
+            raise InputError("compiled=True: the compiled loop has no Coulomb friction; "
+                             "leave compiled unset")
+        check_friction_backend(backend)
+        return "friction"
+    use = compiled_applies(system, law, backend) if compiled is None else compiled
+    if use and not compiled_applies(system, law, backend):
+        raise InputError("compiled=True: the compiled loop does not take this run (a law, "
+                         "force, backend or size outside compiled_applies)")
+    return "compiled" if use else "python"
+
+
 def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
                 theta: float = 0.5, *, t0: float = 0.0, backend: str = "auto",
                 tol: float = DEFAULT_TOL, record_every: int = 1, keep_events: bool = True,
@@ -122,13 +161,16 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     system : LinearSystem
     law : ImpactLaw
         Any impact law; Moreau, Newton and Frémond act in the step form
-        ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k ≥ 0``, other laws map u⁻ = v_free to u⁺ = v_{k+1}.
+        ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k ≥ 0``, other laws map u⁻ = v_free to u⁺ = v_{k+1};
+        Coulomb (on a system with ``contact_dim`` 2 or 3) solves the local frictional
+        problem of docs/theory.md §17 on the closed contacts.
     t_end, h, theta : float
         Final time, step and θ ∈ [0, 1] (validated by :func:`~.simulate.simulate`).
     t0 : float
         Initial time.
     backend, tol : str, float
-        Passed to :func:`impactqp.solve` for every impact problem.
+        Passed to :func:`impactqp.solve` for every impact problem (to
+        :func:`impactqp.solve_friction` with Coulomb's law).
     record_every : int
         Keep every k-th step in the trajectory (the last step always).
     keep_events : bool
@@ -142,24 +184,34 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     Returns
     -------
     Trajectory
-        ``settings["loop"]`` says which loop ran (``"compiled"`` or ``"python"``).
+        ``settings["loop"]`` says which loop ran (``"compiled"``, ``"python"`` or
+        ``"friction"``); ``impulses`` has one column per column of H.
+
+    Raises
+    ------
+    InputError
+        A law and system :func:`route` refuses.
+    CertificateError
+        A step no method certifies (with its time).
     """
+    loop = route(system, law, backend, compiled)
     free = _FreeVelocity(system, h, theta)
-    cache = ClusterCache(free.metric, system.H, system.chain)
-    solver = ImpactSolver(cache, law, backend=backend, tol=tol)
     steps = step_count(t0, t_end, h)
     kept = np.unique(np.append(np.arange(0, steps + 1, record_every), steps))
-    n, m = system.n_dof, system.n_contacts
+    n, m = system.n_dof, system.H.shape[1]
     T, Q, V = t0 + kept * h, np.empty((kept.size, n)), np.empty((kept.size, n))
     L = np.zeros((kept.size, m))
     Q[0], V[0] = system.q0, system.v0
     report = max(1, steps // 200)
-    use = compiled_applies(system, law, backend) if compiled is None else compiled
-    if use and not compiled_applies(system, law, backend):
-        raise InputError("compiled=True: the compiled loop does not take this run (a law, "
-                         "force, backend or size outside compiled_applies)")
-    step = _Step(system, free, solver, h, theta, t0)
-    if use:
+    step: _Step | FrictionStep
+    if loop == "friction":
+        step = FrictionStep(system, free, law, h, theta, t0, backend=backend, tol=tol)
+    else:
+        cache = ClusterCache(free.metric, system.H, system.chain)
+        step = _Step(system, free, ImpactSolver(cache, law, backend=backend, tol=tol),
+                     h, theta, t0)
+    events: list[ImpactEvent | FrictionEvent] | Callable[[], list[ImpactEvent]]
+    if loop == "compiled":
         events = _CompiledLoop(system, law, free, step, tol, keep_events).run(
             steps, kept, Q, V, L, report, progress)
     else:
@@ -180,7 +232,7 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     settings = {"h": h, "theta": theta, "t0": t0, "t_end": t_end, "steps": steps,
                 "backend": backend, "tol": tol, "record_every": record_every,
                 "keep_events": keep_events,
-                "activation": "g + h/2 γ <= 0", "loop": "compiled" if use else "python"}
+                "activation": "g + h/2 γ <= 0", "loop": loop}
     return Trajectory(system, law, "moreau-jean", T, Q, V, L, events, settings)
 
 
