@@ -26,6 +26,11 @@ from ..laws.friction import FRICTION_BACKENDS, FrictionResult, solve_friction
 from ..model.friction import FrictionCertificate, FrictionContactProblem
 from .system import LinearSystem
 
+NEEDS_TANGENTS = ("Coulomb friction needs tangent columns: build the LinearSystem with "
+                  "contact_dim=2 (plane) or 3 (space), H holding the normal and then the "
+                  "tangents of each contact")
+"""The refusal of Coulomb's law on a frictionless system."""
+
 MAX_CACHED = 4096
 """Closed sets whose W and Ŵ⁻¹H_A are kept per run; the cache starts afresh when full."""
 
@@ -41,9 +46,7 @@ def coulomb_coefficients(law: Coulomb, system: LinearSystem) -> tuple[np.ndarray
         μ or e given per contact for another number of contacts.
     """
     if system.contact_dim == 1:
-        raise InputError("Coulomb friction needs tangent columns: build the LinearSystem "
-                         "with contact_dim=2 (plane) or 3 (space), H holding the normal and "
-                         "then the tangents of each contact")
+        raise InputError(NEEDS_TANGENTS)
     m = system.n_contacts
     out = []
     for name, value in (("mu", law.mu), ("restitution", law.restitution)):

@@ -50,7 +50,7 @@ from ..model.problem import ImpactProblem
 from ..model.residuals import restitution_matrix
 from ..model.structure import ImpactStructure
 from .clusters import ClusterCache
-from .friction_step import FrictionEvent, FrictionStep, check_friction_backend
+from .friction_step import NEEDS_TANGENTS, FrictionEvent, FrictionStep, check_friction_backend
 from .impacts import ImpactEvent, ImpactSolver
 from .step_law import MoreauJeanStep
 from .system import LinearSystem
@@ -131,8 +131,7 @@ def route(system: LinearSystem, law: ImpactLaw, backend: str, compiled: bool | N
     frictional = isinstance(law, Coulomb)
     if frictional != (system.contact_dim > 1):
         if frictional:
-            raise InputError("Coulomb friction needs a system with contact_dim=2 or 3 (H "
-                             "holding the normal and then the tangents of each contact)")
+            raise InputError(NEEDS_TANGENTS)
         raise InputError(f"a system with contact_dim = {system.contact_dim} has friction "
                          f"columns: simulate it with iq.Coulomb(mu, restitution), or build "
                          f"it with contact_dim=1 from the normal columns for {law!r}")
