@@ -282,3 +282,14 @@ def test_an_uncertified_step_stops_the_run_with_its_time(monkeypatch):
     monkeypatch.setattr(friction_step, "solve_friction", fail)
     with pytest.raises(CertificateError, match=r"step ending at t = 0\.01 .*no method"):
         simulate(block_on_incline(0.3, gap=OVERLAP), Coulomb(0.3), 1.0, h=0.01)
+
+
+def test_a_frictional_trajectory_saves_its_impulse_components(tmp_path):
+    tr = simulate(box_on_floor(2, velocity=1.0, gap=OVERLAP), Coulomb(0.3), 0.05, h=0.01)
+    header = tr.save(tmp_path / "box.csv").read_text(encoding="utf-8").splitlines()[0]
+    assert "lambda0_n,lambda0_t1,lambda1_n,lambda1_t1,kinetic_energy" in header
+    events = (tmp_path / "box.events.csv").read_text(encoding="utf-8").splitlines()
+    assert len(events) == 1 + len(tr.events) and ",coulomb,True," in events[1]
+    with np.load(tr.save(tmp_path / "box.npz")) as data:
+        assert np.array_equal(data["impulses"], tr.impulses)
+        assert data["event_certified"].all() and data["event_admissible"].all()

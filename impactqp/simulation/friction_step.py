@@ -12,8 +12,9 @@ at velocity level reads it (Siconos' NewtonImpactFrictionNSL).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, partial
 
 import numpy as np
 import scipy.sparse as sp
@@ -86,14 +87,10 @@ class StepMembership(NamedChecks):
 class FrictionEvent:
     """One frictional Moreau–Jean step with closed contacts, with its certificate.
 
-    Attributes
+    Parameters
     ----------
     time : float
         The end of the step.
-    kind : str
-        ``"step"``.
-    dofs : ndarray
-        Every degree of freedom of the system (the step is one local problem).
     contacts : ndarray
         The closed contacts, ascending; their d components each are the rows of the local
         problem, in that order.
@@ -103,6 +100,16 @@ class FrictionEvent:
         The certified answer of :func:`impactqp.solve_friction`.
     u_minus, u_plus : ndarray
         v_free and v_{k+1}.
+    verdict : callable
+        Computes the :class:`StepMembership` of the step (called on first read of
+        :attr:`admissible`).
+
+    Attributes
+    ----------
+    kind : str
+        ``"step"``.
+    dofs : ndarray
+        Every degree of freedom of the system (the step is one local problem).
     settled : ndarray
         Empty (event-driven settling does not apply).
     """
@@ -112,12 +119,12 @@ class FrictionEvent:
 
     def __init__(self, time: float, contacts: np.ndarray, problem: FrictionContactProblem,
                  result: FrictionResult, u_minus: np.ndarray, u_plus: np.ndarray,
-                 step: FrictionStep) -> None:
+                 verdict: Callable[[], StepMembership]) -> None:
         self.time, self.contacts, self.problem, self.result = time, contacts, problem, result
         self.u_minus, self.u_plus = u_minus, u_plus
         self.dofs = np.arange(u_minus.size)
         self.settled = np.zeros(0, dtype=int)
-        self._step = step
+        self._verdict = verdict
 
     impulses = property(lambda self: self.result.r, doc="r on the closed contacts' components.")
 
@@ -134,7 +141,7 @@ class FrictionEvent:
     @cached_property
     def admissible(self) -> StepMembership:
         """u⁺ ∈ S of the step, with r as witness (:class:`StepMembership`)."""
-        return self._step.membership(self.contacts, self.u_minus, self.u_plus, self.result.r)
+        return self._verdict()
 
     def __repr__(self) -> str:
         return (f"FrictionEvent(t={self.time:.12g}, contacts={self.contacts.tolist()[:6]}, "
@@ -211,7 +218,9 @@ class FrictionStep:
                 v_next = v_free + MinvH @ result.r
                 lam = np.zeros(self.impulse_size)
                 lam[cols] = result.r
-                events = [FrictionEvent(time, contacts, problem, result, v_free, v_next, self)]
+                verdict = partial(self.membership, contacts, v_free, v_next, result.r)
+                events = [FrictionEvent(time, contacts, problem, result, v_free, v_next,
+                                        verdict)]
         return q + h * ((1.0 - theta) * v + theta * v_next), v_next, lam, events
 
     def membership(self, contacts: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
