@@ -24,7 +24,7 @@ from impactqp.simulation.system import LinearSystem
 from impactqp.simulation.time_stepping import moreau_jean
 
 G = 9.81
-OVERLAP = -1e-9  # a resting contact starts closed for the activation rule (docs §17)
+OVERLAP = -1e-9  # a resting contact starts closed for the activation rule (docs/theory.md §17)
 
 
 def up_slope(angle: float, dim: int) -> np.ndarray:
@@ -45,7 +45,7 @@ def test_block_on_an_incline_sticks_or_slides_as_the_closed_form(dim, angle, mu,
     a = G * max(0.0, np.sin(angle) - mu * np.cos(angle))  # down the slope
     up = up_slope(angle, dim)
     s, x = tr.v @ up, tr.q @ up
-    # the scheme's own motion (docs §17): s_k = −a t_k, x_k = −a t_k²/2 − a h t_k (θ − ½)
+    # the scheme's own motion (docs/theory.md §17): s_k = −a t_k, x_k = −a t_k²/2 − a h t_k (θ − ½)
     assert np.allclose(s, -a * tr.t, rtol=0, atol=1e-12)
     assert np.allclose(x, -0.5 * a * tr.t**2 - a * h * tr.t * (theta - 0.5), rtol=0,
                        atol=1e-12)
@@ -202,8 +202,8 @@ def test_without_friction_the_step_is_newtons(system, e, t_end):
 @pytest.mark.parametrize("seed", range(4))
 def test_energy_never_grows_beyond_the_schemes_own_bound(seed):
     """A bouncing, sliding, spinning sphere: friction never adds energy; the normal step adds
-    at most (1 − e)/(1 + e) m(hg)²/8, on a step that closes a separating contact (docs §17),
-    and nothing at all for e = 1."""
+    at most (1 − e)/(1 + e) m(hg)²/8, on a step that closes a separating contact, and nothing
+    at all for e = 1 (docs/theory.md §17)."""
     rng = np.random.default_rng(seed)
     mu, e = rng.uniform(0.0, 0.8), [0.0, 0.4, 0.9, 1.0][seed]
     m, h = rng.uniform(0.5, 2.0), 1e-3

@@ -154,7 +154,7 @@ def block_on_incline(angle: float, mass: float = 1.0, gravity: float = 9.81, dim
     tangents: in the plane the up-slope direction t = (cos α, sin α); in space the up-slope
     direction (cos α, 0, sin α) and the horizontal (0, 1, 0), both turned about n by
     ``twist`` (Coulomb's cone is isotropic, so the motion does not depend on it). The gap is
-    nᵀq. Docs/theory.md §17 derives the Moreau–Jean motion in closed form.
+    nᵀq. docs/theory.md §17 derives the Moreau–Jean motion in closed form.
 
     Parameters
     ----------
@@ -213,7 +213,7 @@ def rolling_sphere(mass: float = 1.0, radius: float = 0.1, gravity: float = 9.81
     q = (x, y, φ): the centre and the rotation angle (counter-clockwise), with
     M = diag(m, m, I), I = 2/5 mR². The contact has the normal (0, 1, 0) (gap y − R) and the
     tangent (1, 0, R): the slip velocity of the lowest point is ẋ + Rφ̇, zero when the
-    sphere rolls. Docs/theory.md §17 derives sliding to rolling and the oblique bounce.
+    sphere rolls. docs/theory.md §17 derives sliding to rolling and the oblique bounce.
 
     Parameters
     ----------

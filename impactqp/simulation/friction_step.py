@@ -206,7 +206,7 @@ class FrictionStep:
             cols, H, MinvH, W = self.local(contacts)
             q_loc = H.T @ v_free
             q_loc[::d] += self.e[contacts] * gamma[contacts]
-            if np.any(q_loc[::d] < 0.0):  # else r = 0 solves the step exactly (§17)
+            if np.any(q_loc[::d] < 0.0):  # else r = 0 is exact (docs/theory.md §17)
                 time = self.t0 + (k + 1) * h
                 problem = FrictionContactProblem(W, q_loc, self.mu[contacts], contact_dim=d)
                 try:

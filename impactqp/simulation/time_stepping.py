@@ -37,35 +37,25 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.checks import DEFAULT_TOL
-from ..errors import InputError
 from ..kernels.moreau_jean import CHECKED, DONE, FAILED, run
 from ..kernels.residuals import RESIDUALS
 from ..laws.base import ImpactLaw
 from ..laws.certificate import Certificate
-from ..laws.complementarity import Fremond, Newton
-from ..laws.coulomb import Coulomb
-from ..laws.moreau import Moreau
 from ..laws.result import ImpactResult
 from ..model.problem import ImpactProblem
 from ..model.residuals import restitution_matrix
 from ..model.structure import ImpactStructure
 from .clusters import ClusterCache
-from .friction_step import NEEDS_TANGENTS, FrictionEvent, FrictionStep, check_friction_backend
+from .friction_step import FrictionEvent, FrictionStep
 from .impacts import ImpactEvent, ImpactSolver
+from .routing import compiled_applies as compiled_applies  # re-exported: imported from here
+from .routing import route
 from .step_law import MoreauJeanStep
 from .system import LinearSystem
 from .trajectory import Trajectory
 
 LOOP_BACKEND = "compiled Moreau–Jean loop"
 """What answered an impact solved inside the compiled loop (its events' ``result.backend``)."""
-
-COMPILED_LAWS = (Moreau, Newton, Fremond)
-"""The laws the compiled loop takes, by exact type (a subclass may change the law)."""
-
-MAX_COMPILED = 400
-"""Most degrees of freedom and most contacts the compiled loop takes (it holds Ŵ⁻¹, Ŵ⁻¹H
-and HᵀŴ⁻¹H dense)."""
-
 
 def step_count(t0: float, t_end: float, h: float) -> int:
     """Number of steps of length h that reach t_end (at least one)."""
@@ -105,47 +95,6 @@ class _FreeVelocity:
 
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         return v - self.solver.solve_mass(self.residual(t, q, v))
-
-
-def compiled_applies(system: LinearSystem, law: ImpactLaw, backend: str) -> bool:
-    """Whether a run takes the compiled loop (the module docstring's rule): Moreau's,
-    Newton's or Frémond's law (exact types), a constant or linear force, ``backend="auto"``,
-    a dense system (M and H not scipy.sparse) with at least one contact and at most
-    :data:`MAX_COMPILED` degrees of freedom and contacts."""
-    return (backend == "auto" and type(law) in COMPILED_LAWS and not system.structure.sparse
-            and (system.constant_force is not None or system.linear_force is not None)
-            and 0 < system.n_contacts <= MAX_COMPILED and system.n_dof <= MAX_COMPILED)
-
-
-def route(system: LinearSystem, law: ImpactLaw, backend: str, compiled: bool | None) -> str:
-    """Which loop runs (the module docstring's rule): ``"friction"``, ``"compiled"`` or
-    ``"python"``.
-
-    Raises
-    ------
-    InputError
-        Coulomb's law on a frictionless system (``contact_dim`` 1) or with ``compiled=True``
-        or a backend solve_friction does not take; another law on a frictional system;
-        ``compiled=True`` for a run outside :func:`compiled_applies`.
-    """
-    frictional = isinstance(law, Coulomb)
-    if frictional != (system.contact_dim > 1):
-        if frictional:
-            raise InputError(NEEDS_TANGENTS)
-        raise InputError(f"a system with contact_dim = {system.contact_dim} has friction "
-                         f"columns: simulate it with iq.Coulomb(mu, restitution), or build "
-                         f"it with contact_dim=1 from the normal columns for {law!r}")
-    if frictional:
-        if compiled:
-            raise InputError("compiled=True: the compiled loop has no Coulomb friction; "
-                             "leave compiled unset")
-        check_friction_backend(backend)
-        return "friction"
-    use = compiled_applies(system, law, backend) if compiled is None else compiled
-    if use and not compiled_applies(system, law, backend):
-        raise InputError("compiled=True: the compiled loop does not take this run (a law, "
-                         "force, backend or size outside compiled_applies)")
-    return "compiled" if use else "python"
 
 
 def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
