@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 import impactqp.simulation.friction_step as friction_step
 from impactqp.errors import CertificateError, InputError, ShapeError
@@ -20,7 +21,7 @@ from impactqp.simulation.builders import (
 )
 from impactqp.simulation.friction_step import FrictionEvent
 from impactqp.simulation.simulate import simulate
-from impactqp.simulation.system import LinearSystem
+from impactqp.simulation.system import LinearForce, LinearSystem
 from impactqp.simulation.time_stepping import moreau_jean
 
 G = 9.81
@@ -165,6 +166,43 @@ def test_a_box_on_its_corners_slides_to_a_stop_at_mu_g(dim, velocity):
     assert np.allclose(direction, np.asarray(velocity) / v0, atol=1e-8)
     assert np.abs(tr.v[:, dim - 1:]).max() < 1e-7  # flat: no vertical motion or rotation
     assert all(len(ev.contacts) == 2 ** (dim - 1) for ev in tr.events)
+
+
+# --- a spring: stick-slip through the iteration matrix M + h²θ²K -----------------------------
+def _spring_block(sparse: bool) -> LinearSystem:
+    m, k = 2.0, 50.0
+    M, K = np.diag([m, m]), np.diag([k, 0.0])
+    H = np.array([[0.0, 1.0], [1.0, 0.0]])  # floor normal (y), then the tangent (x)
+    if sparse:
+        M, K, H = sp.csc_matrix(M), sp.csr_matrix(K), sp.csc_matrix(H)
+    return LinearSystem(M, [0.5, 0.0], [0.0, 0.0], LinearForce(K, [0.0, -m * G]), H,
+                        [OVERLAP], contact_dim=2)
+
+
+def _coulomb_oscillator(t: float, x0: float, omega: float, xe: float) -> float:
+    """A mass on a spring with dry friction, released at rest: half cycles about ±xe, each
+    shorter by 2xe in amplitude, until it stops within |x| ≤ xe."""
+    a = x0
+    while abs(a) > xe:
+        centre = np.sign(a) * xe
+        if t <= np.pi / omega:
+            return centre + (a - centre) * np.cos(omega * t)
+        a, t = 2.0 * centre - a, t - np.pi / omega
+    return a
+
+
+@pytest.mark.parametrize("h", [1e-2, 1e-3])
+def test_a_block_on_a_spring_slows_by_four_mu_g_over_omega_squared_a_cycle(h):
+    m, k, mu, x0 = 2.0, 50.0, 0.3, 0.5
+    omega, xe = np.sqrt(k / m), mu * m * G / k
+    tr = simulate(_spring_block(False), Coulomb(mu), 3.0, h=h)
+    exact = np.array([_coulomb_oscillator(t, x0, omega, xe) for t in tr.t])
+    assert np.abs(tr.q[:, 0] - exact).max() < 0.5 * h
+    halves = np.ceil((x0 - xe) / (2 * xe))  # half cycles until |x| ≤ xe (two here)
+    final = (-1) ** halves * (x0 - 2 * xe * halves)
+    assert abs(tr.q[-1, 0] - final) < 10 * h**2 and abs(tr.v[-1, 0]) < 1e-12
+    sparse = simulate(_spring_block(True), Coulomb(mu), 3.0, h=h)
+    assert np.abs(sparse.q - tr.q).max() < 1e-12 and sparse.certified
 
 
 # --- μ = 0 is the frictionless loop ---------------------------------------------------------
