@@ -9,8 +9,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+import impactqp.simulation.friction_loop as friction_loop
 import impactqp.simulation.friction_step as friction_step
 from impactqp.errors import CertificateError, InputError, ShapeError
+from impactqp.kernels.moreau_jean import DONE, FAILED
 from impactqp.laws.complementarity import Newton
 from impactqp.laws.coulomb import Coulomb
 from impactqp.simulation.builders import (
@@ -28,6 +30,24 @@ G = 9.81
 OVERLAP = -1e-9  # a resting contact starts closed for the activation rule (docs/theory.md §17)
 
 
+@pytest.fixture(params=["friction-compiled", "friction"])
+def loop(request) -> str:
+    """The compiled frictional loop (the default route) and the Python one."""
+    return request.param
+
+
+def run(system, law, t_end, loop, **kwargs):
+    """``simulate`` through the default route, which must be the compiled frictional loop,
+    or through the Python frictional loop."""
+    if loop == "friction":
+        h, theta = kwargs.pop("h"), kwargs.pop("theta", 0.5)
+        tr = moreau_jean(system, law, t_end, h, theta, compiled=False, **kwargs)
+    else:
+        tr = simulate(system, law, t_end, **kwargs)
+    assert tr.settings["loop"] == loop
+    return tr
+
+
 def up_slope(angle: float, dim: int) -> np.ndarray:
     return np.array([np.cos(angle), np.sin(angle)]) if dim == 2 else \
         np.array([np.cos(angle), 0.0, np.sin(angle)])
@@ -38,11 +58,11 @@ def up_slope(angle: float, dim: int) -> np.ndarray:
 @pytest.mark.parametrize("angle, mu", [(0.4, 0.2), (0.4, 0.5), (0.3, np.tan(0.3)),
                                        (1.2, 0.05), (0.2, 0.0)])
 @pytest.mark.parametrize("theta", [0.5, 1.0])
-def test_block_on_an_incline_sticks_or_slides_as_the_closed_form(dim, angle, mu, theta):
+def test_block_on_an_incline_sticks_or_slides_as_the_closed_form(dim, angle, mu, theta, loop):
     h, t_end = 0.01, 1.0
     system = block_on_incline(angle, dim=dim, gap=OVERLAP, twist=0.7)
-    tr = simulate(system, Coulomb(mu), t_end, h=h, theta=theta)
-    assert tr.settings["loop"] == "friction" and tr.certified
+    tr = run(system, Coulomb(mu), t_end, loop, h=h, theta=theta)
+    assert tr.certified
     a = G * max(0.0, np.sin(angle) - mu * np.cos(angle))  # down the slope
     up = up_slope(angle, dim)
     s, x = tr.v @ up, tr.q @ up
@@ -61,10 +81,10 @@ def test_block_on_an_incline_sticks_or_slides_as_the_closed_form(dim, angle, mu,
 
 
 @pytest.mark.parametrize("dim", [2, 3])
-def test_a_block_sliding_down_a_gentle_slope_stops_and_sticks(dim):
+def test_a_block_sliding_down_a_gentle_slope_stops_and_sticks(dim, loop):
     angle, mu, s0, h = 0.2, 0.6, -2.0, 0.01
-    tr = simulate(block_on_incline(angle, dim=dim, speed=s0, gap=OVERLAP), Coulomb(mu), 1.5,
-                  h=h)
+    tr = run(block_on_incline(angle, dim=dim, speed=s0, gap=OVERLAP), Coulomb(mu), 1.5, loop,
+             h=h)
     b = G * (mu * np.cos(angle) - np.sin(angle))  # deceleration while sliding down
     s = tr.v @ up_slope(angle, dim)
     exact = np.minimum(s0 + b * tr.t, 0.0)
@@ -78,10 +98,11 @@ def test_a_block_sliding_down_a_gentle_slope_stops_and_sticks(dim):
 # --- (c) a sphere sliding into rolling -----------------------------------------------------
 @pytest.mark.parametrize("mu, v0, omega0", [(0.3, 2.0, 0.0), (0.1, 1.0, 0.0),
                                             (0.3, 2.0, 40.0), (0.3, 2.0, 100.0)])
-def test_a_sliding_sphere_rolls_at_five_sevenths_after_two_v0_over_seven_mu_g(mu, v0, omega0):
+def test_a_sliding_sphere_rolls_at_five_sevenths_after_two_v0_over_seven_mu_g(mu, v0, omega0,
+                                                                             loop):
     R, h, t_end = 0.1, 1e-3, 1.5
-    tr = simulate(rolling_sphere(radius=R, velocity=v0, spin=omega0, gap=OVERLAP),
-                  Coulomb(mu), t_end, h=h)
+    tr = run(rolling_sphere(radius=R, velocity=v0, spin=omega0, gap=OVERLAP), Coulomb(mu),
+             t_end, loop, h=h)
     slip = tr.v[:, 0] + R * tr.v[:, 2]
     w0 = v0 + R * omega0
     t_star = abs(w0) / (3.5 * mu * G)  # 2v0/(7μg) without spin
@@ -116,10 +137,10 @@ def _first_impact(tr):
     (0.3, 1.0, -2.0, 120.0, "slip"), (0.5, 0.0, 0.5, -10.0, "stick"),
 ])
 def test_an_oblique_bounce_of_a_sphere_sticks_or_slips_as_the_closed_form(mu, e, vx, omega,
-                                                                         regime):
+                                                                         regime, loop):
     R, m, h = 0.1, 2.0, 1e-3
-    tr = simulate(rolling_sphere(mass=m, radius=R, velocity=vx, spin=omega, height=0.5),
-                  Coulomb(mu, e), 0.5, h=h)
+    tr = run(rolling_sphere(mass=m, radius=R, velocity=vx, spin=omega, height=0.5),
+             Coulomb(mu, e), 0.5, loop, h=h)
     k = _first_impact(tr)
     (x, y, w), after = tr.v[k], tr.v[k + 1]
     assert y < 0
@@ -139,9 +160,9 @@ def test_an_oblique_bounce_of_a_sphere_sticks_or_slips_as_the_closed_form(mu, e,
 
 
 @pytest.mark.parametrize("mu, e, vx", [(0.2, 0.8, 1.0), (0.2, 0.8, 10.0), (0.0, 1.0, 3.0)])
-def test_an_oblique_bounce_of_a_point_mass_loses_mu_1_plus_e_vy(mu, e, vx):
+def test_an_oblique_bounce_of_a_point_mass_loses_mu_1_plus_e_vy(mu, e, vx, loop):
     h = 1e-3
-    tr = simulate(block_on_incline(0.0, speed=vx, gap=0.3), Coulomb(mu, e), 0.5, h=h)
+    tr = run(block_on_incline(0.0, speed=vx, gap=0.3), Coulomb(mu, e), 0.5, loop, h=h)
     k = _first_impact(tr)
     (x, y), after = tr.v[k], tr.v[k + 1]
     drop = mu * ((1.0 + e) * -y + h * G)
@@ -150,9 +171,9 @@ def test_an_oblique_bounce_of_a_point_mass_loses_mu_1_plus_e_vy(mu, e, vx):
 
 # --- several contacts: a box sliding flat -------------------------------------------------
 @pytest.mark.parametrize("dim, velocity", [(2, 3.0), (3, (2.0, 1.5))])
-def test_a_box_on_its_corners_slides_to_a_stop_at_mu_g(dim, velocity):
+def test_a_box_on_its_corners_slides_to_a_stop_at_mu_g(dim, velocity, loop):
     mu, h = 0.4, 0.01
-    tr = simulate(box_on_floor(dim, velocity=velocity, gap=OVERLAP), Coulomb(mu), 1.0, h=h)
+    tr = run(box_on_floor(dim, velocity=velocity, gap=OVERLAP), Coulomb(mu), 1.0, loop, h=h)
     v0 = np.linalg.norm(velocity)
     horizontal = tr.v[:, :dim - 1]
     speed = np.linalg.norm(horizontal, axis=1)
@@ -192,17 +213,17 @@ def _coulomb_oscillator(t: float, x0: float, omega: float, xe: float) -> float:
 
 
 @pytest.mark.parametrize("h", [1e-2, 1e-3])
-def test_a_block_on_a_spring_slows_by_four_mu_g_over_omega_squared_a_cycle(h):
+def test_a_block_on_a_spring_slows_by_four_mu_g_over_omega_squared_a_cycle(h, loop):
     m, k, mu, x0 = 2.0, 50.0, 0.3, 0.5
     omega, xe = np.sqrt(k / m), mu * m * G / k
-    tr = simulate(_spring_block(False), Coulomb(mu), 3.0, h=h)
+    tr = run(_spring_block(False), Coulomb(mu), 3.0, loop, h=h)
     exact = np.array([_coulomb_oscillator(t, x0, omega, xe) for t in tr.t])
     assert np.abs(tr.q[:, 0] - exact).max() < 0.5 * h
     halves = np.ceil((x0 - xe) / (2 * xe))  # half cycles until |x| ≤ xe (two here)
     final = (-1) ** halves * (x0 - 2 * xe * halves)
     assert abs(tr.q[-1, 0] - final) < 10 * h**2 and abs(tr.v[-1, 0]) < 1e-12
-    sparse = simulate(_spring_block(True), Coulomb(mu), 3.0, h=h)
-    assert np.abs(sparse.q - tr.q).max() < 1e-12 and sparse.certified
+    sparse = run(_spring_block(True), Coulomb(mu), 3.0, "friction", h=h)  # no compiled loop
+    assert np.abs(sparse.q - tr.q).max() < 1e-10 and sparse.certified
 
 
 # --- μ = 0 is the frictionless loop ---------------------------------------------------------
@@ -218,11 +239,11 @@ def _normal_columns(system: LinearSystem) -> LinearSystem:
     (box_on_floor(3, velocity=(1.0, 0.5), gap=0.05), 0.5, 0.5),
     (box_on_floor(2, velocity=1.0, gap=0.05), 0.0, 0.5),
 ])
-def test_without_friction_the_step_is_newtons(system, e, t_end):
+def test_without_friction_the_step_is_newtons(system, e, t_end, loop):
     """To round-off with the certificate's tolerance at round-off (the boxes' W is singular:
     at tol, their velocities agree to about tol·‖q‖)."""
     h = 1e-3
-    rough = simulate(system, Coulomb(0.0, e), t_end, h=h, tol=1e-14)
+    rough = run(system, Coulomb(0.0, e), t_end, loop, h=h, tol=1e-14)
     smooth = simulate(_normal_columns(system), Newton(e), t_end, h=h, tol=1e-14)
     assert len(rough.events) == len(smooth.events) > 0
     scale = np.abs(smooth.v).max()
@@ -238,7 +259,7 @@ def test_without_friction_the_step_is_newtons(system, e, t_end):
 
 # --- energy -------------------------------------------------------------------------------
 @pytest.mark.parametrize("seed", range(4))
-def test_energy_never_grows_beyond_the_schemes_own_bound(seed):
+def test_energy_never_grows_beyond_the_schemes_own_bound(seed, loop):
     """A bouncing, sliding, spinning sphere: friction never adds energy; the normal step adds
     at most (1 − e)/(1 + e) m(hg)²/8, on a step that closes a separating contact, and nothing
     at all for e = 1 (docs/theory.md §17)."""
@@ -247,15 +268,15 @@ def test_energy_never_grows_beyond_the_schemes_own_bound(seed):
     m, h = rng.uniform(0.5, 2.0), 1e-3
     system = rolling_sphere(mass=m, velocity=rng.uniform(-3, 3), spin=rng.uniform(-50, 50),
                             height=rng.uniform(0.15, 0.5), vertical_velocity=rng.uniform(-2, 2))
-    tr = simulate(system, Coulomb(mu, e), 1.0, h=h)
+    tr = run(system, Coulomb(mu, e), 1.0, loop, h=h)
     E = tr.total_energy
     bound = (1 - e) / (1 + e) * m * (h * G) ** 2 / 8
     assert np.diff(E).max() <= bound + 1e-12 * abs(E).max()
     assert E[-1] <= E[0] + 1e-12 * abs(E).max()
 
 
-def test_events_are_certified_and_their_steps_admissible_with_e_0():
-    tr = simulate(box_on_floor(3, velocity=(1.0, -0.5), gap=0.01), Coulomb(0.3), 0.4, h=1e-3)
+def test_events_are_certified_and_their_steps_admissible_with_e_0(loop):
+    tr = run(box_on_floor(3, velocity=(1.0, -0.5), gap=0.01), Coulomb(0.3), 0.4, loop, h=1e-3)
     assert tr.events and all(isinstance(ev, FrictionEvent) for ev in tr.events)
     assert all(ev.certificate.ok and ev.certificate.error <= 1e-9 for ev in tr.events)
     assert tr.admissible().all()  # e = 0: u⁺ in S of each step, r the witness
@@ -295,8 +316,10 @@ def test_laws_and_systems_that_do_not_fit_are_refused_by_name():
         simulate(rough, Coulomb(0.3), 1.0, scheme="event-driven")
     with pytest.raises(InputError, match="event-driven.*no Coulomb"):
         simulate(rough, Newton(0.3), 1.0, scheme="event-driven")
-    with pytest.raises(InputError, match="compiled loop has no Coulomb"):
-        moreau_jean(rough, Coulomb(0.3), 1.0, 0.01, compiled=True)
+    with pytest.raises(InputError, match="compiled frictional loop does not take"):
+        moreau_jean(rough, Coulomb(0.3), 1.0, 0.01, backend="nsgs", compiled=True)
+    with pytest.raises(InputError, match="compiled frictional loop does not take"):
+        moreau_jean(_spring_block(True), Coulomb(0.3), 1.0, 0.01, compiled=True)
     with pytest.raises(InputError, match="solve_friction"):
         simulate(rough, Coulomb(0.3), 1.0, backend="osqp")
     with pytest.raises(ShapeError, match="one per contact"):
@@ -313,13 +336,44 @@ def test_per_contact_coefficients_act_on_their_own_contacts():
     assert tr_half.v[-1, 0] > tr_vec.v[-1, 0] + 0.1
 
 
-def test_an_uncertified_step_stops_the_run_with_its_time(monkeypatch):
+def test_an_uncertified_step_stops_the_run_with_its_time(monkeypatch, loop):
     def fail(problem, **kwargs):
         raise CertificateError("no method certified the frictional contact problem")
 
+    def kernel_fails(q, v, k, stop, row, *args):
+        return FAILED, k, row  # the kernel's verdict on a step it does not certify
+
     monkeypatch.setattr(friction_step, "solve_friction", fail)
+    monkeypatch.setattr(friction_loop, "run", kernel_fails)
     with pytest.raises(CertificateError, match=r"step ending at t = 0\.01 .*no method"):
-        simulate(block_on_incline(0.3, gap=OVERLAP), Coulomb(0.3), 1.0, h=0.01)
+        run(block_on_incline(0.3, gap=OVERLAP), Coulomb(0.3), 1.0, loop, h=0.01)
+
+
+def test_the_compiled_loop_hands_a_step_it_cannot_certify_to_solve_friction(monkeypatch):
+    """A step the kernel fails is solved by the Python step and the kernel resumes after it;
+    the event buffers grow as they fill; both loops give the same run."""
+    system = box_on_floor(3, velocity=(2.0, 1.0), gap=0.02)
+    python = run(system, Coulomb(0.4, 0.3), 0.5, "friction", h=1e-3)
+    kernel = friction_loop.run
+    when = python.events[150].time  # a step with a local problem to solve
+    fail = round(when / 1e-3) - 1
+
+    def fail_once(q, v, k, stop, row, *args):
+        if k <= fail < stop:  # stop before that step, then fail it
+            status, k, row = kernel(q, v, k, fail, row, *args)
+            return (FAILED if status == DONE else status), k, row
+        return kernel(q, v, k, stop, row, *args)
+
+    monkeypatch.setattr(friction_loop, "run", fail_once)
+    mixed = run(system, Coulomb(0.4, 0.3), 0.5, "friction-compiled", h=1e-3)
+    assert len(mixed.events) == len(python.events) > 300  # past the first buffers
+    assert np.abs(mixed.v - python.v).max() < 1e-8 and np.abs(mixed.q - python.q).max() < 1e-8
+    backends = [ev.result.backend for ev in mixed.events]
+    by_python = [i for i, b in enumerate(backends) if b != friction_loop.LOOP_BACKEND]
+    assert len(by_python) == 1 and mixed.events[by_python[0]].time == when
+    for a, b in zip(mixed.events, python.events):
+        assert a.time == b.time and np.array_equal(a.contacts, b.contacts) and a.certified
+        assert np.allclose(a.u_plus, b.u_plus, atol=1e-8)
 
 
 def test_a_frictional_trajectory_saves_its_impulse_components(tmp_path):

@@ -1,7 +1,8 @@
-"""Which Moreau–Jean loop runs a simulation (docs/theory.md §14, §17): the frictional loop
-for Coulomb's law on a system with friction columns, the compiled loop for the runs
-:func:`compiled_applies` accepts, the Python loop for every other run; the combinations no
-loop takes are refused by name."""
+"""Which Moreau–Jean loop runs a simulation (docs/theory.md §14, §17): for Coulomb's law on
+a system with friction columns, the compiled frictional loop where
+:func:`friction_compiled_applies` says so and the Python frictional loop otherwise; for the
+other laws, the compiled loop for the runs :func:`compiled_applies` accepts and the Python
+loop for every other run; the combinations no loop takes are refused by name."""
 
 from __future__ import annotations
 
@@ -31,6 +32,15 @@ def compiled_applies(system: LinearSystem, law: ImpactLaw, backend: str) -> bool
             and 0 < system.n_contacts <= MAX_COMPILED and system.n_dof <= MAX_COMPILED)
 
 
+def friction_compiled_applies(system: LinearSystem, backend: str) -> bool:
+    """Whether a Coulomb run takes the compiled frictional loop: ``backend="auto"``, a
+    constant or linear force, a dense system with at most :data:`MAX_COMPILED` degrees of
+    freedom and contact rows."""
+    return (backend == "auto" and not system.structure.sparse
+            and (system.constant_force is not None or system.linear_force is not None)
+            and 0 < system.H.shape[1] <= MAX_COMPILED and system.n_dof <= MAX_COMPILED)
+
+
 def route(system: LinearSystem, law: ImpactLaw, backend: str, compiled: bool | None) -> str:
     """Which loop runs (the rule of :mod:`.time_stepping`): ``"friction"``, ``"compiled"`` or
     ``"python"``.
@@ -38,9 +48,9 @@ def route(system: LinearSystem, law: ImpactLaw, backend: str, compiled: bool | N
     Raises
     ------
     InputError
-        Coulomb's law on a frictionless system (``contact_dim`` 1) or with ``compiled=True``
-        or a backend solve_friction does not take; another law on a frictional system;
-        ``compiled=True`` for a run outside :func:`compiled_applies`.
+        Coulomb's law on a frictionless system (``contact_dim`` 1) or with a backend
+        solve_friction does not take; another law on a frictional system; ``compiled=True``
+        for a run outside :func:`compiled_applies` (:func:`friction_compiled_applies`).
     """
     frictional = isinstance(law, Coulomb)
     if frictional != (system.contact_dim > 1):
@@ -50,11 +60,14 @@ def route(system: LinearSystem, law: ImpactLaw, backend: str, compiled: bool | N
                          f"columns: simulate it with iq.Coulomb(mu, restitution), or build "
                          f"it with contact_dim=1 from the normal columns for {law!r}")
     if frictional:
-        if compiled:
-            raise InputError("compiled=True: the compiled loop has no Coulomb friction; "
-                             "leave compiled unset")
         check_friction_backend(backend)
-        return "friction"
+        fits = friction_compiled_applies(system, backend)
+        use = fits if compiled is None else compiled
+        if use and not fits:
+            raise InputError("compiled=True: the compiled frictional loop does not take this "
+                             "run (a backend other than 'auto', a callable force, a sparse or "
+                             "a larger system)")
+        return "friction-compiled" if use else "friction"
     use = compiled_applies(system, law, backend) if compiled is None else compiled
     if use and not compiled_applies(system, law, backend):
         raise InputError("compiled=True: the compiled loop does not take this run (a law, "

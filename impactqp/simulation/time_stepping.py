@@ -13,12 +13,13 @@ uses:
    ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k``), giving v_{k+1} = u⁺;
 4. q_{k+1} = q_k + h((1 − θ)v_k + θv_{k+1}).
 
-Three loops run these steps, chosen by :func:`route`. A
-:class:`~impactqp.laws.coulomb.Coulomb` law on a system with ``contact_dim`` 2 or 3 takes
-the frictional loop: the Python loop with
-:class:`~impactqp.simulation.friction_step.FrictionStep` as its step (docs/theory.md §17); a
-Coulomb law on a frictionless system, another law on a frictional system, or
-``compiled=True`` with Coulomb are refused by name. The compiled loop
+Four loops run these steps, chosen by :func:`route`. A
+:class:`~impactqp.laws.coulomb.Coulomb` law on a system with ``contact_dim`` 2 or 3 takes a
+frictional loop (docs/theory.md §17): the compiled one
+(:class:`~impactqp.simulation.friction_loop.CompiledFriction`) under the conditions of the
+compiled loop below, else the Python loop with
+:class:`~impactqp.simulation.friction_step.FrictionStep` as its step; a Coulomb law on a
+frictionless system or another law on a frictional system are refused by name. The compiled loop
 (:func:`impactqp.kernels.moreau_jean.run`) takes a run when :func:`compiled_applies` says
 so: a built-in complementarity law (Moreau, Newton, Frémond, by exact type), a constant or
 linear force, ``backend="auto"`` and a system small enough to be held dense. Every other
@@ -46,6 +47,7 @@ from ..model.problem import ImpactProblem
 from ..model.residuals import restitution_matrix
 from ..model.structure import ImpactStructure
 from .clusters import ClusterCache
+from .friction_loop import CompiledFriction
 from .friction_step import FrictionEvent, FrictionStep
 from .impacts import ImpactEvent, ImpactSolver
 from .routing import compiled_applies as compiled_applies  # re-exported: imported from here
@@ -96,6 +98,17 @@ class _FreeVelocity:
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         return v - self.solver.solve_mass(self.residual(t, q, v))
 
+    def kernel_arrays(self, t0: float) -> tuple:
+        """(L of Ŵ = LLᵀ, K, c, Ŵ⁻¹r, linear): the force as the compiled loops take it, for
+        a linear force or (Ŵ⁻¹r formed once) a constant one."""
+        n = self.system.n_dof
+        if self.K is not None:
+            K = self.K.toarray() if sp.issparse(self.K) else self.K
+            return (self.solver.cholesky_factor, np.ascontiguousarray(K, dtype=float),
+                    self.constant, np.zeros(n), True)
+        shift = self.solver.solve_mass(self.residual(t0, self.system.q0, self.system.v0))
+        return np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0), shift, False
+
 
 def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
                 theta: float = 0.5, *, t0: float = 0.0, backend: str = "auto",
@@ -133,7 +146,8 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     -------
     Trajectory
         ``settings["loop"]`` says which loop ran (``"compiled"``, ``"python"`` or
-        ``"friction"``); ``impulses`` has one column per column of H.
+        ``"friction-compiled"`` or ``"friction"``); ``impulses`` has one column per column
+        of H.
 
     Raises
     ------
@@ -152,7 +166,7 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     Q[0], V[0] = system.q0, system.v0
     report = max(1, steps // 200)
     step: _Step | FrictionStep
-    if loop == "friction":
+    if loop.startswith("friction"):
         step = FrictionStep(system, free, law, h, theta, t0, backend=backend, tol=tol)
     else:
         cache = ClusterCache(free.metric, system.H, system.chain)
@@ -162,6 +176,9 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     if loop == "compiled":
         events = _CompiledLoop(system, law, free, step, tol, keep_events).run(
             steps, kept, Q, V, L, report, progress)
+    elif loop == "friction-compiled":
+        events = CompiledFriction(step, keep_events).run(steps, kept, Q, V, L, report,
+                                                         progress)
     else:
         events = []
         q, v = system.q0.copy(), system.v0.copy()
@@ -214,7 +231,7 @@ class _CompiledLoop:
                  step: _Step, tol: float, keep: bool) -> None:
         self.system, self.law, self.free, self.step = system, law, free, step
         self.tol, self.keep = tol, keep
-        n, m = system.n_dof, system.n_contacts
+        m = system.n_contacts
         Wh = np.ascontiguousarray(free.metric, dtype=float)
         H = np.ascontiguousarray(system.H, dtype=float)
         cache = step.solver.cache
@@ -227,14 +244,7 @@ class _CompiledLoop:
             MinvH, G = full.dense_Minv_W, np.asarray(full.delassus)
         Ht = sp.csr_matrix(H.T)
         Ht.sort_indices()
-        linear = free.K is not None
-        if linear:
-            K = free.K.toarray() if sp.issparse(free.K) else free.K
-            self.force = (free.solver.cholesky_factor, np.ascontiguousarray(K, dtype=float),
-                          free.constant, np.zeros(n), True)
-        else:
-            shift = free.solver.solve_mass(free.residual(step.t0, system.q0, system.v0))
-            self.force = (np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0), shift, False)
+        self.force = free.kernel_arrays(step.t0)
         pairs = np.argwhere(np.triu(Wh != 0.0, 1))
         E = law.step_restitution(np.arange(m))
         self.geometry = (Ht.indptr.astype(np.int64), Ht.indices.astype(np.int64),
