@@ -19,14 +19,15 @@ frictional loop (docs/theory.md §17): the compiled one
 (:class:`~impactqp.simulation.friction_loop.CompiledFriction`) under the conditions of the
 compiled loop below, else the Python loop with
 :class:`~impactqp.simulation.friction_step.FrictionStep` as its step; a Coulomb law on a
-frictionless system or another law on a frictional system are refused by name. The compiled loop
-(:func:`impactqp.kernels.moreau_jean.run`) takes a run when :func:`compiled_applies` says
-so: a built-in complementarity law (Moreau, Newton, Frémond, by exact type), a constant or
-linear force, ``backend="auto"`` and a system small enough to be held dense. Every other
-run — a callable force, any other law (the sector and reflection laws, LZB, a user's law),
-a named backend, a large system — takes the Python loop, which solves each cluster through
-:func:`impactqp.solve`. A step whose compiled certificate fails is solved again by the
-Python loop's step (which raises what it raises), and the compiled loop resumes after it.
+frictionless system or another law on a frictional system are refused by name. The
+compiled loop (:func:`impactqp.kernels.moreau_jean.run`) takes a run when
+:func:`compiled_applies` says so: a built-in complementarity law (Moreau, Newton, Frémond,
+by exact type), a constant or linear force, ``backend="auto"`` and a system small enough to
+be held dense. Every other run — a callable force, any other law (the sector and reflection
+laws, LZB, a user's law), a named backend, a large system — takes the Python loop, which
+solves each cluster through :func:`impactqp.solve`. A step whose compiled certificate fails
+is solved again by the Python loop's step (which raises what it raises), and the compiled
+loop resumes after it.
 """
 
 from __future__ import annotations
