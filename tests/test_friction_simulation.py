@@ -385,3 +385,13 @@ def test_a_frictional_trajectory_saves_its_impulse_components(tmp_path):
     with np.load(tr.save(tmp_path / "box.npz")) as data:
         assert np.array_equal(data["impulses"], tr.impulses)
         assert data["event_certified"].all() and data["event_admissible"].all()
+
+
+def test_records_and_events_can_be_thinned(loop):
+    system = box_on_floor(2, velocity=2.0, gap=0.01)
+    full = run(system, Coulomb(0.3, 0.5), 0.3, loop, h=1e-3)
+    thin = run(system, Coulomb(0.3, 0.5), 0.3, loop, h=1e-3, record_every=7, keep_events=False)
+    rows = np.append(np.arange(0, 301, 7), 300)
+    assert np.array_equal(thin.t, full.t[rows]) and thin.events == []
+    assert np.array_equal(thin.q, full.q[rows]) and np.array_equal(thin.impulses,
+                                                                    full.impulses[rows])

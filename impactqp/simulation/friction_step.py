@@ -101,7 +101,7 @@ class FrictionEvent:
     u_minus, u_plus : ndarray
         v_free and v_{k+1}.
     verdict : callable
-        Computes the :class:`StepMembership` of the step (called on first read of
+        Computes the ``StepMembership`` of the step (called on first read of
         :attr:`admissible`).
 
     Attributes
@@ -140,7 +140,7 @@ class FrictionEvent:
 
     @cached_property
     def admissible(self) -> StepMembership:
-        """u⁺ ∈ S of the step, with r as witness (:class:`StepMembership`)."""
+        """u⁺ ∈ S of the step, with r as witness (a ``StepMembership``)."""
         return self._verdict()
 
     def __repr__(self) -> str:

@@ -116,7 +116,7 @@ class LinearSystem:
     contact_dim : int
         d, the columns of H per contact: 1 (frictionless, the default), 2 (normal and one
         tangent, motion in the plane) or 3 (normal and two tangents, in space). A system with
-        d > 1 is simulated with :class:`impactqp.laws.coulomb.Coulomb`.
+        d > 1 is simulated with ``iq.Coulomb(mu, restitution)``.
 
     Raises
     ------
