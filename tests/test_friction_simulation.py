@@ -21,6 +21,7 @@ from impactqp.simulation.builders import (
     box_on_floor,
     rolling_sphere,
 )
+from impactqp.simulation.event_driven import event_driven
 from impactqp.simulation.friction_step import FrictionEvent
 from impactqp.simulation.simulate import simulate
 from impactqp.simulation.system import LinearForce, LinearSystem
@@ -316,6 +317,8 @@ def test_laws_and_systems_that_do_not_fit_are_refused_by_name():
         simulate(rough, Coulomb(0.3), 1.0, scheme="event-driven")
     with pytest.raises(InputError, match="event-driven.*no Coulomb"):
         simulate(rough, Newton(0.3), 1.0, scheme="event-driven")
+    with pytest.raises(InputError, match="event-driven.*no Coulomb"):
+        event_driven(rough, Coulomb(0.3), 1.0)
     with pytest.raises(InputError, match="compiled frictional loop does not take"):
         moreau_jean(rough, Coulomb(0.3), 1.0, 0.01, backend="nsgs", compiled=True)
     with pytest.raises(InputError, match="compiled frictional loop does not take"):

@@ -32,6 +32,14 @@ def compiled_applies(system: LinearSystem, law: ImpactLaw, backend: str) -> bool
             and 0 < system.n_contacts <= MAX_COMPILED and system.n_dof <= MAX_COMPILED)
 
 
+def check_frictionless(system: LinearSystem, law: ImpactLaw, scheme: str) -> None:
+    """InputError, naming ``scheme``, for Coulomb's law or a system with friction columns:
+    only Moreau–Jean time-stepping has friction."""
+    if isinstance(law, Coulomb) or system.contact_dim > 1:
+        raise InputError(f"scheme={scheme!r} has no Coulomb friction: simulate frictional "
+                         "systems with scheme='moreau-jean'")
+
+
 def friction_compiled_applies(system: LinearSystem, backend: str) -> bool:
     """Whether a Coulomb run takes the compiled frictional loop: ``backend="auto"``, a
     constant or linear force, a dense system with at most :data:`MAX_COMPILED` degrees of

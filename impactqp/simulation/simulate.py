@@ -16,6 +16,7 @@ from ..laws.planner import check_backend, check_law
 from ..model.problem import ImpactProblem
 from .event_driven import event_driven
 from .friction_step import check_friction_backend, coulomb_coefficients
+from .routing import check_frictionless
 from .system import LinearSystem
 from .time_stepping import moreau_jean
 from .trajectory import Trajectory
@@ -118,8 +119,7 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
     frictional = isinstance(law, Coulomb)
     if frictional or system.contact_dim > 1:
         if scheme != "moreau-jean":
-            raise InputError(f"scheme={scheme!r} has no Coulomb friction: simulate frictional "
-                             "systems with scheme='moreau-jean'")
+            check_frictionless(system, law, scheme)
         if frictional:
             coulomb_coefficients(law, system)
     else:
