@@ -140,8 +140,9 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     progress : callable, optional
         Called with the current time now and then (a progress bar).
     compiled : bool, optional
-        Force the compiled loop (True; only where :func:`compiled_applies`) or the Python
-        loop (False); by default the rule of :func:`compiled_applies` decides.
+        Force the compiled loop (True; only where :func:`compiled_applies`, with Coulomb's
+        law where ``routing.friction_compiled_applies``) or the Python loop (False); by
+        default those rules decide.
 
     Returns
     -------
