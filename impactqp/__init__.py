@@ -72,7 +72,15 @@ from .model.physical_chains import (
 from .model.problem import ImpactProblem
 from .model.structure import ChainInfo, ImpactStructure
 from .qp.lcp import LCPResult, solve_lcp
-from .simulation.builders import bead_chain, bouncing_ball, cradle_system
+from .simulation.builders import (
+    bead_chain,
+    block_on_incline,
+    bouncing_ball,
+    box_on_floor,
+    cradle_system,
+    rolling_sphere,
+)
+from .simulation.friction_step import FrictionEvent
 from .simulation.impacts import ImpactEvent
 from .simulation.simulate import simulate
 from .simulation.step_law import MoreauJeanStep
@@ -94,7 +102,8 @@ except PackageNotFoundError:  # running from a source tree that was never instal
 
 __all__ = [
     "AdmissibleSet", "Answer", "BackendUnsuitableError", "BatchResult", "Certificate",
-    "CertificateError", "ChainInfo", "Classification", "Coulomb", "Counterexample",
+    "CertificateError", "ChainInfo", "FrictionEvent", "block_on_incline", "box_on_floor",
+    "rolling_sphere", "Classification", "Coulomb", "Counterexample",
     "DEFAULT_TOL", "Fremond",
     "FrictionCertificate", "FrictionContactProblem", "FrictionResult",
     "ImpactError", "ImpactEvent", "ImpactLaw", "ImpactProblem", "ImpactResult", "ImpactStructure",
