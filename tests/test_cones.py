@@ -172,3 +172,42 @@ def test_solve_cone_checks_its_arguments() -> None:
         solve_cone(program, "mosek")
     with pytest.raises(iq.InputError, match="clarabel has no setting"):
         solve_cone(program, "clarabel", options={"no_such_setting": 1})
+
+
+def test_the_admissible_sets_socp_is_a_certified_cone_program(monkeypatch) -> None:
+    from impactqp.model import admissible
+    seen = []
+
+    def spy(program, backend="clarabel", **kwargs):
+        sol = solve_cone(program, backend, **kwargs)
+        seen.append((program.cones, sol.checks))
+        return sol
+
+    monkeypatch.setattr(admissible, "solve_cone", spy)
+    p = iq.newtons_cradle(3)
+    S = p.admissible_set()
+    y = S.project([0.2, -0.1, 0.4])
+    assert S.contains(y, tol=1e-7)
+    assert [c.kind for c in seen[-1][0]] == ["zero", "nonnegative", "soc", "soc"]
+    assert seen[-1][1].ok
+    # support: the cvxpy form of S (another solver, another formulation) gives the same value
+    c = np.array([1.0, -2.0, 0.5])
+    value, u = S.support(c)
+    import cvxpy as cp
+    v = cp.Variable(3)
+    cp.Problem(cp.Maximize(c @ v), S.constraints(v)).solve(solver="ECOS")
+    assert abs(value - c @ v.value) <= 1e-5 and S.contains(u, tol=1e-7)
+
+
+def test_admissible_set_without_an_approaching_contact_is_one_point() -> None:
+    # two balls already separating (γ⁻ > 0): S = {u⁻}, answered exactly, no SOCP needed
+    p = iq.ImpactProblem(np.diag([1.0, 2.0]), [[-1.0], [1.0]], [-0.5, 0.25])
+    assert p.gamma_minus[0] > 0
+    S = p.admissible_set()
+    u = np.array([0.3, 0.1])
+    m = S.contains(u, method="optimizer")
+    exact = p.norm(u - p.u_minus) / p.norm(p.u_minus)
+    assert not m and m.distance == pytest.approx(exact, rel=1e-12)
+    np.testing.assert_array_equal(S.project(u), p.u_minus)
+    assert S.contains(p.u_minus, method="optimizer") and S.contains(p.u_minus)
+    assert S.support([1.0, 1.0])[0] == pytest.approx(-0.25, rel=1e-12)

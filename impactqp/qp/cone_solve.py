@@ -24,7 +24,8 @@ from . import backends
 from .cones import ConeProgram, ConeSolution
 
 ACCEPT = 1e-8
-"""Default tolerance of a cone answer's certificate (relative residuals, §9)."""
+"""Default tolerance of a cone answer's certificate (relative residuals, docs/theory.md
+§9)."""
 
 
 def solve_cone(program: ConeProgram, backend: str = "clarabel", *, tol: float = 1e-10,
