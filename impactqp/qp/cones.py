@@ -69,6 +69,17 @@ def as_cones(cones: Any) -> tuple[Cone, ...]:
     return tuple(out)
 
 
+def _asymmetry(P: Any) -> tuple[float, float]:
+    """(max |P − Pᵀ|, max |P|); small sparse matrices are compared dense (faster)."""
+    if sp.issparse(P):
+        if P.shape[0] > 300:
+            D = P - P.T
+            return (float(np.abs(D.data).max(initial=0.0)),
+                    float(np.abs(P.data).max(initial=0.0)))
+        P = P.toarray()
+    return float(np.abs(P - P.T).max(initial=0.0)), float(np.abs(P).max(initial=0.0))
+
+
 @dataclass(frozen=True)
 class ConeProgram:
     """min ½xᵀPx + cᵀx  s.t.  Ax + s = b, s ∈ K (the cones of :attr:`cones`, in row order).
@@ -120,8 +131,8 @@ class ConeProgram:
         if P is not None:
             if P.shape != (c.size, c.size):
                 raise ShapeError(f"P must be {c.size} × {c.size}, got {P.shape}")
-            asym = abs(P - P.T).max() if P.size else 0.0
-            if asym > 1e-12 * max(abs(P).max(), 1e-300):
+            asym, scale = _asymmetry(P)
+            if asym > 1e-12 * scale:
                 raise InputError(f"P must be symmetric (largest |P − Pᵀ| = {asym:.1e})")
         for name, value in (("P", P), ("c", c), ("A", A), ("b", b), ("cones", cones)):
             object.__setattr__(self, name, value)
@@ -152,6 +163,11 @@ class ConeProgram:
             found.setdefault(key, []).extend(range(start, start + cone.size))
             start += cone.size
         return {key: np.array(rows, dtype=np.int64) for key, rows in found.items()}
+
+    @cached_property
+    def _At(self) -> Any:
+        """Aᵀ, formed once (CSR when A is sparse)."""
+        return self.A.T.tocsr() if sp.issparse(self.A) else self.A.T
 
     @cached_property
     def cone_of_row(self) -> np.ndarray:
@@ -197,7 +213,7 @@ class ConeProgram:
         Ax = np.asarray(self.A @ x).ravel()
         s = self.b - Ax
         Px = np.zeros_like(x) if self.P is None else np.asarray(self.P @ x).ravel()
-        Atz = np.asarray(self.A.T @ z).ravel()
+        Atz = np.asarray(self._At @ z).ravel()
         primal_obj = self.objective(x)
         dual_obj = -0.5 * float(x @ Px) - float(self.b @ z)
         size = 1.0 + abs(primal_obj) + abs(dual_obj)
@@ -209,7 +225,7 @@ class ConeProgram:
         per_cone[[cone.kind == "zero" for cone in self.cones]] = 0.0
 
         def inf(v: np.ndarray) -> float:
-            return float(np.max(np.abs(v), initial=0.0))
+            return float(np.abs(v).max()) if v.size else 0.0
 
         return NamedChecks({
             "primal": inf(s - self.project(s)) / (1.0 + max(inf(self.b), inf(Ax))),
