@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from typing import Any
 
-import clarabel
 import numpy as np
 import scipy.sparse as sp
 
@@ -24,14 +23,19 @@ from ..base.arrays import as_vector, check_tol
 from ..base.checks import DEFAULT_TOL, UNIT_RANGE, NamedChecks
 from ..errors import InputError
 from ..kernels.nnls import solve_nnls
-from ..qp.backends.clarabel_ import run as run_clarabel
 from ..qp.certified import solve_in_forms
+from ..qp.cone_solve import solve_cone
+from ..qp.cones import Cone, ConeProgram
 from ..qp.lcp import solve_psd_lcp
 from ..qp.program import QPSolution
 from .friction_admissible import friction_coefficients_of, frictional_membership
 from .membership import METHODS, OPTIMIZER_TOL, Membership
 from .programs import impulse_program, preferred_forms, velocity_program
 from .residuals import law_residuals
+
+GRAZING = 1e-12
+"""Approach velocities −γᵢ⁻/(sᵢ‖u⁻‖) up to which a contact counts as not approaching in
+the SOCP of S (when none approaches, S = {u⁻})."""
 
 
 def best_impulses(problem: Any, du: np.ndarray) -> tuple[np.ndarray, float]:
@@ -208,7 +212,8 @@ class AdmissibleSet:
         raise InputError("the SOCP of S needs a factor of M; pass a dense M or a diagonal one")
 
     def _conic(self, c: np.ndarray, point: np.ndarray | None = None) -> np.ndarray:
-        """Solve an SOCP over ξ = (u, Λ, t) ∈ S with Clarabel and return u, all in the
+        """Solve an SOCP over ξ = (u, Λ, t) ∈ S (a cone program, solved and certified
+        through the backend registry by Clarabel, docs/theory.md §9) and return u, all in the
         normalized units of :meth:`contains` (u⁻ divided by its largest entry, M by its
         largest diagonal entry, each column of W by its norm: the same S).
 
@@ -221,6 +226,12 @@ class AdmissibleSet:
         st = p.structure
         n, m = st.n, st.m
         u_minus = p.u_minus / float(np.abs(p.u_minus).max())
+        if np.all(st.Wt_times(u_minus) >= -GRAZING * st.contact_scale
+                  * float(st.kinetic_norms(u_minus))):
+            # no contact approaches: ‖u⁻ + M⁻¹WΛ‖² = ‖u⁻‖² + 2γ⁻ᵀΛ + ΛᵀGΛ > ‖u⁻‖² unless
+            # WΛ = 0, so S = {u⁻} (docs/theory.md §2), a set without interior on which
+            # no interior-point answer can be certified
+            return u_minus
         mu = float(abs(st.M).max())
         M = sp.csc_matrix(st.M) / mu
         W = sp.csc_matrix(st.W) @ sp.diags(1.0 / np.sqrt(np.asarray(
@@ -235,22 +246,21 @@ class AdmissibleSet:
                   [row0[:, :n], row0[:, n:n + m], row0[:, -1:]],
                   [-F, znm, zn1]]
         b = [np.asarray(M @ u_minus).ravel(), np.zeros(2 * m), [radius], np.zeros(n)]
-        cones = [clarabel.ZeroConeT(n), clarabel.NonnegativeConeT(2 * m),
-                 clarabel.SecondOrderConeT(n + 1)]
+        cones = [Cone("zero", n), Cone("nonnegative", 2 * m), Cone("soc", n + 1)]
         if point is not None:
             blocks += [[row0[:, :n], row0[:, n:n + m], sp.csc_matrix([[-1.0]])], [-F, znm, zn1]]
             b += [[0.0], -np.asarray(F @ point).ravel()]
-            cones.append(clarabel.SecondOrderConeT(n + 1))
+            cones.append(Cone("soc", n + 1))
             q = np.concatenate([np.zeros(n + m), [1.0]])
         else:
             blocks += [[row0[:, :n], row0[:, n:n + m], sp.csc_matrix([[-1.0]])]]
             b += [[0.0]]  # t ≥ 0 keeps the unused variable bounded
-            cones.append(clarabel.NonnegativeConeT(1))
+            cones.append(Cone("nonnegative", 1))
             q = np.concatenate([c, np.zeros(m), [1.0]])
-        A = sp.bmat(blocks, format="csc")
-        P = sp.csc_matrix((n + m + 1, n + m + 1))
-        sol, _ = run_clarabel(P, q, A, np.concatenate(b), cones, 1e-12)
-        return np.array(sol.x[:n])
+        program = ConeProgram(None, q, sp.bmat(blocks, format="csc"), np.concatenate(b), cones)
+        # certified to the accuracy the answers promise (OPTIMIZER_TOL): a set S without
+        # interior makes the multipliers grow without bound and the gap close slowly
+        return solve_cone(program, "clarabel", tol=1e-12, accept=OPTIMIZER_TOL).x[:n]
 
     def project(self, point: Any) -> np.ndarray:
         """Nearest point of S to ``point`` in the kinetic metric (an SOCP, Clarabel):

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 from typing import Any
 
-import clarabel
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
@@ -28,7 +27,8 @@ from ..base.arrays import as_array, as_dense
 from ..base.checks import DEFAULT_TOL
 from ..errors import InputError, ShapeError
 from ..kernels.friction import project_cones
-from ..qp.backends.clarabel_ import run as run_clarabel
+from ..qp.cone_solve import solve_cone
+from ..qp.cones import Cone, ConeProgram, friction_cone_rows
 from .membership import OPTIMIZER_TOL, Membership
 
 __all__ = ["cone_least_squares", "friction_coefficients", "friction_coefficients_of",
@@ -82,7 +82,8 @@ def _metric_factor(structure: Any) -> tuple[np.ndarray, np.ndarray]:
 
 def cone_least_squares(B: np.ndarray, b: np.ndarray, mu: np.ndarray, d: int) -> np.ndarray:
     """Λ minimizing ‖BΛ − b‖ over Λ_c ∈ K_μc (one friction cone per contact, d components,
-    the normal first), by Clarabel: the second-order cone program
+    the normal first): the second-order cone program, solved and certified through the
+    solver layer (Clarabel; docs/theory.md §9),
 
         min t  s.t.  (t, b − BΛ) ∈ SOC,  (μ_c Λ_n,c, Λ_T,c) ∈ SOC for μ_c > 0,
                      Λ_n,c ≥ 0 and Λ_T,c = 0 for μ_c = 0.
@@ -90,41 +91,15 @@ def cone_least_squares(B: np.ndarray, b: np.ndarray, mu: np.ndarray, d: int) -> 
     Returns Λ projected onto the cones (the interior-point answer may sit just outside).
     """
     k, n = B.shape[1], B.shape[0]
-    free, rough = np.flatnonzero(mu == 0.0), np.flatnonzero(mu > 0.0)
-    rows, cols, vals, row = [], [], [], 0
-
-    def entry(r: int, c: int, v: float) -> None:
-        rows.append(r), cols.append(c), vals.append(v)
-
-    entry(0, k, -1.0)  # s₀ = t
-    dense = sp.coo_matrix(B)
-    rows += (dense.row + 1).tolist()
-    cols += dense.col.tolist()
-    vals += dense.data.tolist()  # s = b − BΛ
-    row = n + 1
-    for c in free:  # Λ_n ≥ 0
-        entry(row, c * d, -1.0)
-        row += 1
-    for c in free:  # Λ_T = 0
-        for j in range(1, d):
-            entry(row, c * d + j, -1.0)
-            row += 1
-    for c in rough:  # (μΛ_n, Λ_T) in the second-order cone
-        entry(row, c * d, -mu[c])
-        for j in range(1, d):
-            entry(row + j, c * d + j, -1.0)
-        row += d
-    A = sp.csc_matrix((vals, (rows, cols)), shape=(row, k + 1))
-    rhs = np.concatenate([[0.0], b, np.zeros(row - n - 1)])
-    cones = [clarabel.SecondOrderConeT(n + 1)]
-    if free.size:
-        cones += [clarabel.NonnegativeConeT(free.size)]
-        if d > 1:
-            cones += [clarabel.ZeroConeT(free.size * (d - 1))]
-    cones += [clarabel.SecondOrderConeT(d) for _ in rough]
+    C, cones = friction_cone_rows(mu, d)
+    t_row = sp.csc_matrix(([-1.0], ([0], [k])), shape=(1, k + 1))  # s₀ = t
+    A = sp.vstack([t_row, sp.hstack([sp.csc_matrix(B), sp.csc_matrix((n, 1))]),  # b − BΛ
+                   sp.hstack([-C, sp.csc_matrix((C.shape[0], 1))])], format="csc")
+    rhs = np.concatenate([[0.0], b, np.zeros(C.shape[0])])
     cost = np.zeros(k + 1)
     cost[-1] = 1.0
-    sol, _ = run_clarabel(sp.csc_matrix((k + 1, k + 1)), cost, A, rhs, cones, SOCP_TOL)
+    program = ConeProgram(None, cost, A, rhs, [Cone("soc", n + 1), *cones])
+    sol = solve_cone(program, "clarabel", tol=SOCP_TOL, accept=1e-6)
     return project_cones(np.array(sol.x[:k]), mu, d)
 
 
