@@ -97,7 +97,7 @@ def solution_report(result: ImpactResult, source: str = "") -> dict[str, Any]:
     """u⁺, impulses, energies, classification (docs/theory.md §4), admissibility (docs/theory.md
     §2) and certificate."""
     frictional = result.problem.contact_dim > 1
-    c = None if frictional else result.classification  # §4 is about frictionless impacts
+    c = None if frictional else result.classification  # docs/theory.md §4: frictionless
     cert = result.certificate
     S = result.impact_law.admissible_set(result.problem) if result.impact_law else None
     membership = membership_report(result.problem, result.u_plus, optimizer=False, S=S)

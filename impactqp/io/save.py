@@ -24,7 +24,7 @@ from .files import VERSION, file_format, problem_from_dict
 
 def _coefficient_entries(law: str | None, coefficients: Any) -> dict[str, Any]:
     """The file keys of ``law``'s coefficients: one value, or a tuple in the order of
-    :data:`~impactqp.io.files.COEFFICIENT_KEYS` (Coulomb's (μ, e), an entry None left out)."""
+    :data:`~impactqp.io.file_laws.COEFFICIENT_KEYS` (Coulomb's (μ, e), an entry None left out)."""
     keys = COEFFICIENT_KEYS.get(law, ()) if law else ()
     if not keys:
         raise InputError(f"coefficients need a law among {list(COEFFICIENT_KEYS)}, "

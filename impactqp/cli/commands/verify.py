@@ -1,5 +1,5 @@
 """``impactqp verify FILE``: is a candidate post-impact velocity admissible (u⁺ ∈ S,
-docs/theory.md §2; with the friction cones of μ for frictional contacts, §16)?
+docs/theory.md §2, §16: with the friction cones of μ for frictional contacts)?
 
 Exit status: 0 admissible, 1 not admissible, 2 bad input.
 """
