@@ -258,6 +258,14 @@ def test_verify_checks_u_plus_against_s_with_friction(capsys, tmp_path):
     assert run(capsys, "verify", bare, "--mu", "0.3")[0] == 0
 
 
+def test_plot_s_refuses_frictional_contacts(capsys, tmp_path):
+    """The picture of S is of frictionless contacts: a frictional file is refused by name, not
+    drawn as if its tangent columns were contacts."""
+    code, _, err = run(capsys, "plot", "S", SAMPLE, "--out", tmp_path / "S.png")
+    assert code == 2 and "frictional (contact_dim = 2)" in err
+    assert not list(tmp_path.iterdir())
+
+
 def _library_figures(backend: str) -> tuple[str, dict]:
     found = iq.solve_friction(iq.load_fclib(FCLIB), backend=backend)
     return found.backend, {**found.certificate.values, **found.certificate.reported}
