@@ -56,10 +56,14 @@ from .file_laws import KNOWN_COEFFICIENTS, LAWS, check_friction, read_coefficien
 MAX_FILE_BYTES = 10 * 1024 * 1024
 """Largest problem file that is read (10 MB)."""
 
+MAX_DOF = 10_000
+"""Largest number of degrees of freedom (and of contacts) a problem file may declare."""
+
 MAX_DENSE_CONTACTS = 1_000
-"""Largest number of contacts of a general problem in a file: its Delassus matrix is dense
-(m² entries) and every solve costs at least m³, so larger impacts belong in Python with
-scipy.sparse matrices, where the caller decides what is affordable."""
+"""Largest number of columns of W (frictionless contacts, or d per frictional contact) of a
+general problem in a file: its Delassus matrix is dense (m² entries) and every solve costs
+at least m³, so larger impacts belong in Python with scipy.sparse matrices, where the caller
+decides what is affordable."""
 
 VERSION = 1
 CONTACT_DIMS = (1, 2, 3)
@@ -67,9 +71,6 @@ GENERAL_KEYS = ("M", "W")
 CHAIN_KEYS = ("masses", "left_wall", "right_wall")
 KNOWN_KEYS = ("version", *GENERAL_KEYS, "contact_dim", *CHAIN_KEYS, "u_minus", "law", "eps",
               "e", "E", "mu", "u_plus")
-MAX_DOF = 10_000
-"""Largest number of degrees of freedom (and of contacts) a problem file may declare."""
-
 FORMATS = {".json": "json", ".toml": "toml"}
 
 
