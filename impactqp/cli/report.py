@@ -19,7 +19,7 @@ from ..model.admissible import AdmissibleSet, Membership
 from ..model.problem import ImpactProblem
 
 COEFFICIENT_NAMES = {name: law.coefficient_symbol for name, law in NAMED_LAWS.items()}
-KEY_SYMBOLS = {"eps": "ε", "mu": "μ"}
+KEY_SYMBOLS = {"mu": "μ"}
 """How reports print a coefficient of a law of several (Coulomb's μ and e) by its key."""
 CONDITIONS = ("kinetic", "kinematic", "energetic")
 CONDITION_TEXT = {"kinetic": "u⁺ ∈ u⁻ + N", "kinematic": "u⁺ ∈ T_C",
@@ -130,6 +130,7 @@ def format_solution(report: dict[str, Any]) -> str:
     else:
         coef_text = f", {COEFFICIENT_NAMES[law]} = {_numbers(coef)}"
     e, c, a = report["energy"], report["classification"], report["admissibility"]
+    frictional = c is None  # the classification is of frictionless impacts only
     ratio = e["after"] / e["before"] if e["before"] > 0 else float("nan")
     cert = report["certificate"]
     lines = [
@@ -138,15 +139,15 @@ def format_solution(report: dict[str, Any]) -> str:
         f"u⁺         {vector_text(report['u_plus'])}",
         f"impulses Λ {vector_text(report['impulses'])}",
         f"energy     before {e['before']:.6g}, after {e['after']:.6g} (ratio {ratio:.6g})",
-        *([] if c is None else [
+        *([] if frictional else [
             f"classification: α = {c['alpha_deg']:.4g}°, dissipation ε = "
             f"{c['dissipation']:.4g}, intensity {c['intensity']:.6g}"]),
-        f"admissible (u⁺ ∈ S{'' if c else ' with friction'}): "
+        f"admissible (u⁺ ∈ S{' with friction' if frictional else ''}): "
         f"{'yes' if a['admissible'] else 'NO'}",
         *_conditions_text(a),
         f"certificate: {'ok' if cert['ok'] else 'FAILED'} (tol {cert['tolerance']:.0e})"
         + "".join(f", {k} {v:.1e}" for k, v in cert.items()
-                  if k not in ("ok", "tolerance") and c is None),
+                  if k not in ("ok", "tolerance") and frictional),
     ]
     return "\n".join(lines)
 

@@ -69,7 +69,7 @@ class ImpactLaw(ABC):
         reports "no solution" for such a law.
     by_name : bool
         Problem and simulation files and the command line may name the law (its
-        coefficients, if any, under ``coefficient_key``).
+        coefficients, if any, under ``coefficient_keys``).
     coefficient_key, coefficient_symbol : str or None
         How files and the command line spell its coefficient (``"eps"``) and how reports
         print it (``"ε"``); None for a law without coefficients.
