@@ -389,13 +389,17 @@ def test_bad_input_named_errors() -> None:
         iq.point_on_plane(1.0, [np.nan, -1.0])
 
 
-def test_problem_files_refuse_frictional_problems(tmp_path) -> None:
+def test_problem_files_keep_the_friction(tmp_path) -> None:
+    """A frictional problem reads back with its contact_dim (never silently frictionless);
+    its normal problem is a frictionless file (more in tests/test_friction_files.py)."""
     p = iq.point_on_plane(1.0, [1.0, -1.0])
-    with pytest.raises(iq.InputError, match="contact_dim"):
-        iq.save_problem(p, tmp_path / "p.json")
-    iq.save_problem(p.normal_problem(), tmp_path / "p.json")
-    np.testing.assert_array_equal(iq.load_problem(tmp_path / "p.json").problem.W,
-                                  p.W[:, ::2])
+    back = iq.load_problem(iq.save_problem(p, tmp_path / "p.json")).problem
+    assert back.contact_dim == 2
+    np.testing.assert_array_equal(back.W, p.W)
+    iq.save_problem(p.normal_problem(), tmp_path / "n.json")
+    normal = iq.load_problem(tmp_path / "n.json").problem
+    assert normal.contact_dim == 1
+    np.testing.assert_array_equal(normal.W, p.W[:, ::2])
 
 
 def test_normal_problem_and_frictionless_default_unchanged() -> None:

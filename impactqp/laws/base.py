@@ -69,10 +69,14 @@ class ImpactLaw(ABC):
         reports "no solution" for such a law.
     by_name : bool
         Problem and simulation files and the command line may name the law (its
-        coefficients, if any, under ``coefficient_key``).
+        coefficients, if any, under ``coefficient_keys``).
     coefficient_key, coefficient_symbol : str or None
-        How files and the command line spell its coefficients (``"eps"``) and how reports
-        print them (``"ε"``); None for a law without coefficients.
+        How files and the command line spell its coefficient (``"eps"``) and how reports
+        print it (``"ε"``); None for a law without coefficients.
+    coefficient_keys : tuple of str
+        Every key of its coefficients in files and on the command line, in the order of
+        :attr:`coefficients`: ``(coefficient_key,)`` unless the law sets more
+        (``("mu", "e")`` for Coulomb's law, whose :meth:`from_coefficients` takes a pair).
     needs_coefficients : bool
         Naming the law requires its coefficients (they have no default).
     homogeneous : bool
@@ -96,12 +100,15 @@ class ImpactLaw(ABC):
             cls.name = cls.__name__.lower()
         if "title" not in cls.__dict__ and not hasattr(cls, "title"):
             cls.title = cls.__name__
+        if "coefficient_key" in cls.__dict__ and "coefficient_keys" not in cls.__dict__:
+            cls.coefficient_keys = (cls.coefficient_key,) if cls.coefficient_key else ()
     forms: ClassVar[tuple[str, ...]] = ()
     closed_form_backend: ClassVar[str] = "closed form"
     always_solvable: ClassVar[bool] = False
     by_name: ClassVar[bool] = False
     coefficient_key: ClassVar[str | None] = None
     coefficient_symbol: ClassVar[str | None] = None
+    coefficient_keys: ClassVar[tuple[str, ...]] = ()
     needs_coefficients: ClassVar[bool] = False
     homogeneous: ClassVar[bool] = False
     frictional: ClassVar[bool] = False

@@ -116,6 +116,10 @@ class Coulomb(ImpactLaw):
     name = "coulomb"
     title = "Coulomb's law"
     closed_form_backend = "solve_friction"
+    by_name = True
+    coefficient_keys = ("mu", "e")
+    coefficient_symbol = "(μ, e)"
+    needs_coefficients = True
     always_solvable = False  # μ = 0 with unequal eᵢ is local Newton, which may have none
     homogeneous = True
     frictional = True
@@ -134,6 +138,24 @@ class Coulomb(ImpactLaw):
         self._per_contact: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
     # --- coefficients -----------------------------------------------------------------
+    @classmethod
+    def from_coefficients(cls, coefficients: Any = None) -> Coulomb:
+        """Coulomb's law named in a file or on the command line: ``coefficients`` is the pair
+        (μ, e) of :attr:`coefficients` (the keys ``mu`` and ``e``), e None for the default 0.
+
+        Raises
+        ------
+        InputError, NonFiniteError, RestitutionError
+            No pair, or coefficients the law refuses.
+        """
+        if not isinstance(coefficients, tuple) or len(coefficients) != 2:
+            raise InputError("law 'coulomb' needs its coefficients as the pair (mu, e): mu "
+                             f"required, e optional (default 0); got {coefficients!r}")
+        mu, e = coefficients
+        if mu is None:
+            raise InputError("law 'coulomb' needs its friction coefficient 'mu'")
+        return cls(mu) if e is None else cls(mu, e)
+
     @property
     def coefficients(self) -> tuple[np.ndarray, np.ndarray]:
         """(μ, e) as given."""
