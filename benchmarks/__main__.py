@@ -42,7 +42,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--merge needs {args.out}/results.json to merge into")
     run_suite(args.suite, args.out, siconos_python=args.siconos_python,
               progress=not args.no_progress, n_jobs=args.n_jobs, merge=args.merge)
-    print(f"wrote {args.out}/results.csv, results.json, summary.md, plot.png")
+    extra = ", friction_profile.png" if (args.out / "friction_profile.png").exists() else ""
+    print(f"wrote {args.out}/results.csv, results.json, summary.md, plot.png{extra}")
     return 0
 
 

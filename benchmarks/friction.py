@@ -4,7 +4,8 @@ Every answer, impactqp's or Siconos', is judged by the same figure recomputed he
 :func:`impactqp.model.friction.certify_friction` from (W, q, μ, r): the natural-map error
 ‖F‖/‖q‖ (ABH) at tolerance :data:`TOL`; Siconos' own error is recorded in the message
 only. A solve that does not reach the tolerance is a failure whose time spent is kept
-(it counts as ∞ in the Dolan–Moré profile, :mod:`benchmarks.profile`).
+(it counts as ∞ in the Dolan–Moré profile, :mod:`benchmarks.perf_profile`), as is a run
+stopped after :data:`TIME_LIMIT` seconds.
 
 Rows: family ``friction:<problem>`` (size: contacts), methods ``iq:auto``,
 ``iq:clarabel``, ``iq:nsgs`` (:data:`IQ_METHODS`) and ``siconos:NSGS``,
@@ -14,6 +15,7 @@ Rows: family ``friction:<problem>`` (size: contacts), methods ``iq:auto``,
 
 from __future__ import annotations
 
+import multiprocessing
 import tempfile
 import time
 from collections.abc import Callable
@@ -35,7 +37,7 @@ TOL = 1e-8
 MAX_ITER = 100_000
 """Siconos' SICONOS_IPARAM_MAX_ITER."""
 TIME_LIMIT = 180.0
-"""Seconds after which a Siconos run is stopped and recorded as failed (the time spent)."""
+"""Seconds after which a run, impactqp's or Siconos', is stopped and recorded as failed."""
 READ_ALLOWANCE = 10.0
 """Seconds Siconos is given beyond :data:`TIME_LIMIT` and the repeats to read a file."""
 WORKER = Path(__file__).with_name("siconos_worker.py")
@@ -65,27 +67,57 @@ PEER_NOTE = ("fc3d_driver from r = 0 (tol 1e-8, ≤ 1e5 iterations), W sparse-bl
              "by impactqp's certify_friction from Siconos' r")
 
 
-def _timed(run: Callable[[], Any], budget: float,
-           max_repeats: int) -> tuple[Any, list[float], Exception | None]:
-    """The rule of both sides: the first run counts alone when it takes the budget (a
-    solve of seconds needs no warm-up), else it is the warm-up and timed repeats follow.
-    Returns the first run's answer, the times, and the exception a run raised (its time
-    is then the time spent)."""
+def _child(conn: Any, method: Callable[[Any], Any], problem: Any) -> None:
+    """Run ``method(problem)`` once in a forked process; send back its seconds and r, u
+    (or the exception's text)."""
     t0 = time.perf_counter()
     try:
-        first = run()
+        result = method(problem)
+        conn.send(("ok", time.perf_counter() - t0, result.r, result.u, result.backend))
     except Exception as exc:  # e.g. CertificateError: a failure with its time spent
-        return None, [time.perf_counter() - t0], exc
-    seconds = time.perf_counter() - t0
-    if seconds >= budget:
-        return first, [seconds], None
+        conn.send(("error", time.perf_counter() - t0, f"{type(exc).__name__}: {exc}"))
+    conn.close()
+
+
+def first_run(method: Callable[[Any], Any], problem: Any,
+              limit: float = TIME_LIMIT) -> tuple[str, float, Any]:
+    """The first (timed) run of an impactqp method, in a forked copy of this process (its
+    compiled kernels included) that is stopped after ``limit`` seconds, as Siconos' runs.
+
+    Returns
+    -------
+    ("ok", seconds, (r, u, route)), ("error", seconds, message) or ("stopped", limit, "")
+    """
+    ctx = multiprocessing.get_context("fork")
+    receive, send = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_child, args=(send, method, problem), daemon=True)
+    proc.start()
+    send.close()
+    try:
+        if not receive.poll(limit):
+            proc.kill()
+            return "stopped", limit, ""
+        try:
+            status, seconds, *rest = receive.recv()
+        except EOFError:  # the child died without a word
+            return "error", limit, f"the solving process died (exit {proc.exitcode})"
+    finally:
+        proc.join()
+        receive.close()
+    return (status, seconds, tuple(rest)) if status == "ok" else (status, seconds, rest[0])
+
+
+def _repeat(run: Callable[[], Any], budget: float, max_repeats: int) -> list[float]:
+    """One untimed warm-up of a quick solve, then timed repeats until ``budget`` seconds or
+    ``max_repeats`` runs."""
+    run()
     times: list[float] = []
     start = time.perf_counter()
     while len(times) < max_repeats and (not times or time.perf_counter() - start < budget):
         t0 = time.perf_counter()
         run()
         times.append(time.perf_counter() - t0)
-    return first, times, None
+    return times
 
 
 def verdict(cert: FrictionCertificate) -> tuple[str, str]:
@@ -108,19 +140,29 @@ def warm_up() -> None:
 
 
 def run_impactqp(case: FrictionCase, *, budget: float, max_repeats: int) -> list[dict]:
-    """One row per method of :data:`IQ_METHODS` on ``case``."""
+    """One row per method of :data:`IQ_METHODS` on ``case``: the first run counts alone when
+    it takes the budget (a solve of seconds needs no warm-up; one stopped at
+    :data:`TIME_LIMIT` fails), else it is the warm-up and timed repeats follow — the rule of
+    Siconos' side too."""
     rows = []
     for name, method in IQ_METHODS.items():
         with quiet_stdout():
-            result, times, exc = _timed(lambda m=method: m(case.problem), budget, max_repeats)
-        if exc is not None:
-            rows.append(_row(case, name, "impactqp", "failed", times, None,
-                             f"{type(exc).__name__}: {exc}", IQ_NOTE))
+            status, seconds, out = first_run(method, case.problem)
+            times = [seconds]
+            if status == "ok" and seconds < budget:
+                try:
+                    times = _repeat(lambda m=method: m(case.problem), budget, max_repeats)
+                except Exception as exc:  # solved in the child, not here: a failure
+                    status, out = "error", f"{type(exc).__name__}: {exc}"
+        if status != "ok":
+            message = out or f"stopped after {seconds:g} s"
+            rows.append(_row(case, name, "impactqp", "failed", times, None, message, IQ_NOTE))
             continue
-        cert = certify_friction(case.problem, result.r, result.u, tol=TOL)
+        r, u, route = out
+        cert = certify_friction(case.problem, r, u, tol=TOL)
         status, message = verdict(cert)
         rows.append(_row(case, name, "impactqp", status, times, cert.error,
-                         message or f"route {result.backend}", IQ_NOTE))
+                         message or f"route {route}", IQ_NOTE))
     return rows
 
 

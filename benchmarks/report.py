@@ -484,5 +484,6 @@ def write_all(records: list[dict], out_dir: Path, meta: dict) -> list[dict]:
                                                       "records": raw}, indent=1))
     (out_dir / "summary.md").write_text(summary_markdown(rows, meta))
     plot(rows, out_dir / "plot.png")
-    friction_report.plot(rows, out_dir / friction_report.PROFILE_PNG)
+    if not friction_report.plot(rows, out_dir / friction_report.PROFILE_PNG):
+        (out_dir / friction_report.PROFILE_PNG).unlink(missing_ok=True)  # not a stale one
     return rows

@@ -464,3 +464,25 @@ def test_siconos_server_stops_when_silent(tmp_path):
     with pytest.raises(TimeoutError, match="no answer within 0.5 s"):
         server.request({"x": 1}, timeout=0.5)
     assert not server.alive
+
+
+def test_impactqp_runs_are_stopped_at_the_limit():
+    import time
+
+    import impactqp as iq
+    from benchmarks.friction import first_run
+
+    def slow(problem):
+        time.sleep(30)
+
+    def broken(problem):
+        raise iq.CertificateError("no method certified it")
+
+    p = iq.FrictionContactProblem([[1.0, 0, 0], [0, 2.0, 0], [0, 0, 2.0]], [-1.0, 2.0, 0.0],
+                                  0.5)
+    assert first_run(slow, p, limit=0.5) == ("stopped", 0.5, "")
+    status, seconds, message = first_run(broken, p)
+    assert status == "error" and "CertificateError: no method" in message and seconds < 5
+    status, _, (r, u, route) = first_run(iq.solve_friction, p)
+    # sliding (sticking would need r_t = −1, outside the cone): r_n = 1, r_t = −μ r_n
+    assert status == "ok" and abs(r[0] - 1.0) < 1e-9 and abs(r[1] + 0.5) < 1e-9 and route
