@@ -45,11 +45,13 @@ def ratios(times: Mapping[str, Sequence[float]]) -> dict[str, np.ndarray]:
 
 
 def profile(times: Mapping[str, Sequence[float]], taus: Sequence[float]) -> dict[str, np.ndarray]:
-    """ρ_s(τ) for each τ of ``taus``: the fraction of problems with r_ps ≤ τ."""
+    """ρ_s(τ) for each τ of ``taus``: the fraction of problems with r_ps ≤ τ (a failure
+    never counts, not even at τ = ∞: ρ_s(∞) is the fraction s solves)."""
     taus = np.asarray(taus, dtype=float)
     out = {}
     for s, r in ratios(times).items():
-        out[s] = (r[None, :] <= taus[:, None]).mean(axis=1) if r.size else np.zeros(taus.size)
+        within = np.isfinite(r)[None, :] & (r[None, :] <= taus[:, None])  # failures never
+        out[s] = within.mean(axis=1) if r.size else np.zeros(taus.size)
     return out
 
 

@@ -269,10 +269,10 @@ def test_performance_profile_by_hand():
     assert list(r["A"]) == [1.0, 1.0, inf, 3.0]
     assert list(r["B"]) == [1.0, inf, inf, 1.0]
     assert list(r["C"]) == [2.0, 2.0, inf, inf]
-    rho = profile(times, [1.0, 1.9, 2.0, 3.0, 1e9])
-    assert list(rho["A"]) == [0.5, 0.5, 0.5, 0.75, 0.75]  # never p3: all failed there
-    assert list(rho["B"]) == [0.5, 0.5, 0.5, 0.5, 0.5]  # the tie counts for both
-    assert list(rho["C"]) == [0.0, 0.0, 0.5, 0.5, 0.5]
+    rho = profile(times, [1.0, 1.9, 2.0, 3.0, 1e9, inf])
+    assert list(rho["A"]) == [0.5, 0.5, 0.5, 0.75, 0.75, 0.75]  # never p3: all failed there
+    assert list(rho["B"]) == [0.5, 0.5, 0.5, 0.5, 0.5, 0.5]  # the tie counts for both
+    assert list(rho["C"]) == [0.0, 0.0, 0.5, 0.5, 0.5, 0.5]  # ρ(∞): the share solved
     assert list(ratios({"A": [float("nan")], "B": [2.0]})["A"]) == [inf]  # NaN = failed
     grid = tau_grid(times)
     assert grid[0] == 1.0 and 3.0 in grid and grid[-1] >= 10.0
@@ -406,6 +406,7 @@ def test_friction_report_by_hand(tmp_path):
     assert target("Dolan–Moré")[0].startswith("fastest on 2 of 2")
     text = "\n".join(friction_report.markdown(rows))
     assert "| b | 50 |" in text and "2.00 (NSGS failed)" in text and "0.707" in text
+    assert "iq:auto 2/2; iq:nsgs 0/0; siconos:NSGS 0/1." in text  # fastest on / solved
     assert friction_report.plot(rows, tmp_path / "p.png")
     assert (tmp_path / "p.png").read_bytes()[:4] == b"\x89PNG"
     assert not friction_report.plot([], tmp_path / "none.png")
@@ -486,3 +487,30 @@ def test_impactqp_runs_are_stopped_at_the_limit():
     status, _, (r, u, route) = first_run(iq.solve_friction, p)
     # sliding (sticking would need r_t = −1, outside the cone): r_n = 1, r_t = −μ r_n
     assert status == "ok" and abs(r[0] - 1.0) < 1e-9 and abs(r[1] + 0.5) < 1e-9 and route
+
+
+def test_friction_suite_alone_merges_into_earlier_results(tmp_path, monkeypatch, capsys):
+    from benchmarks import friction, friction_impacts
+    from benchmarks.__main__ import main
+    from benchmarks.measure import row
+
+    with pytest.raises(SystemExit) as exc:  # nothing to merge into
+        main(["run", "--suite", "friction", "--merge", "--out", str(tmp_path / "none")])
+    assert exc.value.code == 2 and "--merge needs" in capsys.readouterr().err
+    monkeypatch.setitem(friction.PROBLEMS, "friction", ["LMGC-00046"])
+    monkeypatch.setitem(friction_impacts.SIZES, "friction", ([1], (3, 0.01)))
+    meta = {"suite": "full", "seconds": 9.0, "timing_budget_s": 0.3, "max_repeats": 500,
+            "accurate_below": 1e-6}
+    old = [row("random", 2, "iq:auto", "impactqp", status="ok", times=[1e-5], error=0.0),
+           row("friction:Capsules", 286, "iq:auto", "impactqp", status="ok", times=[1.0])]
+    (tmp_path / "results.json").write_text(json.dumps({"meta": meta, "records": old}))
+    main(["run", "--suite", "friction", "--merge", "--out", str(tmp_path),
+          "--siconos-python", "", "--no-progress"])
+    assert "friction_profile.png" in capsys.readouterr().out
+    data = json.loads((tmp_path / "results.json").read_text())
+    families = {r["family"] for r in data["records"]}
+    assert families == {"random", "friction:LMGC-00046", "friction-impact"}
+    assert data["meta"]["suite"] == "full" and data["meta"]["refreshed"]["suite"] == "friction"
+    text = (tmp_path / "summary.md").read_text()
+    assert "## random" in text and "| LMGC-00046 | 9 |" in text and "## friction-impact" in text
+    assert (tmp_path / "friction_profile.png").read_bytes()[:4] == b"\x89PNG"
