@@ -298,8 +298,14 @@ def summary_markdown(rows: list[dict], meta: dict) -> str:
              f"✗k/n = only k of n runs succeeded (error ≤ {meta['accurate_below']:g}, no "
              "exception). `skip` = size cap or not applicable (see results.csv). peak_mb in "
              "results.csv (cases with max(n, m) or k ≥ 10⁴): tracemalloc peak of the warm-up "
-             "run, Python/numpy allocations only (native solver memory is not seen).", "",
-             "## Targets", "", "| target | measured | verdict |", "|---|---|---|"]
+             "run, Python/numpy allocations only (native solver memory is not seen).", ""]
+    if meta.get("friction_seconds"):
+        lines += [f"The friction suite took {meta['friction_seconds']} s of it.", ""]
+    if meta.get("refreshed"):
+        fresh = meta["refreshed"]
+        lines += [f"Rows of {', '.join(fresh['families'])} refreshed since by a "
+                  f"`{fresh['suite']}` run of {fresh['seconds']} s.", ""]
+    lines += ["## Targets", "", "| target | measured | verdict |", "|---|---|---|"]
     found = targets(rows)
     lines += [f"| {t} | {m} | {v} |" for t, m, v in found]
     missed = dict.fromkeys(t.split(":")[0] for t, _, v in found

@@ -513,4 +513,6 @@ def test_friction_suite_alone_merges_into_earlier_results(tmp_path, monkeypatch,
     assert data["meta"]["suite"] == "full" and data["meta"]["refreshed"]["suite"] == "friction"
     text = (tmp_path / "summary.md").read_text()
     assert "## random" in text and "| LMGC-00046 | 9 |" in text and "## friction-impact" in text
+    assert "Rows of friction-impact, friction:LMGC-00046 refreshed since by a `friction` run" \
+        in text
     assert (tmp_path / "friction_profile.png").read_bytes()[:4] == b"\x89PNG"
