@@ -18,6 +18,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -107,12 +108,13 @@ def spheres_in_a_row(n: int, *, seed: int = 0, mu: float = MU) -> SphereImpact:
 Prepare = Callable[[SphereImpact], Callable[[], Any]]
 METHODS: dict[str, Prepare] = {
     "iq:solve_friction": lambda c: lambda: iq.solve_friction(c.local),
+    "iq:solve(Coulomb)": lambda c: partial(iq.solve, iq.ImpactProblem(
+        c.M, c.H, c.v_minus, contact_dim=3), iq.Coulomb(c.mu)),
     "iq:moreau (frictionless)": lambda c: lambda: iq.moreau(c.normal, 0.0),
 }
 """Per method, ``prepare(case)`` → the timed call (its result: an error attribute, if any,
-is the row's error). A new method is one more entry, e.g. the frictional impact law:
-``"iq:Coulomb": lambda c: partial(iq.solve, iq.ImpactProblem(c.M, c.H, c.v_minus,
-contact_dim=3), iq.Coulomb(c.mu))``."""
+is the row's error). ``iq:solve(Coulomb)`` is the whole impact law through the pipeline
+(local problem, solve, u⁺ and the law's certificate), the problem built untimed."""
 REFERENCE = "each answer's own certificate (error: ABH of solve_friction's)"
 NOTE = ("spheres in a row on a plane (2n − 1 contacts, μ = 0.3, restitution 0): the call "
         "alone, problem built before; iq:solve_friction on W = HᵀM⁻¹H, q = Hᵀv⁻; "
