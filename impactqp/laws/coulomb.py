@@ -14,10 +14,9 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..base.arrays import as_array
-from ..errors import CertificateError, InputError, RestitutionError
+from ..errors import CertificateError, InputError, NonFiniteError, RestitutionError
 from ..model.admissible import AdmissibleSet
 from ..model.friction import FrictionContactProblem, certify_friction
 from ..model.friction_admissible import friction_coefficients
@@ -60,14 +59,12 @@ def local_problem(structure: ImpactStructure, u_minus: np.ndarray, mu: np.ndarra
     d = structure.contact_dim
     q = np.array(structure.Wt_times(u_minus), dtype=float)
     q[::d] *= 1.0 + restitution
-    s = np.repeat(np.sqrt(structure.delassus_diagonal[::d]), d)
-    G = structure.delassus
-    if sp.issparse(G):
-        D = sp.diags(1.0 / s)
-        G = sp.csc_matrix(D @ G @ D)
-    else:
-        G = G / np.outer(s, s)
-    return FrictionContactProblem(G, q / s, mu, contact_dim=d), s
+    G, s = structure.contact_delassus
+    q /= s
+    if not np.isfinite(q).all():
+        raise NonFiniteError("the local problem's free velocity q is not finite: u⁻ is "
+                             "beyond the floats in the contacts' units")
+    return FrictionContactProblem.of_checked(G, q, mu, d), s
 
 
 def _coefficient(name: str, value: Any) -> np.ndarray:

@@ -292,6 +292,18 @@ class ImpactStructure:
         return 0.5 * (G + G.T)
 
     @cached_property
+    def contact_delassus(self) -> tuple[Matrix, np.ndarray]:
+        """(G̃, s), kept: G in each frictional contact's own unit, G̃ = D G D with
+        D = diag(1/s) and sᵢ = √G_nn of the contact of entry i (docs/theory.md §16)."""
+        d = self.contact_dim
+        s = np.repeat(np.sqrt(self.delassus_diagonal[::d]), d)
+        G = self.delassus
+        if sp.issparse(G):
+            D = sp.diags(1.0 / s)
+            return sp.csc_matrix(D @ G @ D), s
+        return G / np.outer(s, s), s
+
+    @cached_property
     def full_column_rank(self) -> bool:
         """W has independent columns, so the Λ of M(u⁺ − u⁻) = WΛ is unique."""
         return self.m <= self.n and int(np.linalg.matrix_rank(as_dense(self.W))) == self.m
