@@ -69,11 +69,14 @@ def test_z_is_always_in_S(p, eps):
     # classification of Moreau points: α = 0, dissipation = ε (when there is an impact)
     r = iq.moreau(p, eps)
     c = r.classification
-    # dissipation is √(⟨u⁺ − z, u⁺ + z⟩/‖z⊥‖²): a round-off δ of u⁺ moves it by about
-    # √(δV)/‖z⊥‖ near ε = 0, so the 1e-6 check needs an impact that is not tiny against u⁻
-    if p.norm(r.z_perp) > 1e-3 * p.velocity_scale:
+    # dissipation is √(⟨u⁺ − z, u⁺ + z⟩/‖z⊥‖²): a round-off δ ≈ 1e-16·V of u⁺ moves it by
+    # up to √(2δV)/‖z⊥‖ ≈ 1.5e-8·V/‖z⊥‖ near ε = 0 (the square root's slope is infinite
+    # there), so the check allows that beside 1e-6 on every impact
+    zp = p.norm(r.z_perp) / p.velocity_scale
+    if zp > 1e-3:
         assert c.alpha_deg < 1e-3
-        assert abs(c.dissipation - eps) < 1e-6
+    if zp > 0 and c.intensity > 0:  # an impact (without one, the dissipation is NaN)
+        assert abs(c.dissipation - eps) < 1e-6 + 1e-7 / zp
 
 
 def test_inconsistent_velocity_moreau_can_leave_S_and_says_so():
