@@ -166,14 +166,14 @@ def read_simulation(path: Path) -> tuple[LinearSystem, ImpactLaw, dict[str, Any]
         raise ProblemFileError(f"{path}: {exc}") from exc
 
 
-def check_scheme(system: LinearSystem, scheme: Any) -> None:
-    """ProblemFileError for an unknown scheme, or for the event-driven scheme on a system
-    with friction columns (only Moreau–Jean time-stepping has friction, docs/theory.md
-    §17)."""
+def check_scheme(system: LinearSystem, scheme: Any, where: str = "simulation.scheme") -> None:
+    """ProblemFileError, naming ``where`` (the file's key or a command-line option), for an
+    unknown scheme, or for the event-driven scheme on a system with friction columns (only
+    Moreau–Jean time-stepping has friction, docs/theory.md §17)."""
     if scheme not in SCHEMES:
-        raise ProblemFileError(f"simulation.scheme must be one of {SCHEMES}, got {scheme!r}")
+        raise ProblemFileError(f"{where} must be one of {SCHEMES}, got {scheme!r}")
     if scheme != "moreau-jean" and system.contact_dim > 1:
-        raise ProblemFileError(f"simulation.scheme = {scheme!r} has no friction, and the "
+        raise ProblemFileError(f"{where} = {scheme!r} has no friction, and the "
                                f"system has contact_dim = {system.contact_dim}: simulate it "
                                "with scheme = 'moreau-jean'")
 
@@ -185,8 +185,18 @@ def _content(data: Any) -> tuple[LinearSystem, ImpactLaw, dict[str, Any]]:
     for key in ("system", "law", "simulation"):
         if key not in top:
             raise ProblemFileError(f"missing table [{key}]")
-    system = _system(top["system"])
-    law = _law(top["law"], system)
+    try:
+        system = _system(top["system"])
+    except ProblemFileError:
+        raise
+    except InputError as exc:
+        raise ProblemFileError(f"[system]: {exc}") from exc
+    try:
+        law = _law(top["law"], system)
+    except ProblemFileError:
+        raise
+    except InputError as exc:
+        raise ProblemFileError(f"[law]: {exc}") from exc
     sim = {k: _value(f"simulation.{k}", v) for k, v in
            _table(top["simulation"], "[simulation]", SIMULATION).items()}
     if "t_end" not in sim:

@@ -50,7 +50,8 @@ def run(args: argparse.Namespace) -> int:
     for flag, key in (("scheme", "scheme"), ("t_end", "t_end"), ("h", "h")):
         if getattr(args, flag) is not None:
             sim[key] = getattr(args, flag)
-    check_scheme(system, sim.get("scheme", "moreau-jean"))
+    check_scheme(system, sim.get("scheme", "moreau-jean"),
+                 "--scheme" if args.scheme is not None else "simulation.scheme")
     if "t_end" not in sim:
         raise ProblemFileError(f"{args.file}: [simulation] needs t_end (or pass --t-end)")
     t0, t_end = as_real("simulation.t0", sim.get("t0", 0.0)), as_real("simulation.t_end",
