@@ -1,6 +1,7 @@
-"""The law of a problem file (:mod:`impactqp.io.files`): which names and coefficient keys
-go together, the coefficients read for a problem's contacts, and frictional laws on
-frictional contacts only (docs/theory.md §16)."""
+"""The law of a problem or simulation file (:mod:`impactqp.io.files`,
+:mod:`impactqp.io.simulation_files`): which names and coefficient keys go together, the
+coefficients read for a problem's or a system's contacts, and frictional laws on frictional
+contacts only (docs/theory.md §16, §17)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,6 @@ from ..laws.catalogue import NAMED_LAWS
 from ..laws.complementarity import check_restitution
 from ..laws.moreau import check_eps
 from ..model.friction_admissible import friction_coefficients
-from ..model.problem import ImpactProblem
 
 LAWS = tuple(NAMED_LAWS)
 COEFFICIENT_KEYS: dict[str, tuple[str, ...]] = {
@@ -25,16 +25,17 @@ KNOWN_COEFFICIENTS: dict[str, tuple[str, ...]] = {
 """Each coefficient key and the laws it goes with (``e``: newton and coulomb)."""
 
 
-def check_friction(law: str | None, problem: ImpactProblem) -> None:
-    """A frictional law on frictional contacts, a frictionless one on frictionless ones
-    (ProblemFileError otherwise)."""
+def check_friction(law: str | None, contact_dim: int, matrix: str = "W") -> None:
+    """A frictional law on frictional contacts (``contact_dim`` 2 or 3), a frictionless one
+    on frictionless ones (ProblemFileError otherwise, naming ``matrix``, the columns of the
+    contacts: W of a problem file, H of a simulation file)."""
     if law is None:
         return
-    d = problem.contact_dim
+    d = contact_dim
     if NAMED_LAWS[law].frictional and d == 1:
         raise ProblemFileError(f"law {law!r} needs frictional contacts: set contact_dim = 2 "
-                               "or 3 with d columns of W per contact (for frictionless "
-                               "contacts use law 'newton')")
+                               f"or 3 with d columns of {matrix} per contact (for "
+                               "frictionless contacts use law 'newton')")
     if not NAMED_LAWS[law].frictional and d > 1:
         frictional = [n for n, cls in NAMED_LAWS.items() if cls.frictional]
         raise ProblemFileError(f"law {law!r} acts on frictionless contacts, but contact_dim "

@@ -267,7 +267,7 @@ def problem_from_dict(data: Any) -> ProblemFile:
         raise ProblemFileError(f"law must be one of {list(LAWS)}, got {law!r}")
     try:
         problem = _problem(data)
-        check_friction(law, problem)
+        check_friction(law, problem.contact_dim)
         coefficients = read_coefficients(law, _typed_coefficients(data), problem.n_contacts)
         u_plus = (as_vector("u_plus", _vector("u_plus", data["u_plus"]), problem.n_dof)
                   if "u_plus" in data else None)
