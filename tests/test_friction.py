@@ -126,16 +126,21 @@ def test_rank_deficient_W_with_a_known_solution(mu: float) -> None:
 def test_auto_goes_past_a_failed_nsgs() -> None:
     """An ill-conditioned global problem reduced to local form (W = HᵀM⁻¹H, M's masses over
     six decades, μ = 1) where 100 NSGS sweeps and their Newton polish do not certify: ``auto``
-    goes on to Newton from r = 0, and its velocities are those of the SOCP route from zero."""
+    goes on to Newton from r = 0 (W sparse: the general route), or answers in the compiled
+    call (W dense), and both velocities are those of the SOCP route from zero."""
     rng = np.random.default_rng(4)
     m, d = 6, 3
     H = rng.standard_normal((12, m * d))
     W = H.T @ np.diag(np.logspace(0, -6, 12)) @ H
-    problem = iq.FrictionContactProblem(W, H.T @ rng.standard_normal(12), 1.0)
-    auto = iq.solve_friction(problem)
-    assert auto.certificate.ok and auto.backend == "newton"
+    q = H.T @ rng.standard_normal(12)
+    problem = iq.FrictionContactProblem(sp.csr_matrix(W), q, 1.0)
+    general = iq.solve_friction(problem)
+    assert general.certificate.ok and general.backend == "newton"
+    dense = iq.solve_friction(iq.FrictionContactProblem(W, q, 1.0))
+    assert dense.certificate.ok and dense.backend == "kernel"
     cold = iq.solve_friction(problem, backend="clarabel")
-    np.testing.assert_allclose(auto.u, cold.u, atol=1e-6 * np.linalg.norm(problem.q))
+    for res in (general, dense):
+        np.testing.assert_allclose(res.u, cold.u, atol=1e-6 * np.linalg.norm(q))
 
 
 def test_sparse_W_gives_the_dense_answer() -> None:

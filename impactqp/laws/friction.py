@@ -21,7 +21,14 @@ import scipy.sparse.linalg as spla
 
 from ..base.arrays import check_tol
 from ..errors import CertificateError, InputError, SolverError
-from ..kernels.friction import alart_curnier, modified_velocity, natural_map, nsgs, project_cones
+from ..kernels.friction import (
+    alart_curnier,
+    modified_velocity,
+    natural_map,
+    nsgs,
+    project_cones,
+    solve_small,
+)
 from ..model.friction import FrictionCertificate, FrictionContactProblem, certify_friction
 from ..qp.backends.clarabel_ import run as run_clarabel
 
@@ -52,6 +59,9 @@ NSGS_SWEEPS = 20000
 """Most sweeps of the projected Gauss–Seidel."""
 NSGS_SHORT = 100
 """Sweeps of the projected Gauss–Seidel that ``auto`` tries first (cheap where it works)."""
+SMALL_CONTACTS = 16
+"""Most contacts of a dense W that ``auto`` first solves in one compiled call
+(:func:`impactqp.kernels.friction.solve_small`: dense Newton and NSGS, no cone program)."""
 
 
 @dataclass(frozen=True)
@@ -117,6 +127,10 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
         raise InputError(f"backend must be one of {', '.join(FRICTION_BACKENDS)}, got "
                          f"{backend!r}")
     start = time.perf_counter()
+    if backend == "auto" and problem.n_contacts <= SMALL_CONTACTS and not sp.issparse(problem.W):
+        small = _solve_small(problem, tol, start)
+        if small is not None:
+            return small
     data = _Data(problem)
     methods = {"auto": AUTO, "newton": ("newton", "newton-damped"), "clarabel": ("clarabel",),
                "nsgs": ("nsgs",)}[backend]
@@ -154,9 +168,34 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
                            f"{tol:.0e}: " + "; ".join(failures))
 
 
+def _solve_small(problem: FrictionContactProblem, tol: float,
+                 start: float) -> FrictionResult | None:
+    """The certified answer of :func:`impactqp.kernels.friction.solve_small`, or None to go on
+    to the general route."""
+    W = np.ascontiguousarray(problem.W, dtype=float)
+    r = np.empty_like(problem.q)
+    its, ok = solve_small(W, problem.q, problem.mu, _scales(W.diagonal(), problem.contact_dim),
+                          problem.contact_dim, tol, r, NEWTON_STEPS, NSGS_SHORT)
+    if not ok:
+        return None
+    u = problem.velocity(r)
+    cert = certify_friction(problem, r, u, tol=tol)
+    if not cert.ok:
+        return None
+    return FrictionResult(r, u, cert.error, cert, int(its), time.perf_counter() - start,
+                          "kernel")
+
+
+def _scales(diagonal: np.ndarray, d: int) -> np.ndarray:
+    """ρ_c of each contact's Alart–Curnier function: 1 over the mean of W_cc's diagonal
+    (1 where that mean is not positive)."""
+    mean = diagonal.reshape(-1, d).mean(axis=1)
+    return 1.0 / np.where(mean > 0.0, mean, 1.0)
+
+
 class _Data:
     """The problem's arrays as the solvers use them: W as compressed rows, the scale ρ_c of
-    each contact's Alart–Curnier function (1 over the mean of W_cc's diagonal)."""
+    each contact's Alart–Curnier function (:func:`_scales`)."""
 
     def __init__(self, problem: FrictionContactProblem) -> None:
         self.W = sp.csr_matrix(problem.W, dtype=float)
@@ -166,8 +205,7 @@ class _Data:
         self.d = problem.contact_dim
         self.n = self.q.size
         self.qn = float(np.linalg.norm(self.q)) or 1.0
-        diag = self.W.diagonal().reshape(-1, self.d).mean(axis=1)
-        self.rho = 1.0 / np.where(diag > 0.0, diag, 1.0)
+        self.rho = _scales(self.W.diagonal(), self.d)
 
     def velocity(self, r: np.ndarray) -> np.ndarray:
         """u = W r + q."""
