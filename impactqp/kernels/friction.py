@@ -408,7 +408,7 @@ def _accept(W, q, mu, d, r, tol):
 
 
 @kernel
-def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps):
+def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
     """A local problem of a few contacts (dense W) in one compiled call, into ``r``: Newton
     from r = 0, then NSGS followed by Newton, then the damped Newton (shift factor 10) from
     r = 0 — the order of ``auto`` without the cone programs (docs/theory.md §15).
@@ -425,7 +425,7 @@ def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps):
     for i in range(n):
         for j in range(n):
             indices[i * n + j] = j
-    done, _ = nsgs(indptr, indices, W.ravel(), q, mu, d, r, 0.5 * tol, sweeps, 100)
+    done, _ = nsgs(indptr, indices, W.ravel(), q, mu, d, r, 0.5 * tol, sweeps, local_iters)
     its += done
     if _accept(W, q, mu, d, r, tol):
         return its, True
