@@ -56,7 +56,7 @@ def test_one_contact_closed_forms(case, backend: str) -> None:
     res = iq.solve_friction(problem, backend=backend)
     assert res.certificate.ok and res.error <= 1e-8
     np.testing.assert_allclose(res.r, r, atol=1e-8)
-    np.testing.assert_allclose(res.u, u, atol=1e-8)
+    np.testing.assert_allclose(res.u, u, atol=1e-8 * np.linalg.norm(q))  # ABH: ‖F‖ ≤ tol‖q‖
 
 
 def test_sliding_reaction_on_the_cone_opposite_to_the_slip() -> None:
@@ -123,11 +123,10 @@ def test_rank_deficient_W_with_a_known_solution(mu: float) -> None:
             np.testing.assert_allclose(res.u, u, atol=1e-6 * qn)
 
 
-def test_auto_goes_past_a_failed_nsgs() -> None:
+def test_ill_conditioned_problem_general_route_and_kernel() -> None:
     """An ill-conditioned global problem reduced to local form (W = HᵀM⁻¹H, M's masses over
-    six decades, μ = 1) where 100 NSGS sweeps and their Newton polish do not certify: ``auto``
-    goes on to Newton from r = 0 (W sparse: the general route), or answers in the compiled
-    call (W dense), and both velocities are those of the SOCP route from zero."""
+    six decades, μ = 1): ``auto`` by the general route (W sparse) and by the compiled call
+    (W dense) certify velocities that are those of the SOCP route from zero."""
     rng = np.random.default_rng(4)
     m, d = 6, 3
     H = rng.standard_normal((12, m * d))
@@ -135,7 +134,7 @@ def test_auto_goes_past_a_failed_nsgs() -> None:
     q = H.T @ rng.standard_normal(12)
     problem = iq.FrictionContactProblem(sp.csr_matrix(W), q, 1.0)
     general = iq.solve_friction(problem)
-    assert general.certificate.ok and general.backend == "newton"
+    assert general.certificate.ok and general.backend != "kernel"
     dense = iq.solve_friction(iq.FrictionContactProblem(W, q, 1.0))
     assert dense.certificate.ok and dense.backend == "kernel"
     cold = iq.solve_friction(problem, backend="clarabel")
