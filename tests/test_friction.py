@@ -10,15 +10,18 @@ import scipy.sparse as sp
 
 import impactqp as iq
 from impactqp.kernels.friction import (
+    alart_curnier,
+    lu_solve,
     modified_velocity,
     modified_velocity_jacobian,
     natural_map,
     project_cones,
     projection_jacobian,
+    solve_small,
 )
 from impactqp.model.friction import certify_friction
 
-BACKENDS = ("auto", "clarabel", "nsgs")
+BACKENDS = ("auto", "newton", "clarabel", "nsgs")
 
 
 def random_problem(m: int, d: int, mu: float, seed: int, skew: float = 0.0):
@@ -57,6 +60,27 @@ def test_one_contact_closed_forms(case, backend: str) -> None:
     assert res.certificate.ok and res.error <= 1e-8
     np.testing.assert_allclose(res.r, r, atol=1e-8)
     np.testing.assert_allclose(res.u, u, atol=1e-8 * np.linalg.norm(q))  # ABH: ‖F‖ ≤ tol‖q‖
+
+
+@pytest.mark.parametrize("case", CLOSED)
+def test_one_contact_closed_forms_in_the_compiled_call(case) -> None:
+    """A dense W of one contact is answered by the compiled call, to the closed form; the
+    Alart–Curnier function vanishes at the closed form and not beside it."""
+    w, q, mu, r, u = case
+    d = len(q)
+    problem = iq.FrictionContactProblem(np.diag(w), q, mu, contact_dim=d)
+    res = iq.solve_friction(problem)
+    assert res.backend == "kernel" and res.certificate.ok
+    np.testing.assert_allclose(res.r, r, atol=1e-8)
+    mus, rho = np.array([mu]), np.array([1.0 / np.mean(w)])
+    A, B = np.empty((1, d, d)), np.empty((1, d, d))
+    zero = alart_curnier(np.array(r, float), np.array(u, float), mus, rho, d, False, A, B)
+    np.testing.assert_allclose(zero, 0.0, atol=1e-15)
+    for j in range(d):
+        bad = np.array(r, float)
+        bad[j] += 1e-3
+        ub = np.diag(w) @ bad + q
+        assert np.linalg.norm(alart_curnier(bad, ub, mus, rho, d, False, A, B)) > 1e-5
 
 
 def test_sliding_reaction_on_the_cone_opposite_to_the_slip() -> None:
@@ -140,6 +164,34 @@ def test_ill_conditioned_problem_general_route_and_kernel() -> None:
     cold = iq.solve_friction(problem, backend="clarabel")
     for res in (general, dense):
         np.testing.assert_allclose(res.u, cold.u, atol=1e-6 * np.linalg.norm(q))
+
+
+@pytest.mark.parametrize("m", [1, 2, 4, 9])
+@pytest.mark.parametrize("d", [2, 3])
+def test_compiled_call_agrees_with_the_general_route(m: int, d: int) -> None:
+    """Dense W (the compiled call) against the same problem with W sparse (the general
+    route) and the SOCP route: the velocities agree."""
+    for seed in range(3):
+        dense = random_problem(m, d, [0.1, 0.5, 1.0][seed], seed=40 + seed, skew=0.01 * seed)
+        sparse = iq.FrictionContactProblem(sp.csr_matrix(dense.W), dense.q, dense.mu,
+                                           contact_dim=d)
+        qn = np.linalg.norm(dense.q)
+        a, b = iq.solve_friction(dense), iq.solve_friction(sparse)
+        c = iq.solve_friction(dense, backend="clarabel")
+        assert a.backend == "kernel" and b.backend != "kernel"
+        assert a.certificate.ok and b.certificate.ok
+        np.testing.assert_allclose(a.u, b.u, atol=1e-6 * qn)
+        np.testing.assert_allclose(a.u, c.u, atol=1e-6 * qn)
+
+
+def test_compiled_call_refuses_a_problem_without_solution() -> None:
+    """W = 0 and q_n < 0: the compiled call says it did not get there (and the general route
+    then raises, see below); its r is no answer."""
+    W, q, mu = np.zeros((3, 3)), np.array([-1.0, 0.0, 0.0]), np.array([0.5])
+    r = np.empty(3)
+    _, ok = solve_small(W, q, mu, np.ones(1), 3, 1e-8, r, 50, 100, 10)
+    assert not ok
+    assert not certify_friction(iq.FrictionContactProblem(W, q, mu), r).ok
 
 
 def test_sparse_W_gives_the_dense_answer() -> None:
@@ -233,6 +285,41 @@ def test_jacobians_match_finite_differences(d: int) -> None:
             e[j::d] = h
             fd = (f(x + e, mu, d) - f(x - e, mu, d)).reshape(m, d) / (2 * h)
             np.testing.assert_allclose(J[:, :, j], fd, atol=1e-6)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_alart_curnier_jacobian_matches_finite_differences(d: int) -> None:
+    """dΦ/dr = A + B W (A, B the kernel's blocks) against central differences of
+    r ↦ Φ(r, W r + q), at points where every contact is off its kinks."""
+    rng = np.random.default_rng(30 + d)
+    m = 40
+    problem = random_problem(m, d, 0.5, seed=d, skew=0.05)
+    W, q = problem.W, problem.q
+    mu = rng.uniform(0.1, 1.5, m)
+    rho = rng.uniform(0.5, 2.0, m)
+    r = rng.standard_normal(m * d)
+    A, B = np.empty((m, d, d)), np.empty((m, d, d))
+    alart_curnier(r, W @ r + q, mu, rho, d, True, A, B)
+    J = sp.block_diag(list(A)).toarray() + sp.block_diag(list(B)).toarray() @ W
+    h = 1e-7
+    for j in range(m * d):
+        e = np.zeros(m * d)
+        e[j] = h
+        up, down = r + e, r - e
+        fd = (alart_curnier(up, W @ up + q, mu, rho, d, False, A, B)
+              - alart_curnier(down, W @ down + q, mu, rho, d, False, A, B)) / (2 * h)
+        np.testing.assert_allclose(J[:, j], fd, atol=1e-6)
+
+
+def test_lu_solve_against_numpy() -> None:
+    rng = np.random.default_rng(8)
+    for n in (1, 3, 12):
+        J = rng.standard_normal((n, n))
+        b = rng.standard_normal(n)
+        x = b.copy()
+        assert lu_solve(J.copy(), x)
+        np.testing.assert_allclose(x, np.linalg.solve(J, b), rtol=1e-10, atol=1e-12)
+    assert not lu_solve(np.zeros((2, 2)), np.ones(2))
 
 
 def test_natural_map_vanishes_at_a_solution_only() -> None:
