@@ -11,14 +11,13 @@ import scipy.sparse as sp
 import impactqp as iq
 from impactqp.kernels.friction import (
     alart_curnier,
-    lu_solve,
     modified_velocity,
     modified_velocity_jacobian,
     natural_map,
     project_cones,
     projection_jacobian,
-    solve_small,
 )
+from impactqp.kernels.friction_newton import lu_solve, solve_small
 from impactqp.model.friction import certify_friction
 
 BACKENDS = ("auto", "newton", "clarabel", "nsgs")

@@ -25,10 +25,10 @@ from ..kernels.friction import (
     alart_curnier,
     modified_velocity,
     natural_map,
-    nsgs,
+    nsgs_rows,
     project_cones,
-    solve_small,
 )
+from ..kernels.friction_newton import solve_small
 from ..model.friction import FrictionCertificate, FrictionContactProblem, certify_friction
 from ..qp.backends.clarabel_ import run as run_clarabel
 
@@ -64,7 +64,8 @@ NSGS_LOCAL = 10
 wasted while the other contacts still move: 100 made the sweeps 3 to 5 times slower)."""
 SMALL_CONTACTS = 16
 """Most contacts of a dense W that ``auto`` first solves in one compiled call
-(:func:`impactqp.kernels.friction.solve_small`: dense Newton and NSGS, no cone program)."""
+(:func:`impactqp.kernels.friction_newton.solve_small`: dense Newton and NSGS, no cone
+program)."""
 
 
 @dataclass(frozen=True)
@@ -173,8 +174,8 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
 
 def _solve_small(problem: FrictionContactProblem, tol: float,
                  start: float) -> FrictionResult | None:
-    """The certified answer of :func:`impactqp.kernels.friction.solve_small`, or None to go on
-    to the general route."""
+    """The certified answer of :func:`impactqp.kernels.friction_newton.solve_small`, or None
+    to go on to the general route."""
     W = np.ascontiguousarray(problem.W, dtype=float)
     r = np.empty_like(problem.q)
     its, ok = solve_small(W, problem.q, problem.mu, _scales(W.diagonal(), problem.contact_dim),
@@ -299,7 +300,7 @@ def _nsgs_route(data: _Data, r0: np.ndarray, tol: float,
     """The compiled projected Gauss–Seidel from r0 to the tolerance (or ``sweeps``)."""
     r = np.array(r0, dtype=float)
     W = data.W
-    sweeps, _ = nsgs(W.indptr, W.indices, W.data, data.q, data.mu, data.d, r, 0.5 * tol,
+    sweeps, _ = nsgs_rows(W.indptr, W.indices, W.data, data.q, data.mu, data.d, r, 0.5 * tol,
                      sweeps, NSGS_LOCAL)
     return r, int(sweeps)
 
