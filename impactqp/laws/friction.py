@@ -49,6 +49,9 @@ SOCP_ROUNDS = 30
 """Most SOCPs of the fixed point on s = μ‖u_T‖."""
 NEWTON_STEPS = 50
 """Most steps of one run of Newton (those that converge here take 5 to 35)."""
+POLISH_STEPS = 20
+"""Most Newton steps after NSGS (where they converge they take fewer than 10; where NSGS
+failed, Newton from there tends to fail too, and r = 0 is tried next)."""
 NEWTON_SHIFT = {"newton": 1.0, "newton-damped": 10.0}
 """The factor κ of the shift κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²)·I added to Newton's Jacobian by each
 variant: the damped one converges on some problems where the other stalls, and takes more
@@ -155,7 +158,8 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
             failures.append(f"{method}: {exc}")
             continue
         if method not in NEWTON_SHIFT and not polished and data.error(r) > 0.5 * tol:
-            r, its_newton, _ = _newton(data, r, tol)
+            steps = NEWTON_STEPS if method == "clarabel" else POLISH_STEPS
+            r, its_newton, _ = _newton(data, r, tol, max_steps=steps)
             its += its_newton
             polished = True
         name = method + "+newton" if polished else method
@@ -305,15 +309,15 @@ def _nsgs_route(data: _Data, r0: np.ndarray, tol: float,
     return r, int(sweeps)
 
 
-def _newton(data: _Data, r: np.ndarray, tol: float,
-            kappa: float = 1.0) -> tuple[np.ndarray, int, bool]:
+def _newton(data: _Data, r: np.ndarray, tol: float, kappa: float = 1.0,
+            max_steps: int = NEWTON_STEPS) -> tuple[np.ndarray, int, bool]:
     """Semismooth Newton on Alart–Curnier's function Φ (docs/theory.md §15) from r: steps
     (J + λI)Δ = −Φ with J = A + B W (A, B block-diagonal, from
     :func:`impactqp.kernels.friction.alart_curnier`) and λ = κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²) (J is
     singular where W is; the shift vanishes with Φ), by sparse LU, then backtracking on ‖Φ‖.
 
     Stops when the projected r is within tol/2 in ‖F‖/‖q‖ (projecting moves r by up to ‖F‖,
-    hence u by up to ‖W‖‖F‖), after :data:`NEWTON_STEPS`, or when the line search fails.
+    hence u by up to ‖W‖‖F‖), after ``max_steps`` steps, or when the line search fails.
     Returns r projected onto the cones, the steps done, and whether that r is within tol/2
     (the certificate's figure)."""
     W, q, mu, d, rho = data.W, data.q, data.mu, data.d, data.rho
@@ -331,7 +335,7 @@ def _newton(data: _Data, r: np.ndarray, tol: float,
             rp = project_cones(r, mu, d)
             if data.error(rp) <= 0.5 * tol:
                 return rp, steps, True
-        if steps == NEWTON_STEPS:
+        if steps == max_steps:
             break
         steps += 1
         shift = kappa * min(f / (scale or 1.0), 1e-2)
