@@ -88,7 +88,9 @@ class FrictionResult:
     solve_time : float
         Wall-clock seconds.
     backend : str
-        The method that produced the answer, e.g. ``"newton"`` or ``"clarabel+newton"``.
+        The method that produced the answer: one of :data:`AUTO`, with ``"+newton"`` when
+        Newton finished it (e.g. ``"clarabel+newton"``), or ``"kernel"`` (the compiled call
+        of a few contacts)
     """
 
     r: np.ndarray
