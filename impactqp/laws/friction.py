@@ -65,10 +65,11 @@ NSGS_SHORT = 100
 NSGS_LOCAL = 10
 """Most projected fixed-point steps on one contact's local problem per sweep (more are
 wasted while the other contacts still move: 100 made the sweeps 3 to 5 times slower)."""
-SMALL_CONTACTS = 16
+SMALL_CONTACTS = 32
 """Most contacts of a dense W that ``auto`` first solves in one compiled call
 (:func:`impactqp.kernels.friction_newton.solve_small`: dense Newton and NSGS, no cone
-program)."""
+program); on random well-conditioned problems it beats the general route up to ~50 contacts
+(20 contacts: 0.13 ms against 1.3 ms)."""
 
 
 @dataclass(frozen=True)
