@@ -89,9 +89,10 @@ class FrictionResult:
     solve_time : float
         Wall-clock seconds.
     backend : str
-        The method that produced the answer: one of :data:`AUTO`, with ``"+newton"`` when
-        Newton finished it (e.g. ``"clarabel+newton"``), or ``"kernel"`` (the compiled call
-        of a few contacts)
+        The method that produced the answer: ``"nsgs-short"``, ``"newton"``,
+        ``"clarabel"``, ``"newton-damped"`` or ``"nsgs"``, with ``"+newton"`` when Newton
+        finished it (e.g. ``"clarabel+newton"``), or ``"kernel"`` (the compiled call of a
+        few contacts)
     """
 
     r: np.ndarray
