@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .friction import alart_curnier, natural_map, nsgs, project_cones
-from .jit import kernel
+from .jit import inline_kernel, kernel
 
 
 @kernel
@@ -46,10 +46,21 @@ def lu_solve(J, b):
     return True
 
 
+@inline_kernel
+def affine(W, r, q, out):
+    """out = W r + q by plain loops (for the few unknowns here, cheaper than a BLAS call)."""
+    for i in range(q.size):
+        v = q[i]
+        for j in range(r.size):
+            v += W[i, j] * r[j]
+        out[i] = v
+    return out
+
+
 @kernel
 def abh_error(W, q, mu, d, r, qn):
     """‖F(r)‖/qn with u = W r + q (W dense)."""
-    F = natural_map(r, W @ r + q, mu, d)
+    F = natural_map(r, affine(W, r, q, np.empty_like(q)), mu, d)
     return np.sqrt(np.sum(F * F)) / qn
 
 
@@ -70,7 +81,9 @@ def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
     scale = np.sqrt(np.sum(alart_curnier(np.zeros(n), q, mu, rho, d, False, A, B) ** 2))
     if scale == 0.0:
         scale = 1.0
-    u = W @ r + q
+    u = affine(W, r, q, np.empty(n))
+    u_try = np.empty(n)
+    r_try = np.empty(n)
     phi = alart_curnier(r, u, mu, rho, d, True, A, B)
     f = np.sqrt(np.sum(phi * phi))
     steps = 0
@@ -101,8 +114,9 @@ def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
             break
         t = 1.0
         while t > 1e-8:
-            r_try = r + t * step
-            u_try = W @ r_try + q
+            for i in range(n):
+                r_try[i] = r[i] + t * step[i]
+            affine(W, r_try, q, u_try)
             phi_try = alart_curnier(r_try, u_try, mu, rho, d, False, A, B)
             f_try = np.sqrt(np.sum(phi_try * phi_try))
             if f_try <= (1.0 - 1e-4 * t) * f:
@@ -111,7 +125,7 @@ def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
         if not t > 1e-8:
             break  # no descent: stalled
         r[:] = r_try
-        u = u_try
+        u[:] = u_try
         phi = alart_curnier(r, u, mu, rho, d, True, A, B)
         f = f_try
     return steps, False
