@@ -217,6 +217,8 @@ def test_no_solution_is_a_certificate_error() -> None:
     problem = iq.FrictionContactProblem(np.zeros((3, 3)), [-1.0, 0.0, 0.0], 0.5)
     with pytest.raises(iq.CertificateError, match="natural_map|clarabel"):
         iq.solve_friction(problem)
+    with pytest.raises(iq.CertificateError, match="newton-damped: .*natural_map"):
+        iq.solve_friction(problem, backend="newton")
 
 
 # --- the certificate ----------------------------------------------------------------------------
