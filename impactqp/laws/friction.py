@@ -66,7 +66,7 @@ NSGS_LOCAL = 10
 """Most projected fixed-point steps on one contact's local problem per sweep (more are
 wasted while the other contacts still move: 100 made the sweeps 3 to 5 times slower)."""
 SMALL_CONTACTS = 32
-"""Most contacts of a dense W that ``auto`` first solves in one compiled call
+"""Most contacts of a problem that ``auto`` first solves in one compiled call, W made dense
 (:func:`impactqp.kernels.friction_newton.solve_small`: dense Newton and NSGS, no cone
 program); on random well-conditioned problems it beats the general route up to ~50 contacts
 (20 contacts: 0.13 ms against 1.3 ms)."""
@@ -138,7 +138,7 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
         raise InputError(f"backend must be one of {', '.join(FRICTION_BACKENDS)}, got "
                          f"{backend!r}")
     start = time.perf_counter()
-    if backend == "auto" and problem.n_contacts <= SMALL_CONTACTS and not sp.issparse(problem.W):
+    if backend == "auto" and problem.n_contacts <= SMALL_CONTACTS:
         small = _solve_small(problem, tol, start)
         if small is not None:
             return small
@@ -184,7 +184,7 @@ def _solve_small(problem: FrictionContactProblem, tol: float,
                  start: float) -> FrictionResult | None:
     """The certified answer of :func:`impactqp.kernels.friction_newton.solve_small`, or None
     to go on to the general route."""
-    W = np.ascontiguousarray(problem.W, dtype=float)
+    W = np.ascontiguousarray(problem.dense_W(), dtype=float)
     r = np.empty_like(problem.q)
     its, ok = solve_small(W, problem.q, problem.mu, _scales(W.diagonal(), problem.contact_dim),
                           problem.contact_dim, tol, r, NEWTON_STEPS, NSGS_SHORT, NSGS_LOCAL)
