@@ -19,6 +19,7 @@ from impactqp.kernels.friction import (
 )
 from impactqp.kernels.friction_newton import lu_solve, solve_small
 from impactqp.laws import friction as friction_law
+from impactqp.laws import friction_newton
 from impactqp.model.friction import certify_friction
 
 BACKENDS = ("auto", "newton", "clarabel", "nsgs")
@@ -152,6 +153,24 @@ def general_route(problem):
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(friction_law, "SMALL_CONTACTS", 0)
         return iq.solve_friction(problem)
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.5])
+def test_least_squares_newton_agrees_with_newton_on_alart_curnier(mu: float) -> None:
+    """The last-resort least-squares Newton on F and the Newton on Φ, each from a few NSGS
+    sweeps, on a rank-deficient W: both certify, and their velocities agree."""
+    rng = np.random.default_rng(12)
+    m, d = 6, 3
+    H = rng.standard_normal((m * d // 2, m * d))
+    problem = iq.FrictionContactProblem(H.T @ H / 9.0, H.T @ rng.standard_normal(9), mu)
+    data = friction_newton.FrictionData(problem)
+    start = friction_law._nsgs_route(data, np.zeros(m * d), 1e-8, 5)[0]
+    found = [friction_newton.lstsq_newton(data, start, 1e-8),
+             friction_newton.newton(data, start, 1e-8)]
+    for r, _, ok in found:
+        assert ok and certify_friction(problem, r).ok
+    u = [problem.velocity(r) for r, _, _ in found]
+    np.testing.assert_allclose(u[0], u[1], atol=1e-6 * np.linalg.norm(problem.q))
 
 
 def test_ill_conditioned_problem_general_route_and_kernel() -> None:

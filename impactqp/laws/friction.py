@@ -17,20 +17,14 @@ from dataclasses import dataclass
 import clarabel
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..base.arrays import check_tol
 from ..errors import CertificateError, InputError, SolverError
-from ..kernels.friction import (
-    alart_curnier,
-    modified_velocity,
-    natural_map,
-    nsgs_rows,
-    project_cones,
-)
+from ..kernels.friction import modified_velocity, nsgs_rows, project_cones
 from ..kernels.friction_newton import solve_small
 from ..model.friction import FrictionCertificate, FrictionContactProblem, certify_friction
 from ..qp.backends.clarabel_ import run as run_clarabel
+from .friction_newton import LSTSQ_MAX, NEWTON_STEPS, FrictionData, lstsq_newton, newton, scales
 
 __all__ = ["FRICTION_BACKENDS", "FrictionResult", "solve_friction"]
 
@@ -39,16 +33,15 @@ FRICTION_BACKENDS = ("auto", "newton", "clarabel", "nsgs")
 r = 0, then its damped variant), ``clarabel`` (SOCP fixed point, then Newton), ``nsgs``
 (projected Gauss–Seidel, then Newton) and ``auto`` (:data:`AUTO`)."""
 
-AUTO = ("nsgs-short", "newton", "clarabel", "newton-damped", "nsgs")
+AUTO = ("nsgs-short", "newton", "clarabel", "newton-damped", "newton-lstsq", "nsgs")
 """The order in which ``auto`` tries the methods: cheapest where each works first (a short
 NSGS certifies well-conditioned problems in a few sweeps; Newton from r = 0 most of the
-rest; the SOCP route the badly conditioned ones). The SOCP route and the long NSGS start
-from the best answer so far."""
+rest; the SOCP route the badly conditioned ones; the least-squares Newton some
+rank-deficient ones). The SOCP route, the least-squares Newton and the long NSGS start from
+the best answer so far."""
 
 SOCP_ROUNDS = 30
 """Most SOCPs of the fixed point on s = μ‖u_T‖."""
-NEWTON_STEPS = 50
-"""Most steps of one run of Newton (those that converge here take 5 to 35)."""
 POLISH_STEPS = 20
 """Most Newton steps after NSGS (where they converge they take fewer than 10; where NSGS
 failed, Newton from there tends to fail too, and r = 0 is tried next)."""
@@ -90,9 +83,9 @@ class FrictionResult:
         Wall-clock seconds.
     backend : str
         The method that produced the answer: ``"nsgs-short"``, ``"newton"``,
-        ``"clarabel"``, ``"newton-damped"`` or ``"nsgs"``, with ``"+newton"`` when Newton
-        finished it (e.g. ``"clarabel+newton"``), or ``"kernel"`` (the compiled call of a
-        few contacts)
+        ``"clarabel"``, ``"newton-damped"``, ``"newton-lstsq"`` or ``"nsgs"``, with
+        ``"+newton"`` when Newton finished it (e.g. ``"clarabel+newton"``), or ``"kernel"``
+        (the compiled call of a few contacts)
     """
 
     r: np.ndarray
@@ -116,8 +109,9 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     backend : {"auto", "newton", "clarabel", "nsgs"}
         ``newton``: Alart–Curnier semismooth Newton from r = 0; ``clarabel``: the fixed
         point of SOCPs, then Newton; ``nsgs``: projected Gauss–Seidel, then Newton;
-        ``auto``: 100 NSGS sweeps, then Newton from r = 0, then the SOCP route, then a long
-        NSGS, the last two warm-started from the best answer so far.
+        ``auto``: 100 NSGS sweeps, Newton from r = 0, the SOCP route, the damped Newton, the
+        least-squares Newton on the natural map, a long NSGS (docs/theory.md §15); a problem
+        of a few contacts first goes whole to one compiled call.
     tol : float
         Tolerance of the certificate: ‖F‖/‖q‖ ≤ tol among others.
 
@@ -142,7 +136,7 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
         small = _solve_small(problem, tol, start)
         if small is not None:
             return small
-    data = _Data(problem)
+    data = FrictionData(problem)
     methods = {"auto": AUTO, "newton": ("newton", "newton-damped"), "clarabel": ("clarabel",),
                "nsgs": ("nsgs",)}[backend]
     best: FrictionCertificate | None = None
@@ -154,16 +148,21 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
             if method == "clarabel":
                 r, its, polished = _socp_route(data, r_best, tol)
             elif method in NEWTON_SHIFT:
-                r, its, _ = _newton(data, np.zeros_like(data.q), tol, NEWTON_SHIFT[method])
+                r, its, _ = newton(data, np.zeros_like(data.q), tol, NEWTON_SHIFT[method])
+            elif method == "newton-lstsq":
+                if data.n > LSTSQ_MAX:
+                    continue
+                r, its, _ = lstsq_newton(data, r_best, tol)
             else:
                 sweeps = NSGS_SHORT if method == "nsgs-short" else NSGS_SWEEPS
                 r, its = _nsgs_route(data, r_best, tol, sweeps)
         except SolverError as exc:
             failures.append(f"{method}: {exc}")
             continue
-        if method not in NEWTON_SHIFT and not polished and data.error(r) > 0.5 * tol:
+        if method in ("nsgs-short", "clarabel", "nsgs") and not polished \
+                and data.error(r) > 0.5 * tol:
             steps = NEWTON_STEPS if method == "clarabel" else POLISH_STEPS
-            r, its_newton, _ = _newton(data, r, tol, max_steps=steps)
+            r, its_newton, _ = newton(data, r, tol, max_steps=steps)
             its += its_newton
             polished = True
         name = method + "+newton" if polished else method
@@ -186,7 +185,7 @@ def _solve_small(problem: FrictionContactProblem, tol: float,
     to go on to the general route."""
     W = np.ascontiguousarray(problem.dense_W(), dtype=float)
     r = np.empty_like(problem.q)
-    its, ok = solve_small(W, problem.q, problem.mu, _scales(W.diagonal(), problem.contact_dim),
+    its, ok = solve_small(W, problem.q, problem.mu, scales(W.diagonal(), problem.contact_dim),
                           problem.contact_dim, tol, r, NEWTON_STEPS, NSGS_SHORT, NSGS_LOCAL)
     if not ok:
         return None
@@ -196,42 +195,6 @@ def _solve_small(problem: FrictionContactProblem, tol: float,
         return None
     return FrictionResult(r, u, cert.error, cert, int(its), time.perf_counter() - start,
                           "kernel")
-
-
-def _scales(diagonal: np.ndarray, d: int) -> np.ndarray:
-    """ρ_c of each contact's Alart–Curnier function: 1 over the mean of W_cc's diagonal
-    (1 where that mean is not positive)."""
-    mean = diagonal.reshape(-1, d).mean(axis=1)
-    return 1.0 / np.where(mean > 0.0, mean, 1.0)
-
-
-class _Data:
-    """The problem's arrays as the solvers use them: W as compressed rows, the scale ρ_c of
-    each contact's Alart–Curnier function (:func:`_scales`)."""
-
-    def __init__(self, problem: FrictionContactProblem) -> None:
-        if sp.issparse(problem.W):
-            self.W = sp.csr_matrix(problem.W, dtype=float)
-            self.W.sum_duplicates()
-        else:  # every entry stored: no scan for zeros, which costs more than a sweep
-            n = problem.q.size
-            self.W = sp.csr_matrix((np.asarray(problem.W, dtype=float).ravel(),
-                                    np.tile(np.arange(n), n), np.arange(0, n * n + 1, n)),
-                                   shape=(n, n))
-        self.q = problem.q
-        self.mu = problem.mu
-        self.d = problem.contact_dim
-        self.n = self.q.size
-        self.qn = float(np.linalg.norm(self.q)) or 1.0
-        self.rho = _scales(self.W.diagonal(), self.d)
-
-    def velocity(self, r: np.ndarray) -> np.ndarray:
-        """u = W r + q."""
-        return self.W @ r + self.q
-
-    def error(self, r: np.ndarray) -> float:
-        """‖F(r)‖/‖q‖."""
-        return float(np.linalg.norm(natural_map(r, self.velocity(r), self.mu, self.d))) / self.qn
 
 
 def _socp(P: sp.csc_matrix, c: np.ndarray, mu: np.ndarray, d: int) -> np.ndarray:
@@ -265,7 +228,7 @@ def _socp(P: sp.csc_matrix, c: np.ndarray, mu: np.ndarray, d: int) -> np.ndarray
     return np.array(sol.x)
 
 
-def _socp_route(data: _Data, r0: np.ndarray, tol: float) -> tuple[np.ndarray, int, bool]:
+def _socp_route(data: FrictionData, r0: np.ndarray, tol: float) -> tuple[np.ndarray, int, bool]:
     """The fixed point of SOCPs on s = μ‖u_T‖e_n and the skew part of W (lagged), halving
     the change of s when the error grows; from an error of :data:`NEWTON_FROM` on, Newton
     is tried each time the error has fallen tenfold, and its answer returned if it passes.
@@ -290,20 +253,20 @@ def _socp_route(data: _Data, r0: np.ndarray, tol: float) -> tuple[np.ndarray, in
             r = 0.5 * (r + r_new)
         if best_err <= 0.1 * tried:
             tried = best_err
-            r_pol, steps, ok = _newton(data, best_r, tol)
+            r_pol, steps, ok = newton(data, best_r, tol)
             rounds += steps
             if ok:
                 return r_pol, rounds, True
     return best_r, rounds, False
 
 
-def _lag(data: _Data, r: np.ndarray) -> np.ndarray:
+def _lag(data: FrictionData, r: np.ndarray) -> np.ndarray:
     """ũ − u = μ‖u_T‖e_n at u = W r + q: the De Saxcé term the SOCP holds fixed."""
     u = data.velocity(r)
     return modified_velocity(u, data.mu, data.d) - u
 
 
-def _nsgs_route(data: _Data, r0: np.ndarray, tol: float,
+def _nsgs_route(data: FrictionData, r0: np.ndarray, tol: float,
                 sweeps: int) -> tuple[np.ndarray, int]:
     """The compiled projected Gauss–Seidel from r0 to the tolerance (or ``sweeps``)."""
     r = np.array(r0, dtype=float)
@@ -311,56 +274,3 @@ def _nsgs_route(data: _Data, r0: np.ndarray, tol: float,
     sweeps, _ = nsgs_rows(W.indptr, W.indices, W.data, data.q, data.mu, data.d, r, 0.5 * tol,
                      sweeps, NSGS_LOCAL)
     return r, int(sweeps)
-
-
-def _newton(data: _Data, r: np.ndarray, tol: float, kappa: float = 1.0,
-            max_steps: int = NEWTON_STEPS) -> tuple[np.ndarray, int, bool]:
-    """Semismooth Newton on Alart–Curnier's function Φ (docs/theory.md §15) from r: steps
-    (J + λI)Δ = −Φ with J = A + B W (A, B block-diagonal, from
-    :func:`impactqp.kernels.friction.alart_curnier`) and λ = κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²) (J is
-    singular where W is; the shift vanishes with Φ), by sparse LU, then backtracking on ‖Φ‖.
-
-    Stops when the projected r is within tol/2 in ‖F‖/‖q‖ (projecting moves r by up to ‖F‖,
-    hence u by up to ‖W‖‖F‖), after ``max_steps`` steps, or when the line search fails.
-    Returns r projected onto the cones, the steps done, and whether that r is within tol/2
-    (the certificate's figure)."""
-    W, q, mu, d, rho = data.W, data.q, data.mu, data.d, data.rho
-    n, m = data.n, mu.size
-    A = np.empty((m, d, d))
-    B = np.empty((m, d, d))
-    blocks = (np.arange(m), np.arange(m + 1))
-    scale = float(np.linalg.norm(alart_curnier(np.zeros(n), q, mu, rho, d, False, A, B)))
-    u = data.velocity(r)
-    phi = alart_curnier(r, u, mu, rho, d, True, A, B)
-    f = float(np.linalg.norm(phi))
-    steps = 0
-    while True:
-        if np.linalg.norm(natural_map(r, u, mu, d)) <= 0.5 * tol * data.qn:
-            rp = project_cones(r, mu, d)
-            if data.error(rp) <= 0.5 * tol:
-                return rp, steps, True
-        if steps == max_steps:
-            break
-        steps += 1
-        shift = kappa * min(f / (scale or 1.0), 1e-2)
-        J = (sp.bsr_matrix((A, *blocks), shape=(n, n)) + shift * sp.identity(n)
-             + sp.bsr_matrix((B, *blocks), shape=(n, n)) @ W)
-        try:
-            step = spla.splu(sp.csc_matrix(J)).solve(-phi)
-        except RuntimeError:  # an exactly singular J
-            break
-        t = 1.0
-        while t > 1e-8:
-            r_try = r + t * step
-            u_try = data.velocity(r_try)
-            phi_try = alart_curnier(r_try, u_try, mu, rho, d, False, A, B)
-            f_try = float(np.linalg.norm(phi_try))
-            if f_try <= (1.0 - 1e-4 * t) * f:
-                break
-            t *= 0.5
-        else:
-            break  # no descent: stalled
-        r, u = r_try, u_try
-        phi = alart_curnier(r, u, mu, rho, d, True, A, B)
-        f = float(np.linalg.norm(phi))
-    return project_cones(r, mu, d), steps, False
