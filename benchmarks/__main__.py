@@ -1,4 +1,5 @@
-"""``python -m benchmarks run --suite smoke|quick|full [--out DIR] [--n-jobs N]``."""
+"""``python -m benchmarks run --suite smoke|quick|full|friction [--out DIR] [--n-jobs N]
+[--merge]``."""
 
 from __future__ import annotations
 
@@ -33,10 +34,16 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--n-jobs", type=_jobs, default=2,
                      help="local processes of the sweep benchmark, timed against one "
                           "(default 2)")
+    run.add_argument("--merge", action="store_true",
+                     help="replace only this suite's families in the results already in --out "
+                          "(e.g. --suite friction --out benchmarks/reference)")
     args = parser.parse_args(argv)
+    if args.merge and not (args.out / "results.json").is_file():
+        parser.error(f"--merge needs {args.out}/results.json to merge into")
     run_suite(args.suite, args.out, siconos_python=args.siconos_python,
-              progress=not args.no_progress, n_jobs=args.n_jobs)
-    print(f"wrote {args.out}/results.csv, results.json, summary.md, plot.png")
+              progress=not args.no_progress, n_jobs=args.n_jobs, merge=args.merge)
+    extra = ", friction_profile.png" if (args.out / "friction_profile.png").exists() else ""
+    print(f"wrote {args.out}/results.csv, results.json, summary.md, plot.png{extra}")
     return 0
 
 

@@ -163,7 +163,7 @@ BUILDERS: dict[str, Callable[[int, int], Case]] = {
 }
 #: families of whole runs (benchmarks/dynamics.py): reported, not plotted
 RUN_FAMILIES = {"sim-ball": "steps", "sim-cradle": "N", "sim-column": "N", "event-ball": "T",
-                "lzb": "N", "startup": "cases"}
+                "lzb": "N", "startup": "cases", "friction-impact": "contacts"}
 SIZE_LABEL = {"cradle": "N", "chain-random": "N", "random": "m", "redundant": "m",
               "mass-ratio": "r", "discs": "m", "batch": "k", "sweep": "cells", **RUN_FAMILIES}
 #: seeded instances per size (only the random families vary with the seed)
@@ -178,6 +178,7 @@ SUITES: dict[str, dict[str, list[int]]] = {
              "mass-ratio": [10, 1000, 1_000_000], "discs": [100, 1000, 10_000],
              "batch": [10_000, 100_000, 1_000_000, 10_000_000],
              "chain-random": [1_000_000]},
+    "friction": {},  # the friction rows alone (benchmarks/friction.py, friction_impacts.py)
 }
 
 

@@ -36,6 +36,16 @@ def relative_error(case: Case, u_plus: np.ndarray, *, law: str = "moreau") -> fl
     return float(np.max(num / np.where(den > 0, den, 1.0)))
 
 
+def fmt_time(seconds: float | None) -> str:
+    """Seconds as "1.23 ms" (three significant digits, s, ms, µs or ns); "—" for None."""
+    if seconds is None:
+        return "—"
+    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("µs", 1e-6)):
+        if seconds >= scale:
+            return f"{seconds / scale:.3g} {unit}"
+    return f"{seconds * 1e9:.3g} ns"
+
+
 def output_size(raw: Any) -> float | None:
     """MB of a batch result's own arrays (u⁺, Λ, the residuals): what peak memory must hold
     anyway, so that what a batch needs beyond input and output can be told apart."""

@@ -14,7 +14,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from . import friction_report  # noqa: E402
 from .families import RUN_FAMILIES, SIZE_LABEL  # noqa: E402
+from .measure import fmt_time  # noqa: E402
 
 COLUMNS = ["family", "size", "method", "group", "instances", "ran", "ok", "success_rate",
            "median_s", "p90_s", "max_error", "peak_mb", "output_mb", "status", "message",
@@ -67,15 +69,6 @@ def read_rows(path: Path) -> list[dict[str, Any]]:
         for key in NUMERIC:
             row[key] = float(row[key]) if row.get(key) not in (None, "") else None
     return rows
-
-
-def fmt_time(seconds: float | None) -> str:
-    if seconds is None:
-        return "—"
-    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("µs", 1e-6)):
-        if seconds >= scale:
-            return f"{seconds / scale:.3g} {unit}"
-    return f"{seconds * 1e9:.3g} ns"
 
 
 def _median(rows: list[dict], family: str, size: int | None, method: str) -> dict | None:
@@ -174,6 +167,7 @@ def targets(rows: list[dict]) -> list[tuple[str, str, str]]:
                             f"{fmt_time(raw['median_s'])})",
                             "met" if ratio <= 1.3 else f"MISSED by {ratio / 1.3:.1f}×"))
     out += _run_targets(rows)
+    out += friction_report.targets(rows)
     return out
 
 
@@ -304,8 +298,14 @@ def summary_markdown(rows: list[dict], meta: dict) -> str:
              f"✗k/n = only k of n runs succeeded (error ≤ {meta['accurate_below']:g}, no "
              "exception). `skip` = size cap or not applicable (see results.csv). peak_mb in "
              "results.csv (cases with max(n, m) or k ≥ 10⁴): tracemalloc peak of the warm-up "
-             "run, Python/numpy allocations only (native solver memory is not seen).", "",
-             "## Targets", "", "| target | measured | verdict |", "|---|---|---|"]
+             "run, Python/numpy allocations only (native solver memory is not seen).", ""]
+    if meta.get("friction_seconds"):
+        lines += [f"The friction suite took {meta['friction_seconds']} s of it.", ""]
+    if meta.get("refreshed"):
+        fresh = meta["refreshed"]
+        lines += [f"Rows of {', '.join(fresh['families'])} refreshed since by a "
+                  f"`{fresh['suite']}` run of {fresh['seconds']} s.", ""]
+    lines += ["## Targets", "", "| target | measured | verdict |", "|---|---|---|"]
     found = targets(rows)
     lines += [f"| {t} | {m} | {v} |" for t, m, v in found]
     missed = dict.fromkeys(t.split(":")[0] for t, _, v in found
@@ -313,6 +313,7 @@ def summary_markdown(rows: list[dict], meta: dict) -> str:
     if missed:
         lines += ["", "Why the missed targets are missed:", ""]
         lines += [f"- *{key}*: {WHY_MISSED[key]}" for key in missed]
+    lines += friction_report.markdown(rows)
     for family, label in SIZE_LABEL.items():
         fam = [r for r in rows if r["family"] == family]
         if not fam:
@@ -331,7 +332,8 @@ def summary_markdown(rows: list[dict], meta: dict) -> str:
     failures = [r for r in rows if r["status"] in ("failed", "mixed", "inaccurate")]
     if failures:
         lines += ["", "## Failures and inaccurate answers", ""]
-        lines += [f"- {r['family']} {SIZE_LABEL[r['family']]}={r['size']:g} {r['method']}: "
+        lines += [f"- {r['family']} {SIZE_LABEL.get(r['family'], 'contacts')}={r['size']:g} "
+                  f"{r['method']}: "
                   f"{r['message']}" for r in failures]
     notes = sorted({(r["method"], r["note"]) for r in rows if r["note"]})
     lines += ["", "## What the timer covers beyond the solve", ""]
@@ -475,7 +477,8 @@ def plot_figure(rows: list[dict]) -> Any:
 
 
 def write_all(records: list[dict], out_dir: Path, meta: dict) -> list[dict]:
-    """Write results.csv, results.json, summary.md and plot.png into ``out_dir``."""
+    """Write results.csv, results.json, summary.md and plot.png into ``out_dir`` (and
+    friction_profile.png when there are friction rows)."""
     out_dir.mkdir(parents=True, exist_ok=True)
     rows = aggregate(records)
     with open(out_dir / "results.csv", "w", newline="") as fh:
@@ -487,4 +490,6 @@ def write_all(records: list[dict], out_dir: Path, meta: dict) -> list[dict]:
                                                       "records": raw}, indent=1))
     (out_dir / "summary.md").write_text(summary_markdown(rows, meta))
     plot(rows, out_dir / "plot.png")
+    if not friction_report.plot(rows, out_dir / friction_report.PROFILE_PNG):
+        (out_dir / friction_report.PROFILE_PNG).unlink(missing_ok=True)  # not a stale one
     return rows

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from collections.abc import Sequence
@@ -13,22 +14,31 @@ from tqdm import tqdm
 from . import families, peers, report
 from .dynamics import run_per_impact, run_simulations, run_startup
 from .families import Case
+from .friction import run_friction
+from .friction_impacts import run_friction_impacts
 from .measure import measure, quiet_stdout
 from .methods import METHODS, Method
 from .sweeps import run_sweeps
 
 #: per suite: (seconds of timed repeats per method and case, most repeats)
-TIMING = {"smoke": (0.01, 10), "quick": (0.02, 30), "full": (0.3, 500)}
+TIMING = {"smoke": (0.01, 10), "quick": (0.02, 30), "full": (0.3, 500),
+          "friction": (0.3, 500)}
+#: families a suite's rows belong to when they replace rows of earlier results (``merge``)
+FRICTION_FAMILIES = ("friction:", "friction-impact")
 
 
 def run_suite(suite: str, out_dir: Path | str, *, methods: Sequence[Method] | None = None,
               siconos_python: str = peers.SICONOS_PYTHON,
-              progress: bool = True, n_jobs: int = 2) -> list[dict[str, Any]]:
-    """Run ``suite`` and write results.csv, results.json, summary.md and plot.png.
+              progress: bool = True, n_jobs: int = 2,
+              merge: bool = False) -> list[dict[str, Any]]:
+    """Run ``suite`` and write results.csv, results.json, summary.md and plot.png (and
+    friction_profile.png with friction rows).
 
     Parameters
     ----------
-    suite : {"smoke", "quick", "full"}
+    suite : {"smoke", "quick", "full", "friction"}
+        ``friction``: the friction rows alone (FCLib problems beside Siconos' fc3d solvers,
+        frictional impacts of spheres).
     out_dir : path
         Created when missing.
     methods : sequence of Method, optional
@@ -41,6 +51,10 @@ def run_suite(suite: str, out_dir: Path | str, *, methods: Sequence[Method] | No
     n_jobs : int
         Local processes of the scaled-out sweep, timed against one process (timed methods
         always run one at a time: parallel timings would disturb each other).
+    merge : bool
+        Keep the records of ``out_dir/results.json`` except those of the families this run
+        produces, and write the reports of both (refreshes e.g. only the friction rows of
+        benchmarks/reference/).
 
     Returns
     -------
@@ -83,9 +97,39 @@ def run_suite(suite: str, out_dir: Path | str, *, methods: Sequence[Method] | No
     records += run_simulations(suite, siconos_python)
     records += run_per_impact(suite)
     records += run_startup(suite)
+    bar.set_postfix_str("friction suite", refresh=False)
+    friction_started = time.perf_counter()
+    records += run_friction(suite, budget=budget, max_repeats=max_repeats,
+                            siconos_python=siconos_python,
+                            progress=lambda name: bar.set_postfix_str(f"friction: {name}"))
+    records += run_friction_impacts(suite)
     bar.close()
     meta = {"suite": suite, "seconds": round(time.perf_counter() - started, 1),
             "timing_budget_s": budget, "max_repeats": max_repeats,
-            "accurate_below": peers.ACCURATE}
+            "accurate_below": peers.ACCURATE,
+            "friction_seconds": round(time.perf_counter() - friction_started, 1)}
+    if merge:
+        records, meta = merge_records(Path(out_dir) / "results.json", records, meta)
     report.write_all(records, Path(out_dir), meta)
     return records
+
+
+def merge_records(path: Path, records: list[dict[str, Any]],
+                  meta: dict[str, Any]) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """The records of ``path`` (a results.json) with those of the families in ``records``
+    replaced by ``records``; the old meta, noting the refresh.
+
+    Raises
+    ------
+    FileNotFoundError
+        No results.json to merge into.
+    """
+    old = json.loads(path.read_text())
+    fresh = {r["family"] for r in records}
+    kept = [r for r in old["records"] if r["family"] not in fresh
+            and not (r["family"].startswith(FRICTION_FAMILIES)
+                     and any(f.startswith(FRICTION_FAMILIES) for f in fresh))]
+    merged = dict(old["meta"])
+    merged["refreshed"] = {"suite": meta["suite"], "seconds": meta["seconds"],
+                           "families": sorted(fresh)}
+    return kept + records, merged

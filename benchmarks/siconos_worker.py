@@ -1,4 +1,4 @@
-"""Time Siconos' LCP solvers on impact LCPs; runs under Debian's /usr/bin/python3 only.
+"""Time Siconos' LCP and fc3d solvers; runs under Debian's /usr/bin/python3 only.
 
 Usage: ``/usr/bin/python3 siconos_worker.py IN.json OUT.json``. IN holds
 ``{"budget": seconds, "max_repeats": int, "problems": [{"id", "M", "q", "solvers"}]}``
@@ -7,6 +7,16 @@ with the LCP ``0 ≤ z ⟂ Mz + q ≥ 0`` (M = G, q = (1+ε)γ⁻) and solver na
 arrays and the solver options, then calls the driver (as a user of Siconos from Python
 would). OUT holds per problem and solver the run times, the median, z, and Siconos' info
 code (0 = solved). With ``--check`` it only verifies that siconos imports.
+
+Usage: ``/usr/bin/python3 siconos_worker.py --fc3d-serve`` serves frictional contact
+problems, one JSON line per request on stdin: ``{"path", "solver", "tol", "max_iter",
+"budget", "max_repeats"}`` with ``path`` a local problem in Siconos' text layout (read by
+Siconos' own ``frictionContact_new_from_filename``, W stored sparse-block) and ``solver``
+among ``NSGS``, ``NSN_AC``, ``PROX`` (:data:`FC3D`). Each timed run calls ``fc3d_driver``
+from r = u = 0 with fresh solver options (tolerance ``SICONOS_DPARAM_TOL``, most
+iterations ``SICONOS_IPARAM_MAX_ITER``); the problem is read before the timer. The answer,
+one line prefixed :data:`ANSWER`, holds the run times, Siconos' info code, its iterations
+and its own error (for the record only: the caller recomputes the error), r and u.
 
 This file must stay importable without siconos and self-contained (no impactqp import).
 """
@@ -22,6 +32,13 @@ import time
 def _solver_ids(sn) -> dict:
     return {"lemke": sn.SICONOS_LCP_LEMKE, "pgs": sn.SICONOS_LCP_PGS,
             "enum": sn.SICONOS_LCP_ENUM}
+
+
+#: the fc3d solvers served: name → Siconos' solver id attribute
+FC3D = {"NSGS": "SICONOS_FRICTION_3D_NSGS", "NSN_AC": "SICONOS_FRICTION_3D_NSN_AC",
+        "PROX": "SICONOS_FRICTION_3D_PROX"}
+#: the prefix of the server's answer lines (anything else on its stdout is Siconos talking)
+ANSWER = "@@ "
 
 
 def run_one(sn, np, M, q, solver_id: int) -> tuple[int, list]:
@@ -46,6 +63,54 @@ def time_solver(sn, np, M, q, solver_id: int, budget: float, max_repeats: int) -
     return {"info": info, "z": z, "times": times, "median": statistics.median(times)}
 
 
+def fc3d_once(sn, np, problem, solver: str, tol: float, max_iter: int) -> dict:
+    """One fc3d_driver call from r = u = 0; its seconds, info, iterations, own error, r, u."""
+    size = problem.dimension * problem.numberOfContacts
+    r, u = np.zeros(size), np.zeros(size)
+    options = sn.SolverOptions(getattr(sn, FC3D[solver]))
+    options.dparam[sn.SICONOS_DPARAM_TOL] = tol
+    options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = max_iter
+    t0 = time.perf_counter()
+    info = sn.fc3d_driver(problem, r, u, options)
+    seconds = time.perf_counter() - t0
+    return {"seconds": seconds, "info": int(info),
+            "iterations": int(options.iparam[sn.SICONOS_IPARAM_ITER_DONE]),
+            "siconos_error": float(options.dparam[sn.SICONOS_DPARAM_RESIDU]),
+            "r": r.tolist(), "u": u.tolist()}
+
+
+def fc3d_time(sn, np, job: dict) -> dict:
+    """Time one solver on one problem: the first run counts when it alone takes the budget
+    (a solve of seconds needs no warm-up), else it is the warm-up and timed repeats follow
+    until ``budget`` seconds or ``max_repeats`` runs."""
+    problem = sn.frictionContact_new_from_filename(job["path"])
+    if problem is None:
+        raise RuntimeError(f"siconos cannot read {job['path']}")
+    args = (sn, np, problem, job["solver"], job["tol"], job["max_iter"])
+    first = fc3d_once(*args)
+    times = [first["seconds"]]
+    if first["seconds"] < job["budget"]:
+        times = []
+        start = time.perf_counter()
+        while len(times) < job["max_repeats"] and (
+                not times or time.perf_counter() - start < job["budget"]):
+            times.append(fc3d_once(*args)["seconds"])
+    first.pop("seconds")
+    return {"times": times, **first}
+
+
+def fc3d_serve(sn, np) -> int:
+    """Answer fc3d requests (see the module doc), one per input line, until EOF."""
+    for line in sys.stdin:
+        try:
+            answer = fc3d_time(sn, np, json.loads(line))
+        except Exception as exc:  # reported to the caller, the server goes on
+            answer = {"error": f"{type(exc).__name__}: {exc}"}
+        sys.stdout.write(ANSWER + json.dumps(answer) + "\n")
+        sys.stdout.flush()
+    return 0
+
+
 def main(argv: list[str]) -> int:
     """Entry point; returns the exit status (3 when siconos cannot be imported)."""
     try:
@@ -56,6 +121,8 @@ def main(argv: list[str]) -> int:
         return 3
     if argv[1:] == ["--check"]:
         return 0
+    if argv[1:] == ["--fc3d-serve"]:
+        return fc3d_serve(sn, np)
     with open(argv[1]) as fh:
         job = json.load(fh)
     ids = _solver_ids(sn)

@@ -35,10 +35,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import queue
 import statistics
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -167,37 +169,86 @@ def serve() -> int:
 
 
 class SiconosServer:
-    """This file serving Siconos runs in ``python``; one process for a whole comparison."""
+    """A script serving Siconos runs in ``python`` over a pipe; one process for a whole
+    comparison. By default this file (Moreau–Jean runs, :meth:`run`); ``script`` and
+    ``flag`` name another server that answers JSON lines the same way (:meth:`request`),
+    such as :mod:`benchmarks.siconos_worker`'s fc3d solvers."""
 
-    def __init__(self, python: str) -> None:
+    def __init__(self, python: str, script: Path | None = None,
+                 flag: str = "--siconos-serve") -> None:
         self.errors = tempfile.TemporaryFile("w+")  # a pipe left unread could fill and block
-        self.proc = subprocess.Popen([python, str(Path(__file__).resolve()), "--siconos-serve"],
+        where = script or Path(__file__).resolve()
+        self.proc = subprocess.Popen([python, str(where), flag],
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                      stderr=self.errors, text=True)
+        self._lines: queue.Queue[str | None] = queue.Queue()
+        threading.Thread(target=self._read, daemon=True).start()
 
-    def run(self, system: str, n: int, steps: int) -> tuple[float, dict[str, list[float]]]:
-        """Seconds and state of one Siconos run (raises RuntimeError when it fails)."""
-        self.proc.stdin.write(json.dumps({"system": system, "n": n, "steps": steps}) + "\n")
-        self.proc.stdin.flush()
+    def _read(self) -> None:
+        """Forward the server's output lines to :meth:`request` (None at its end)."""
         for line in self.proc.stdout:
-            if line.startswith(ANSWER):
-                answer = json.loads(line[len(ANSWER):])
-                if "error" in answer:
-                    raise RuntimeError(f"siconos: {answer['error']}")
-                return answer.pop("seconds"), answer
+            self._lines.put(line)
+        self._lines.put(None)
+
+    @property
+    def alive(self) -> bool:
+        """Is the server still running (it dies with a crash of Siconos)?"""
+        return self.proc.poll() is None
+
+    def request(self, job: dict[str, Any], timeout: float | None = None) -> dict[str, Any]:
+        """Send one JSON request, return the answer.
+
+        Raises
+        ------
+        RuntimeError
+            The server reports an error, or has died (its last words are in the message).
+        TimeoutError
+            No answer within ``timeout`` seconds: the server is killed (start another).
+        """
+        try:
+            self.proc.stdin.write(json.dumps(job) + "\n")
+            self.proc.stdin.flush()
+        except (BrokenPipeError, ValueError):
+            pass  # it has died: its last words are read below
+        else:
+            while True:
+                try:
+                    line = self._lines.get(timeout=timeout)
+                except queue.Empty:
+                    self.proc.kill()
+                    self.close()
+                    raise TimeoutError(f"siconos gave no answer within {timeout:g} s "
+                                       "(server stopped)") from None
+                if line is None:
+                    break
+                if line.startswith(ANSWER):
+                    answer = json.loads(line[len(ANSWER):])
+                    if "error" in answer:
+                        raise RuntimeError(f"siconos: {answer['error']}")
+                    return answer
         self.proc.wait(timeout=60)  # its output ended: it is exiting
         self.errors.seek(0)
         message = self.errors.read().strip()[-300:]
         self.close()
-        raise RuntimeError(f"siconos server died: {message}")
+        raise RuntimeError(f"siconos server died (exit {self.proc.returncode}): {message}")
+
+    def run(self, system: str, n: int, steps: int) -> tuple[float, dict[str, list[float]]]:
+        """Seconds and state of one Siconos run (raises RuntimeError when it fails)."""
+        answer = self.request({"system": system, "n": n, "steps": steps})
+        return answer.pop("seconds"), answer
 
     def close(self) -> None:
         """End the server (it exits at the end of its input)."""
         if self.proc.poll() is None:
             self.proc.stdin.close()
             self.proc.wait(timeout=60)
-        self.proc.stdout.close()
-        self.errors.close()
+        elif not self.proc.stdin.closed:
+            try:
+                self.proc.stdin.close()
+            except BrokenPipeError:
+                pass
+        if not self.errors.closed:
+            self.errors.close()
 
     def __enter__(self) -> SiconosServer:
         return self

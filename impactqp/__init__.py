@@ -47,6 +47,7 @@ from .laws.batch import BatchResult, moreau_batch, sector_law_batch, solve_batch
 from .laws.catalogue import available_backends
 from .laws.certificate import Certificate, SectorLawCertificate
 from .laws.complementarity import Fremond, Newton
+from .laws.coulomb import Coulomb
 from .laws.friction import FrictionResult, solve_friction
 from .laws.functions import fremond, moreau, newton, reflection_law, sector_law
 from .laws.lzb import LZB, LZBAnswer, LZBCertificate, LZBRecord
@@ -59,6 +60,7 @@ from .model.admissible import AdmissibleSet, Membership
 from .model.builders import chain, newtons_cradle, random_impact
 from .model.classify import Classification, classify
 from .model.friction import FrictionCertificate, FrictionContactProblem
+from .model.friction_builders import point_on_plane, sphere_on_plane, two_spheres
 from .model.physical_chains import (
     PhysicalChain,
     ball_chain,
@@ -70,7 +72,15 @@ from .model.physical_chains import (
 from .model.problem import ImpactProblem
 from .model.structure import ChainInfo, ImpactStructure
 from .qp.lcp import LCPResult, solve_lcp
-from .simulation.builders import bead_chain, bouncing_ball, cradle_system
+from .simulation.builders import (
+    bead_chain,
+    block_on_incline,
+    bouncing_ball,
+    box_on_floor,
+    cradle_system,
+    rolling_sphere,
+)
+from .simulation.friction_step import FrictionEvent
 from .simulation.impacts import ImpactEvent
 from .simulation.simulate import simulate
 from .simulation.step_law import MoreauJeanStep
@@ -92,7 +102,9 @@ except PackageNotFoundError:  # running from a source tree that was never instal
 
 __all__ = [
     "AdmissibleSet", "Answer", "BackendUnsuitableError", "BatchResult", "Certificate",
-    "CertificateError", "ChainInfo", "Classification", "Counterexample", "DEFAULT_TOL", "Fremond",
+    "CertificateError", "ChainInfo", "FrictionEvent", "block_on_incline", "box_on_floor",
+    "rolling_sphere", "Classification", "Coulomb", "Counterexample",
+    "DEFAULT_TOL", "Fremond",
     "FrictionCertificate", "FrictionContactProblem", "FrictionResult",
     "ImpactError", "ImpactEvent", "ImpactLaw", "ImpactProblem", "ImpactResult", "ImpactStructure",
     "InputError", "IntegrationBudgetError", "LCPResult", "LZB", "LZBAnswer", "LZBCertificate",
@@ -110,5 +122,5 @@ __all__ = [
     "newtons_cradle", "random_impact", "reflection_law", "reflection_law_table", "save_problem",
     "sector_law", "sector_law_batch", "sector_law_table", "simulate", "solve", "solve_batch",
     "solve_friction", "solve_lcp", "sphere_mass", "tapered_chain", "verify_law",
-    "load_fclib", "save_fclib",
+    "load_fclib", "save_fclib", "point_on_plane", "sphere_on_plane", "two_spheres",
 ]

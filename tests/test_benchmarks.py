@@ -256,3 +256,263 @@ def test_targets_of_the_runs():
     assert "*LZB 100-ball steel chain*" in text and "*100-bead column, 1000 steps*" in text
     assert first_call_extra({"import": 1.0, "a": 0.5, "a (warm call)": 0.1, "b": 0.2,
                              "b (warm call)": 0.2}) == pytest.approx(0.4)
+
+
+# --- friction: the Dolan–Moré profile, the data, the report, the peer ------------------------
+def test_performance_profile_by_hand():
+    from benchmarks.perf_profile import profile, ratios, tau_grid
+
+    inf = float("inf")
+    # p1: A and B tie; p2: B fails; p3: every solver fails; p4: C fails, A 3× the best
+    times = {"A": [1.0, 2.0, inf, 3.0], "B": [1.0, inf, inf, 1.0], "C": [2.0, 4.0, inf, inf]}
+    r = ratios(times)
+    assert list(r["A"]) == [1.0, 1.0, inf, 3.0]
+    assert list(r["B"]) == [1.0, inf, inf, 1.0]
+    assert list(r["C"]) == [2.0, 2.0, inf, inf]
+    rho = profile(times, [1.0, 1.9, 2.0, 3.0, 1e9, inf])
+    assert list(rho["A"]) == [0.5, 0.5, 0.5, 0.75, 0.75, 0.75]  # never p3: all failed there
+    assert list(rho["B"]) == [0.5, 0.5, 0.5, 0.5, 0.5, 0.5]  # the tie counts for both
+    assert list(rho["C"]) == [0.0, 0.0, 0.5, 0.5, 0.5, 0.5]  # ρ(∞): the share solved
+    assert list(ratios({"A": [float("nan")], "B": [2.0]})["A"]) == [inf]  # NaN = failed
+    grid = tau_grid(times)
+    assert grid[0] == 1.0 and 3.0 in grid and grid[-1] >= 10.0
+    with pytest.raises(ValueError, match="positive"):
+        ratios({"A": [0.0]})
+
+
+SBM_TEXT = """2
+2
+1
+4
+4
+3
+2
+2
+2\t4\t
+2\t4\t
+3
+3
+0\t2\t3\t
+0\t1\t1\t
+0
+1.0 2.0 3.0 4.0
+1
+5.0 0.0 0.0 6.0
+2
+7.0 8.0 9.0 10.0
+-1.0 0.5 -2.0 0.25
+0.3 0.6
+"""
+
+
+def test_siconos_text_reader_by_hand(tmp_path):
+    """A sparse-block file written out by hand: blocks column-major, the block numbers
+    skipped, an empty block (row 2, column 1) left zero."""
+    import numpy as np
+
+    from benchmarks.friction_data import read_siconos_text, write_siconos_text
+
+    (tmp_path / "p.dat").write_text(SBM_TEXT)
+    p = read_siconos_text(tmp_path / "p.dat")
+    assert p.contact_dim == 2 and p.n_contacts == 2
+    assert np.array_equal(p.dense_W(), [[1, 3, 5, 0], [2, 4, 0, 6],
+                                        [0, 0, 7, 9], [0, 0, 8, 10]])
+    assert list(p.q) == [-1.0, 0.5, -2.0, 0.25] and list(p.mu) == [0.3, 0.6]
+    for storage in (0, 1):  # both layouts read back bit for bit
+        write_siconos_text(p, tmp_path / f"{storage}.dat", storage=storage)
+        back = read_siconos_text(tmp_path / f"{storage}.dat")
+        assert np.array_equal(back.dense_W(), p.dense_W()) and np.array_equal(back.q, p.q)
+    (tmp_path / "short.dat").write_text(SBM_TEXT[:60])
+    with pytest.raises(ValueError, match="ends after"):
+        read_siconos_text(tmp_path / "short.dat")
+
+
+def test_suite_problems_load():
+    import numpy as np
+
+    from benchmarks import friction_data
+
+    expected = {"NESpheres-10": (9, 0.8), "BoxesStack1": (52, 0.7), "Spheres": (356, 0.7),
+                "KaplasTower": (570, 0.3), "LMGC-00046": (9, 0.3)}
+    for name, (contacts, mu) in expected.items():
+        case = friction_data.load(name)
+        assert case.n_contacts == contacts and np.all(case.problem.mu == mu), name
+        assert case.family == f"friction:{name}"
+    W = friction_data.load("NESpheres-10").problem.dense_W()  # dense storage, column-major
+    assert W[0, 0] == 0.2 and np.abs(W - W.T).max() <= 1e-15
+    W = friction_data.load("BoxesStack1").problem.dense_W()  # sparse-block storage
+    assert np.abs(W - W.T).max() <= 1e-12 * np.abs(W).max()
+    assert np.linalg.matrix_rank(W) == 78  # 156 rows: rank-deficient, as the README says
+
+
+def test_spheres_in_a_row_geometry():
+    import numpy as np
+
+    import impactqp as iq
+    from benchmarks.friction_impacts import MU, RADIUS, spheres_in_a_row
+
+    one = spheres_in_a_row(1)
+    # W of a sphere on a plane: 1/m in the normal, 1/m + R²/I = 1 + 5/2 in each tangent
+    assert np.allclose(one.local.W, np.diag([1.0, 3.5, 3.5]))
+    rolling = np.array([2.0 * RADIUS, 0.0, 0.0, 0.0, 2.0, 0.0])  # v = ω × (R e_z)
+    assert np.allclose(one.H.T @ rolling, 0.0)  # the contact point does not move
+    three = spheres_in_a_row(3)
+    assert three.n_contacts == 5 and np.allclose(three.local.W, three.local.W.T)
+    assert np.linalg.eigvalsh(three.local.W).min() > -1e-12
+    # a single plastic impact in closed form: r_n = −q_n / W_nn, sliding when the sticking
+    # impulse lies outside the cone, against the solver
+    q = one.local.q
+    rn = -q[0]
+    stick = -q[1:] / 3.5
+    rt = stick if np.linalg.norm(stick) <= MU * rn else -MU * rn * q[1:] / np.linalg.norm(q[1:])
+    res = iq.solve_friction(one.local)
+    assert np.allclose(res.r, [rn, *rt], atol=1e-8)
+
+
+def _frow(problem, method, status, median, error=1e-9, size=10):
+    return {"family": f"friction:{problem}", "size": size, "method": method,
+            "group": "peer" if method.startswith("siconos") else "impactqp",
+            "status": status, "median_s": median, "max_error": error, "success_rate": 1,
+            "ok": 1, "ran": 1, "note": "", "message": "", "reference": ""}
+
+
+def test_friction_report_by_hand(tmp_path):
+    import math
+
+    from benchmarks import friction_report
+
+    rows = []
+    for problem, size, auto, nsgs, nsgs_status in (("a", 5, 1e-3, 4e-3, "ok"),
+                                                   ("b", 50, 2e-2, 1e-2, "failed")):
+        rows += [_frow(problem, "iq:auto", "ok", auto, size=size),
+                 _frow(problem, "iq:nsgs", "failed", 1.0, 1e-3, size=size),
+                 _frow(problem, "siconos:NSGS", nsgs_status, nsgs, size=size),
+                 _frow(problem, "siconos:PROX", "skipped", None, None, size=size)]
+    assert friction_report.problems(rows) == ["friction:a", "friction:b"]
+    ratio = friction_report.default_ratios(rows)
+    assert ratio == {"friction:a": (0.25, True, True), "friction:b": (2.0, True, False)}
+    times = friction_report.profile_times(rows)
+    assert set(times) == {"iq:auto", "iq:nsgs", "siconos:NSGS"}  # PROX skipped: left out
+    assert times["siconos:NSGS"] == [4e-3, math.inf] and times["iq:nsgs"] == [math.inf] * 2
+    found = friction_report.targets(rows)
+
+    def target(start):
+        (hit,) = [(m, v) for t, m, v in found if t.startswith(f"friction: {start}")]
+        return hit
+
+    assert target("every FCLib") == ("2 of 2", "met")
+    assert target("iq:auto time") == ("1 of 2 (slower: b)", "MISSED")
+    assert target("geometric mean") == ("0.707", "MISSED by 1.4×")  # √(0.25 · 2)
+    assert target("Dolan–Moré")[0].startswith("fastest on 2 of 2")
+    text = "\n".join(friction_report.markdown(rows))
+    assert "| b | 50 |" in text and "2.00 (NSGS failed)" in text and "0.707" in text
+    assert "iq:auto 2/2; iq:nsgs 0/0; siconos:NSGS 0/1." in text  # fastest on / solved
+    assert friction_report.plot(rows, tmp_path / "p.png")
+    assert (tmp_path / "p.png").read_bytes()[:4] == b"\x89PNG"
+    assert not friction_report.plot([], tmp_path / "none.png")
+
+
+def test_friction_suite_without_siconos_is_skipped(tmp_path):
+    from benchmarks.friction import IQ_METHODS, run_friction
+
+    rows = run_friction("quick", budget=0.0, max_repeats=1, siconos_python=sys.executable)
+    if any(r["group"] == "peer" and r["status"] != "skipped" for r in rows):
+        pytest.skip("siconos imports in this Python itself")
+    mine = [r for r in rows if r["group"] == "impactqp"]
+    assert [r["method"] for r in mine] == list(IQ_METHODS)
+    assert all(r["status"] == "ok" and r["error"] <= 1e-8 and r["times"] for r in mine)
+    peer = [r for r in rows if r["group"] == "peer"]
+    assert len(peer) == 3 and all(r["status"] == "skipped" for r in peer)
+    assert run_friction("smoke", budget=0.0, max_repeats=1) == []
+
+
+@pytest.mark.skipif(not _siconos_here(), reason="python3-siconos not installed")
+def test_friction_peer_is_judged_by_impactqp():
+    from benchmarks.friction import run_friction
+
+    rows = run_friction("quick", budget=0.0, max_repeats=1)
+    peer = {r["method"]: r for r in rows if r["group"] == "peer"}
+    assert set(peer) == {"siconos:NSGS", "siconos:NSN_AC", "siconos:PROX"}
+    nsgs = peer["siconos:NSGS"]
+    assert nsgs["status"] == "ok" and nsgs["error"] <= 1e-8 and "Siconos info 0" in nsgs["message"]
+    for r in peer.values():  # ok exactly when impactqp's ABH error is within 1e-8
+        assert (r["status"] == "ok") == (r["error"] <= 1e-8), r
+
+
+def test_merge_replaces_only_friction_rows(tmp_path):
+    from benchmarks.measure import row
+    from benchmarks.runner import merge_records
+
+    old = [row("random", 2, "iq:auto", "impactqp", status="ok", times=[1.0]),
+           row("friction:gone", 3, "iq:auto", "impactqp", status="ok", times=[1.0]),
+           row("friction-impact", 1, "iq:solve_friction", "impactqp", status="ok")]
+    (tmp_path / "results.json").write_text(json.dumps({"meta": {"suite": "full"},
+                                                       "records": old}))
+    new = [row("friction:kept", 9, "iq:auto", "impactqp", status="ok", times=[2.0])]
+    records, meta = merge_records(tmp_path / "results.json", new,
+                                  {"suite": "friction", "seconds": 3.0})
+    assert [r["family"] for r in records] == ["random", "friction:kept"]
+    assert meta["suite"] == "full" and meta["refreshed"]["families"] == ["friction:kept"]
+
+
+def test_siconos_server_stops_when_silent(tmp_path):
+    from benchmarks import siconos_worker, simulation
+
+    assert siconos_worker.ANSWER == simulation.ANSWER  # one protocol for both servers
+    script = tmp_path / "silent.py"
+    script.write_text("import sys, time\nsys.stdin.readline()\ntime.sleep(30)\n")
+    server = simulation.SiconosServer(sys.executable, script, "--serve")
+    with pytest.raises(TimeoutError, match="no answer within 0.5 s"):
+        server.request({"x": 1}, timeout=0.5)
+    assert not server.alive
+
+
+def test_impactqp_runs_are_stopped_at_the_limit():
+    import time
+
+    import impactqp as iq
+    from benchmarks.friction import first_run
+
+    def slow(problem):
+        time.sleep(30)
+
+    def broken(problem):
+        raise iq.CertificateError("no method certified it")
+
+    p = iq.FrictionContactProblem([[1.0, 0, 0], [0, 2.0, 0], [0, 0, 2.0]], [-1.0, 2.0, 0.0],
+                                  0.5)
+    assert first_run(slow, p, limit=0.5) == ("stopped", 0.5, "")
+    status, seconds, message = first_run(broken, p)
+    assert status == "error" and "CertificateError: no method" in message and seconds < 5
+    status, _, (r, u, route) = first_run(iq.solve_friction, p)
+    # sliding (sticking would need r_t = −1, outside the cone): r_n = 1, r_t = −μ r_n
+    assert status == "ok" and abs(r[0] - 1.0) < 1e-9 and abs(r[1] + 0.5) < 1e-9 and route
+
+
+def test_friction_suite_alone_merges_into_earlier_results(tmp_path, monkeypatch, capsys):
+    from benchmarks import friction, friction_impacts
+    from benchmarks.__main__ import main
+    from benchmarks.measure import row
+
+    with pytest.raises(SystemExit) as exc:  # nothing to merge into
+        main(["run", "--suite", "friction", "--merge", "--out", str(tmp_path / "none")])
+    assert exc.value.code == 2 and "--merge needs" in capsys.readouterr().err
+    monkeypatch.setitem(friction.PROBLEMS, "friction", ["LMGC-00046"])
+    monkeypatch.setitem(friction_impacts.SIZES, "friction", ([1], (3, 0.01)))
+    meta = {"suite": "full", "seconds": 9.0, "timing_budget_s": 0.3, "max_repeats": 500,
+            "accurate_below": 1e-6}
+    old = [row("random", 2, "iq:auto", "impactqp", status="ok", times=[1e-5], error=0.0),
+           row("friction:Capsules", 286, "iq:auto", "impactqp", status="ok", times=[1.0])]
+    (tmp_path / "results.json").write_text(json.dumps({"meta": meta, "records": old}))
+    main(["run", "--suite", "friction", "--merge", "--out", str(tmp_path),
+          "--siconos-python", "", "--no-progress"])
+    assert "friction_profile.png" in capsys.readouterr().out
+    data = json.loads((tmp_path / "results.json").read_text())
+    families = {r["family"] for r in data["records"]}
+    assert families == {"random", "friction:LMGC-00046", "friction-impact"}
+    assert data["meta"]["suite"] == "full" and data["meta"]["refreshed"]["suite"] == "friction"
+    text = (tmp_path / "summary.md").read_text()
+    assert "## random" in text and "| LMGC-00046 | 9 |" in text and "## friction-impact" in text
+    assert "Rows of friction-impact, friction:LMGC-00046 refreshed since by a `friction` run" \
+        in text
+    assert (tmp_path / "friction_profile.png").read_bytes()[:4] == b"\x89PNG"

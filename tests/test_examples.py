@@ -22,6 +22,9 @@ EXPECTED = {
     "benchmark_run.py": ["# impactqp benchmark — suite `smoke`", "## Targets"],
     "lzb_comparison.py": ["3 balls, u⁻ = (1, 0, …, 0) m/s", "10 balls"],
     "simulate_cradle.py": ["cradle.gif"],
+    "friction.py": ["sphere on the floor", " 0.05  slip ", "  0.3  stick ",
+                    "FCLib LMGC_GlobalFrictionContactProblem00046.hdf5: 9 contacts, d = 3",
+                    "certificate ok at tol 1e-08"],
 }
 
 WRITES = {
@@ -86,3 +89,21 @@ def test_example_writes_where_it_is_told(name, tmp_path):
     assert _printed_folder(done.stdout) == Path("figs")
     assert [p.name for p in tmp_path.iterdir()] == ["figs"]
     assert {p.name for p in (tmp_path / "figs").iterdir()} == WRITES[name]
+
+
+def test_friction_example_agrees_with_its_closed_form_and_writes_only_when_told(tmp_path):
+    """Every μ's u⁺ matches the stick/slip closed form printed beside it; nothing is written
+    without ``--out``, the sphere's problem file (law coulomb) with it."""
+    import impactqp as iq
+
+    done = _run("friction.py", tmp_path, "--out", "out")
+    rows = [line.split() for line in done.stdout.splitlines()
+            if line.split()[1:2] in (["stick"], ["slip"])]
+    assert [(row[0], row[1]) for row in rows] == [("0.0", "slip"), ("0.05", "slip"),
+                                                  ("0.3", "stick")]
+    assert all(float(row[-3]) < 1e-9 and row[-2:] == ["ok", "yes"] for row in rows)
+    assert _printed_folder(done.stdout) == Path("out")
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+    content = iq.load_problem(tmp_path / "out" / "sphere_on_plane.toml")
+    assert content.law == "coulomb" and content.coefficients == (0.3, 0.5)
+    assert content.problem.contact_dim == 2

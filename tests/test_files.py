@@ -147,15 +147,24 @@ def test_toml_writer_round_trips_exactly():
 
 def test_every_law_named_in_files_is_the_registrys() -> None:
     """Files, the command line and the registry share one table of law names: every name
-    builds its law (with coefficients where it takes them) and solves the cradle."""
+    builds its law (with coefficients where it takes them) and solves the cradle, or a sphere
+    landing on two planes for a law of frictional contacts."""
     from impactqp.laws.catalogue import NAMED_LAWS, law_named
 
-    p = iq.newtons_cradle(3)
-    coefficients = {"eps": 0.5, "e": [1.0, 0.5], "E": [[0.5, 0.0], [0.0, 0.5]]}
+    cradle = iq.newtons_cradle(3)
+    sphere = iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.3])
+    frictional = iq.ImpactProblem(sphere.M, np.hstack([sphere.structure.W] * 2), sphere.u_minus,
+                                  contact_dim=2)
+    coefficients = {"eps": 0.5, "e": [1.0, 0.5], "E": [[0.5, 0.0], [0.0, 0.5]],
+                    "mu": [0.2, 0.4]}
     for name, law_class in NAMED_LAWS.items():
-        key = law_class.coefficient_key
-        law = law_named(name, coefficients[key] if key else None)
+        keys = law_class.coefficient_keys
+        given = tuple(coefficients[k] for k in keys)
+        law = law_named(name, given if len(keys) > 1 else given[0] if keys else None)
+        p = frictional if law_class.frictional else cradle
         assert type(law) is law_class and iq.solve(p, law).certificate.ok
+        assert iq.solve(p, law_named(name, law.coefficients)).u_plus.tolist() == \
+            iq.solve(p, law).u_plus.tolist()
         if law_class.needs_coefficients:
             with pytest.raises(iq.InputError, match="needs its coefficients"):
                 law_named(name)

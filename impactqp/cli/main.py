@@ -9,9 +9,9 @@ from importlib.metadata import PackageNotFoundError, version
 
 from ..base.log import verbosity
 from ..errors import ImpactError
-from .commands import demo, plot, sector, simulate, solve, verify
+from .commands import demo, fclib, plot, sector, simulate, solve, verify
 
-COMMANDS = [demo, solve, verify, plot, sector, simulate]
+COMMANDS = [demo, solve, verify, fclib, plot, sector, simulate]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -31,7 +31,7 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-NUMBER_OPTIONS = ("--u-plus", "--eps", "--e", "--E", "--v", "--mass")
+NUMBER_OPTIONS = ("--u-plus", "--eps", "--e", "--E", "--mu", "--v", "--mass")
 """Options whose value may start with a minus sign (``--u-plus -1,0,0``)."""
 
 

@@ -15,10 +15,12 @@ import numpy as np
 
 from ..laws.catalogue import NAMED_LAWS
 from ..laws.result import ImpactResult
-from ..model.admissible import Membership
+from ..model.admissible import AdmissibleSet, Membership
 from ..model.problem import ImpactProblem
 
 COEFFICIENT_NAMES = {name: law.coefficient_symbol for name, law in NAMED_LAWS.items()}
+KEY_SYMBOLS = {"mu": "μ"}
+"""How reports print a coefficient of a law of several (Coulomb's μ and e) by its key."""
 CONDITIONS = ("kinetic", "kinematic", "energetic")
 CONDITION_TEXT = {"kinetic": "u⁺ ∈ u⁻ + N", "kinematic": "u⁺ ∈ T_C",
                   "energetic": "‖u⁺‖ ≤ ‖u⁻‖"}
@@ -66,14 +68,17 @@ def vector_text(a: Any, digits: int = 6) -> str:
 
 
 def membership_report(problem: ImpactProblem, u_plus: np.ndarray, *,
-                      optimizer: bool = True) -> dict[str, Any]:
+                      optimizer: bool = True, S: AdmissibleSet | None = None) -> dict[str, Any]:
     """The verdict u⁺ ∈ S (docs/theory.md §2): each condition's exact residual, and the optimizer's
     distance.
 
     The exact test is NNLS plus explicit checks; the optimizer one is the SOCP distance from
-    u⁺ to S (:meth:`AdmissibleSet.contains` with ``method="optimizer"``).
+    u⁺ to S (:meth:`AdmissibleSet.contains` with ``method="optimizer"``). ``S`` defaults to
+    the problem's frictionless S; with friction (docs/theory.md §16) it is
+    ``problem.admissible_set(mu=...)``, whose optimizer test is the cone program of the
+    kinetic condition (its distance None).
     """
-    S = problem.admissible_set()
+    S = problem.admissible_set() if S is None else S
     exact: Membership = S.contains(u_plus)
     report: dict[str, Any] = {
         "u_plus": u_plus, "admissible": exact.member, "tolerance": exact.tol,
@@ -91,16 +96,18 @@ def membership_report(problem: ImpactProblem, u_plus: np.ndarray, *,
 def solution_report(result: ImpactResult, source: str = "") -> dict[str, Any]:
     """u⁺, impulses, energies, classification (docs/theory.md §4), admissibility (docs/theory.md
     §2) and certificate."""
-    c = result.classification
+    frictional = result.problem.contact_dim > 1
+    c = None if frictional else result.classification  # docs/theory.md §4: frictionless
     cert = result.certificate
-    membership = membership_report(result.problem, result.u_plus, optimizer=False)
+    S = result.impact_law.admissible_set(result.problem) if result.impact_law else None
+    membership = membership_report(result.problem, result.u_plus, optimizer=False, S=S)
     return {
         "source": source, "law": result.law, "coefficients": result.coefficients,
         "backend": result.backend, "u_minus": result.problem.u_minus, "u_plus": result.u_plus,
         "impulses": result.impulses,
         "energy": {"before": result.energy_before, "after": result.energy_after},
-        "classification": {"alpha_deg": c.alpha_deg, "dissipation": c.dissipation,
-                           "intensity": c.intensity},
+        "classification": None if c is None else {
+            "alpha_deg": c.alpha_deg, "dissipation": c.dissipation, "intensity": c.intensity},
         "admissibility": {k: v for k, v in membership.items() if k not in ("u_plus", "impulses")},
         "certificate": {"ok": cert.ok, "tolerance": cert.tol, **cert.residuals},
     }
@@ -114,9 +121,16 @@ def _conditions_text(report: dict[str, Any]) -> list[str]:
 
 def format_solution(report: dict[str, Any]) -> str:
     """Plain text of :func:`solution_report`."""
-    coef = report["coefficients"]
-    coef_text = "" if coef is None else f", {COEFFICIENT_NAMES[report['law']]} = {_numbers(coef)}"
+    coef, law = report["coefficients"], report["law"]
+    if coef is None:
+        coef_text = ""
+    elif isinstance(coef, tuple):
+        coef_text = "".join(f", {KEY_SYMBOLS.get(key, key)} = {_numbers(value)}" for key, value
+                            in zip(NAMED_LAWS[law].coefficient_keys, coef, strict=True))
+    else:
+        coef_text = f", {COEFFICIENT_NAMES[law]} = {_numbers(coef)}"
     e, c, a = report["energy"], report["classification"], report["admissibility"]
+    frictional = c is None  # the classification is of frictionless impacts only
     ratio = e["after"] / e["before"] if e["before"] > 0 else float("nan")
     cert = report["certificate"]
     lines = [
@@ -125,11 +139,15 @@ def format_solution(report: dict[str, Any]) -> str:
         f"u⁺         {vector_text(report['u_plus'])}",
         f"impulses Λ {vector_text(report['impulses'])}",
         f"energy     before {e['before']:.6g}, after {e['after']:.6g} (ratio {ratio:.6g})",
-        f"classification: α = {c['alpha_deg']:.4g}°, dissipation ε = {c['dissipation']:.4g}, "
-        f"intensity {c['intensity']:.6g}",
-        f"admissible (u⁺ ∈ S): {'yes' if a['admissible'] else 'NO'}",
+        *([] if frictional else [
+            f"classification: α = {c['alpha_deg']:.4g}°, dissipation ε = "
+            f"{c['dissipation']:.4g}, intensity {c['intensity']:.6g}"]),
+        f"admissible (u⁺ ∈ S{' with friction' if frictional else ''}): "
+        f"{'yes' if a['admissible'] else 'NO'}",
         *_conditions_text(a),
-        f"certificate: {'ok' if cert['ok'] else 'FAILED'} (tol {cert['tolerance']:.0e})",
+        f"certificate: {'ok' if cert['ok'] else 'FAILED'} (tol {cert['tolerance']:.0e})"
+        + "".join(f", {k} {v:.1e}" for k, v in cert.items()
+                  if k not in ("ok", "tolerance") and frictional),
     ]
     return "\n".join(lines)
 
@@ -139,12 +157,17 @@ def format_verdict(report: dict[str, Any], source: str = "") -> str:
     opt = report["optimizer"]
     agree = "" if opt["admissible"] == report["admissible"] else \
         "  (disagrees with the exact test; trust the exact one)"
+    if opt["distance"] is None:  # with friction: the cone program of the kinetic condition
+        test = "optimizer (cone program for Λ in the friction cones"
+        figure = ""
+    else:
+        test, figure = "optimizer (SOCP distance to S", f"{opt['distance']:.1e}, "
     lines = [
         f"{source}: candidate u⁺ = {vector_text(report['u_plus'])}",
         f"exact test (NNLS + explicit checks, tol {report['tolerance']:.0e}):",
         *_conditions_text(report),
-        f"optimizer (SOCP distance to S, tol {opt['tolerance']:.0e}): "
-        f"{opt['distance']:.1e}, {'in S' if opt['admissible'] else 'not in S'}{agree}",
+        f"{test}, tol {opt['tolerance']:.0e}): "
+        f"{figure}{'in S' if opt['admissible'] else 'not in S'}{agree}",
         f"verdict: {'ADMISSIBLE' if report['admissible'] else 'NOT ADMISSIBLE'}"
         + ("" if report["admissible"] else f" (fails: {', '.join(report['failed'])})"),
     ]

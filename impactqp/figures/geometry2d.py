@@ -125,6 +125,10 @@ def plane_picture(problem: ImpactProblem, candidates: Mapping[str, ArrayLike] | 
         When the problem or a candidate cannot be drawn in the plane, saying why.
     """
     st = problem.structure
+    if problem.contact_dim > 1:  # its S has friction cones, not the half-spaces drawn here
+        raise InputError(f"the picture of S is of frictionless contacts; this problem's are "
+                         f"frictional (contact_dim = {problem.contact_dim}): draw "
+                         "problem.normal_problem() for the frictionless S")
     W = as_dense(st.W)
     if st.m != 2 or np.linalg.matrix_rank(W) != 2:
         raise InputError(f"the picture of S needs exactly 2 independent contacts (S then lies in "

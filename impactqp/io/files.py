@@ -6,17 +6,25 @@ One flat schema, stored as JSON or TOML (chosen by the file suffix)::
     version  = 1                          # optional; 1 is the only version
     # either a general problem ...
     M        = [[1.0, 0.0], [0.0, 2.0]]   # (n, n) mass matrix
-    W        = [[-1.0], [1.0]]            # (n, m) contact directions
-    # ... or a chain of balls (docs/theory.md §5)
+    W        = [[-1.0], [1.0]]            # (n, m·d) contact directions
+    contact_dim = 1                       # optional: d = 1 frictionless (default), 2 or 3
+    # ... or a chain of balls (docs/theory.md §5), frictionless
     masses     = [1.0, 1.0, 1.0]
     left_wall  = false                    # optional
     right_wall = false                    # optional
     # always
     u_minus  = [1.0, 0.0, 0.0]
     # optional
-    law      = "moreau"             # "moreau" | "newton" | "fremond" | "sector" | "reflection"
+    law      = "moreau"   # "moreau" | "newton" | "fremond" | "sector" | "reflection" | "coulomb"
     eps      = 0.5                        # moreau; "e" for newton, "E" for fremond
     u_plus   = [0.0, 0.0, 1.0]            # a candidate post-impact velocity
+
+Frictional contacts (docs/theory.md §16) have ``contact_dim = 2`` (planar) or ``3``
+(spatial): W holds d columns per contact, the normal first, and the law is ``"coulomb"``
+with ``mu`` (friction coefficients, required: one number ≥ 0 or one per contact) and ``e``
+(Newton's restitution of the normal velocities in [0, 1], one or one per contact; default
+0). ``coulomb`` on frictionless contacts and a frictionless law on frictional ones are
+refused, as is a W whose column count is not a multiple of ``contact_dim``.
 
 Reading is strict: unknown or duplicate keys, wrong types, ragged or mis-shaped arrays and
 non-finite numbers are refused with a :class:`~impactqp.errors.ProblemFileError` that names
@@ -24,8 +32,8 @@ the field. Nothing is evaluated or unpickled. Only regular files are read, at mo
 :data:`MAX_FILE_BYTES` of them (a FIFO or a device cannot hang or exhaust memory); numbers
 too large for a float and nesting too deep for the parser are refused; problems above
 :data:`MAX_DOF` degrees of freedom, and general (dense) problems above
-:data:`MAX_DENSE_CONTACTS` contacts, are refused before any work is done. Writing is in
-:mod:`impactqp.io.save`. (Problem structure: docs/theory.md §1, §3, §5.)
+:data:`MAX_DENSE_CONTACTS` columns of W, are refused before any work is done. Writing is in
+:mod:`impactqp.io.save`. (Problem structure: docs/theory.md §1, §3, §5, §16.)
 """
 
 from __future__ import annotations
@@ -41,11 +49,9 @@ import numpy as np
 
 from ..base.arrays import as_vector
 from ..errors import InputError, ProblemFileError
-from ..laws.catalogue import NAMED_LAWS
-from ..laws.complementarity import check_restitution
-from ..laws.moreau import check_eps
 from ..model.builders import chain
 from ..model.problem import ImpactProblem
+from .file_laws import KNOWN_COEFFICIENTS, LAWS, check_friction, read_coefficients
 
 MAX_FILE_BYTES = 10 * 1024 * 1024
 """Largest problem file that is read (10 MB)."""
@@ -54,18 +60,17 @@ MAX_DOF = 10_000
 """Largest number of degrees of freedom (and of contacts) a problem file may declare."""
 
 MAX_DENSE_CONTACTS = 1_000
-"""Largest number of contacts of a general problem in a file: its Delassus matrix is dense
-(m² entries) and every solve costs at least m³, so larger impacts belong in Python with
-scipy.sparse matrices, where the caller decides what is affordable."""
+"""Largest number of columns of W (frictionless contacts, or d per frictional contact) of a
+general problem in a file: its Delassus matrix is dense (m² entries) and every solve costs
+at least m³, so larger impacts belong in Python with scipy.sparse matrices, where the caller
+decides what is affordable."""
 
 VERSION = 1
-LAWS = tuple(NAMED_LAWS)
-COEFFICIENT_KEYS = {name: law.coefficient_key for name, law in NAMED_LAWS.items()
-                    if law.coefficient_key}
+CONTACT_DIMS = (1, 2, 3)
 GENERAL_KEYS = ("M", "W")
 CHAIN_KEYS = ("masses", "left_wall", "right_wall")
-KNOWN_KEYS = ("version", *GENERAL_KEYS, *CHAIN_KEYS, "u_minus", "law", "eps", "e", "E",
-              "u_plus")
+KNOWN_KEYS = ("version", *GENERAL_KEYS, "contact_dim", *CHAIN_KEYS, "u_minus", "law", "eps",
+              "e", "E", "mu", "u_plus")
 FORMATS = {".json": "json", ".toml": "toml"}
 
 
@@ -78,9 +83,11 @@ class ProblemFile:
     problem : ImpactProblem
     law : str or None
         A name of :data:`!impactqp.laws.catalogue.NAMED_LAWS` (``"moreau"``, ``"newton"``,
-        ``"fremond"``, ``"sector"``, ``"reflection"``) or None when absent.
-    coefficients : float, ndarray or None
-        ε (Moreau), the eᵢ (Newton, an (m,) array) or Frémond's (m, m) matrix E.
+        ``"fremond"``, ``"sector"``, ``"reflection"``, ``"coulomb"``) or None when absent.
+    coefficients : float, ndarray, tuple or None
+        ε (Moreau), the eᵢ (Newton, an (m,) array), Frémond's (m, m) matrix E, or Coulomb's
+        pair (μ, e): each a number or an (m,) array as the file gives it, e None when
+        absent (the law's default 0).
     u_plus : ndarray or None
         A candidate post-impact velocity.
     path : Path or None
@@ -178,9 +185,32 @@ def _bool(name: str, value: Any) -> bool:
     return value
 
 
+def _typed_coefficients(data: dict[str, Any]) -> dict[str, Any]:
+    """The coefficients present in ``data``, typed: ``E`` a matrix, ``eps`` a number, ``e``
+    and ``mu`` a number or a vector (what they mean is checked by the law's reading)."""
+    out: dict[str, Any] = {}
+    for key in KNOWN_COEFFICIENTS:
+        if key not in data:
+            continue
+        value = data[key]
+        out[key] = (_matrix(key, value) if key == "E" else
+                    _vector(key, value) if key != "eps" and isinstance(value, list) else
+                    _number(key, value))
+    return out
+
+
+def _contact_dim(data: dict[str, Any]) -> int:
+    value = data.get("contact_dim", 1)
+    if isinstance(value, bool) or not isinstance(value, int) or value not in CONTACT_DIMS:
+        raise ProblemFileError(f"contact_dim must be the integer 1 (frictionless), 2 (planar "
+                               f"friction) or 3 (spatial friction), got {value!r}")
+    return value
+
+
 def _problem(data: dict[str, Any]) -> ImpactProblem:
     general = [k for k in GENERAL_KEYS if k in data]
     chained = [k for k in CHAIN_KEYS if k in data]
+    d = _contact_dim(data)
     if general and chained:
         raise ProblemFileError(f"give either a general problem (M, W) or a chain (masses), "
                                f"not both: found {general + chained}")
@@ -190,6 +220,10 @@ def _problem(data: dict[str, Any]) -> ImpactProblem:
     if chained:
         if "masses" not in data:
             raise ProblemFileError(f"a chain needs 'masses'; found only {chained}")
+        if d > 1:
+            raise ProblemFileError(f"contact_dim = {d} needs a general problem (M, W with "
+                                   f"{d} columns per contact); a chain's contacts are "
+                                   "frictionless")
         return chain(_vector("masses", data["masses"]), u_minus,
                      left_wall=_bool("left_wall", data.get("left_wall", False)),
                      right_wall=_bool("right_wall", data.get("right_wall", False)))
@@ -200,31 +234,16 @@ def _problem(data: dict[str, Any]) -> ImpactProblem:
     if missing:
         raise ProblemFileError(f"a general problem needs 'M' and 'W'; missing {missing}")
     M, W = _matrix("M", data["M"]), _matrix("W", data["W"])
-    if W.ndim == 2 and W.shape[1] > MAX_DENSE_CONTACTS:
-        raise ProblemFileError(f"W has {W.shape[1]} contacts; problem files hold general "
-                               f"problems of at most {MAX_DENSE_CONTACTS} contacts "
-                               "(MAX_DENSE_CONTACTS: the Delassus matrix is dense); build "
+    if W.shape[1] > MAX_DENSE_CONTACTS:
+        raise ProblemFileError(f"W has {W.shape[1]} columns; problem files hold general "
+                               f"problems of at most {MAX_DENSE_CONTACTS} columns (frictionless "
+                               "contacts, or d per frictional contact; MAX_DENSE_CONTACTS: "
+                               "the Delassus matrix is dense); build "
                                "larger impacts in Python with scipy.sparse matrices")
-    return ImpactProblem(M, W, u_minus)
-
-
-def _coefficients(law: str | None, data: dict[str, Any], m: int) -> float | np.ndarray | None:
-    given = [k for k in COEFFICIENT_KEYS.values() if k in data]
-    wanted = COEFFICIENT_KEYS.get(law) if law else None
-    stray = [k for k in given if k != wanted]
-    if stray:
-        where = f"law {law!r}" if law else "no law"
-        raise ProblemFileError(f"coefficient {stray[0]!r} does not fit {where}; "
-                               f"eps goes with moreau, e with newton, E with fremond")
-    if wanted is None or wanted not in data:
-        return None
-    value = data[wanted]
-    if wanted == "eps":
-        return check_eps(_number("eps", value))
-    if wanted == "e" and not isinstance(value, list):
-        return check_restitution("e", _number("e", value), m)
-    arr = _vector("e", value) if wanted == "e" else _matrix("E", value)
-    return check_restitution(wanted, arr, m, matrix=wanted == "E")
+    if W.shape[1] % d:
+        raise ProblemFileError(f"W has {W.shape[1]} columns, not a multiple of contact_dim = "
+                               f"{d}: give {d} columns per contact, the normal first")
+    return ImpactProblem(M, W, u_minus, contact_dim=d)
 
 
 def problem_from_dict(data: Any) -> ProblemFile:
@@ -248,7 +267,8 @@ def problem_from_dict(data: Any) -> ProblemFile:
         raise ProblemFileError(f"law must be one of {list(LAWS)}, got {law!r}")
     try:
         problem = _problem(data)
-        coefficients = _coefficients(law, data, problem.n_contacts)
+        check_friction(law, problem)
+        coefficients = read_coefficients(law, _typed_coefficients(data), problem.n_contacts)
         u_plus = (as_vector("u_plus", _vector("u_plus", data["u_plus"]), problem.n_dof)
                   if "u_plus" in data else None)
     except ProblemFileError:

@@ -18,28 +18,47 @@ from ..base.arrays import as_dense
 from ..base.outputs import output_file
 from ..errors import InputError
 from ..model.problem import ImpactProblem
-from .files import COEFFICIENT_KEYS, VERSION, file_format, problem_from_dict
+from .file_laws import COEFFICIENT_KEYS
+from .files import VERSION, file_format, problem_from_dict
+
+
+def _coefficient_entries(law: str | None, coefficients: Any) -> dict[str, Any]:
+    """The file keys of ``law``'s coefficients: one value, or a tuple in the order of
+    :data:`~impactqp.io.file_laws.COEFFICIENT_KEYS` (Coulomb's (μ, e), an entry None left out)."""
+    keys = COEFFICIENT_KEYS.get(law, ()) if law else ()
+    if not keys:
+        raise InputError(f"coefficients need a law among {list(COEFFICIENT_KEYS)}, "
+                         f"got law={law!r}")
+    if len(keys) == 1:
+        values = (coefficients,)
+    elif isinstance(coefficients, (tuple, list)) and len(coefficients) == len(keys):
+        values = tuple(coefficients)
+    else:
+        raise InputError(f"law {law!r} takes its coefficients as a pair "
+                         f"({', '.join(keys)}), got {coefficients!r}")
+    return {key: np.asarray(value, dtype=float).tolist()
+            for key, value in zip(keys, values, strict=True) if value is not None}
 
 
 def problem_to_dict(problem: ImpactProblem, *, law: str | None = None, coefficients: Any = None,
                     u_plus: Any = None) -> dict[str, Any]:
-    """The file content of a problem as plain lists and numbers (validated by a re-read)."""
+    """The file content of a problem as plain lists and numbers (validated by a re-read).
+    Frictional problems (``contact_dim`` 2 or 3, docs/theory.md §16) are written with their
+    ``contact_dim`` and dense M and W."""
     data: dict[str, Any] = {"version": VERSION}
     info = problem.chain
-    if info is not None:
+    if info is not None and problem.contact_dim == 1:
         data["masses"] = info.masses.tolist()
         data.update(left_wall=info.left_wall, right_wall=info.right_wall)
     else:
         data.update(M=as_dense(problem.M).tolist(), W=as_dense(problem.W).tolist())
+        if problem.contact_dim > 1:
+            data["contact_dim"] = problem.contact_dim
     data["u_minus"] = problem.u_minus.tolist()
     if law is not None:
         data["law"] = law
     if coefficients is not None:
-        key = COEFFICIENT_KEYS.get(law) if law else None
-        if key is None:
-            raise InputError(f"coefficients need a law among {list(COEFFICIENT_KEYS)}, "
-                             f"got law={law!r}")
-        data[key] = np.asarray(coefficients, dtype=float).tolist()
+        data.update(_coefficient_entries(law, coefficients))
     if u_plus is not None:
         data["u_plus"] = np.asarray(u_plus, dtype=float).tolist()
     problem_from_dict(data)  # refuse to write what could not be read back
@@ -73,15 +92,17 @@ def save_problem(problem: ImpactProblem, path: str | Path, *, law: str | None = 
                  coefficients: Any = None, u_plus: Any = None) -> Path:
     """Write a problem file; the format follows the suffix (``.json`` or ``.toml``).
 
-    Chains are written as chains (masses and walls), every other problem as dense M and W.
+    Chains are written as chains (masses and walls), every other problem as dense M and W
+    (with ``contact_dim`` for frictional contacts).
 
     Parameters
     ----------
     problem : ImpactProblem
     path : str or Path
-    law : {"moreau", "newton", "fremond", "sector"}, optional
-    coefficients : float or array_like, optional
-        ε, the eᵢ or E of ``law``.
+    law : {"moreau", "newton", "fremond", "sector", "reflection", "coulomb"}, optional
+    coefficients : float, array_like or tuple, optional
+        ε, the eᵢ or E of ``law``; for ``"coulomb"`` the pair (μ, e) (``law.coefficients``
+        of an :class:`~impactqp.Coulomb`), each one number or one per contact.
     u_plus : (n,) array_like, optional
         A candidate post-impact velocity.
 

@@ -67,9 +67,11 @@ def abh_error(W, q, mu, d, r, qn):
 @kernel
 def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
     """Semismooth Newton on Alart–Curnier's function for a dense W, updating ``r`` in place:
-    the iteration of ``impactqp.laws.friction._newton`` (docs/theory.md §15), its steps
-    (J + λI)Δ = −Φ solved by :func:`lu_solve`. Returns (steps done, whether the projected r,
-    left in ``r``, is within tol/2 in ‖F‖/‖q‖)."""
+    the iteration of ``impactqp.laws.friction_newton.newton`` (docs/theory.md §15), its steps
+    (J + λI)Δ = −Φ solved by :func:`lu_solve`. Once within tolerance it takes one step more
+    and keeps it if it is better (near a solution a step gains digits quadratically: the few
+    contacts of a time step are answered to round-off, not just to the tolerance). Returns
+    (steps done, whether the projected r, left in ``r``, is within tol/2 in ‖F‖/‖q‖)."""
     n = r.size
     m = mu.size
     qn = np.sqrt(np.sum(q * q))
@@ -87,14 +89,22 @@ def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
     phi = alart_curnier(r, u, mu, rho, d, True, A, B)
     f = np.sqrt(np.sum(phi * phi))
     steps = 0
+    kept = np.empty(n)  # the first projected r within tolerance
+    kept_error = np.inf
+    kept_at = max_steps
     while True:
         F = natural_map(r, u, mu, d)
         if np.sqrt(np.sum(F * F)) <= 0.5 * tol * qn:
             rp = project_cones(r, mu, d)
-            if abh_error(W, q, mu, d, rp, qn) <= 0.5 * tol:
-                r[:] = rp
-                return steps, True
-        if steps == max_steps:
+            error = abh_error(W, q, mu, d, rp, qn)
+            if error <= 0.5 * tol:
+                if kept_error <= 0.5 * tol or error == 0.0:  # the step more is taken
+                    r[:] = rp if error < kept_error else kept
+                    return steps, True
+                kept[:] = rp
+                kept_error = error
+                kept_at = steps
+        if steps == max_steps or steps > kept_at:  # the step more did not do better
             break
         steps += 1
         shift = kappa * min(f / scale, 1e-2)
@@ -128,6 +138,9 @@ def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
         u[:] = u_try
         phi = alart_curnier(r, u, mu, rho, d, True, A, B)
         f = f_try
+    if kept_error <= 0.5 * tol:  # the step more failed: the r within tolerance
+        r[:] = kept
+        return steps, True
     return steps, False
 
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..base.arrays import as_vector
 from ..errors import InputError
-from ..model.admissible import best_impulses
+from ..model.admissible import AdmissibleSet, best_impulses
 from ..model.problem import ImpactProblem
 from ..model.programs import preferred_forms
 from ..model.residuals import impact_residuals, normalized_rows
@@ -69,17 +69,25 @@ class ImpactLaw(ABC):
         reports "no solution" for such a law.
     by_name : bool
         Problem and simulation files and the command line may name the law (its
-        coefficients, if any, under ``coefficient_key``).
+        coefficients, if any, under ``coefficient_keys``).
     coefficient_key, coefficient_symbol : str or None
-        How files and the command line spell its coefficients (``"eps"``) and how reports
-        print them (``"ε"``); None for a law without coefficients.
+        How files and the command line spell its coefficient (``"eps"``) and how reports
+        print it (``"ε"``); None for a law without coefficients.
+    coefficient_keys : tuple of str
+        Every key of its coefficients in files and on the command line, in the order of
+        :attr:`coefficients`: ``(coefficient_key,)`` unless the law sets more
+        (``("mu", "e")`` for Coulomb's law, whose :meth:`from_coefficients` takes a pair).
     needs_coefficients : bool
         Naming the law requires its coefficients (they have no default).
     homogeneous : bool
         u⁻ ↦ (u⁺, Λ) is positively homogeneous of degree one (the laws of docs/theory.md
-        §3, §6, §10, §13): :func:`impactqp.solve` may then solve a problem whose velocities
-        are far from order one in order-one units and scale the answer back (docs/theory.md
-        §8).
+        §3, §6, §10, §13, §16): :func:`impactqp.solve` may then solve a problem whose
+        velocities are far from order one in order-one units and scale the answer back
+        (docs/theory.md §8).
+    frictional : bool
+        The law acts on frictional contacts (``problem.contact_dim`` 2 or 3, docs/theory.md
+        §16), like :class:`~impactqp.Coulomb`; every other law is refused such a problem
+        by the entry points (its ``normal_problem()`` is the frictionless one).
     """
 
     name: ClassVar[str]
@@ -92,14 +100,18 @@ class ImpactLaw(ABC):
             cls.name = cls.__name__.lower()
         if "title" not in cls.__dict__ and not hasattr(cls, "title"):
             cls.title = cls.__name__
+        if "coefficient_key" in cls.__dict__ and "coefficient_keys" not in cls.__dict__:
+            cls.coefficient_keys = (cls.coefficient_key,) if cls.coefficient_key else ()
     forms: ClassVar[tuple[str, ...]] = ()
     closed_form_backend: ClassVar[str] = "closed form"
     always_solvable: ClassVar[bool] = False
     by_name: ClassVar[bool] = False
     coefficient_key: ClassVar[str | None] = None
     coefficient_symbol: ClassVar[str | None] = None
+    coefficient_keys: ClassVar[tuple[str, ...]] = ()
     needs_coefficients: ClassVar[bool] = False
     homogeneous: ClassVar[bool] = False
+    frictional: ClassVar[bool] = False
 
     @classmethod
     def from_coefficients(cls, coefficients: Any = None) -> ImpactLaw:
@@ -136,7 +148,8 @@ class ImpactLaw(ABC):
 
     def check(self, problem: ImpactProblem) -> None:  # noqa: B027 (optional hook)
         """Raise an InputError (naming the argument) when the law cannot act on ``problem``;
-        the default accepts every problem."""
+        the default accepts every problem (the entry points refuse frictional contacts to a
+        law that is not ``frictional`` before they ask)."""
 
     def preferred_forms(self, problem: ImpactProblem) -> tuple[str, ...]:
         """The law's forms to try, best first (:func:`!impactqp.model.programs.preferred_forms`)."""
@@ -171,11 +184,11 @@ class ImpactLaw(ABC):
         """
         if hasattr(output, "u_plus") and hasattr(output, "impulses"):  # an Answer or kin
             u_plus = as_vector(f"{self.title}: u⁺", output.u_plus, problem.n_dof)
-            impulses = as_vector(f"{self.title}: Λ", output.impulses, problem.n_contacts)
+            impulses = as_vector(f"{self.title}: Λ", output.impulses, problem.n_impulses)
             return output._replace(u_plus=u_plus, impulses=impulses)
         if isinstance(output, tuple) and len(output) == 2:
             u_plus = as_vector(f"{self.title}: u⁺", output[0], problem.n_dof)
-            impulses = as_vector(f"{self.title}: Λ", output[1], problem.n_contacts)
+            impulses = as_vector(f"{self.title}: Λ", output[1], problem.n_impulses)
         else:
             u_plus = as_vector(f"{self.title}: u⁺", output, problem.n_dof)
             impulses = best_impulses(problem, u_plus - problem.u_minus)[0]
@@ -196,12 +209,18 @@ class ImpactLaw(ABC):
                          U_minus: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(U⁺, Λ) of a closed-form law for every row of U_minus; by default row by row
         through :meth:`closed_form` (a law that can do better overrides it)."""
-        k, n, m = U_minus.shape[0], problem.n_dof, problem.n_contacts
+        k, n, m = U_minus.shape[0], problem.n_dof, problem.n_impulses
         U_plus, impulses = np.empty((k, n)), np.empty((k, m))
         for i, u in enumerate(U_minus):
             row = problem.with_u_minus(u)
             U_plus[i], impulses[i] = self.answer_of(row, self.closed_form(row))[:2]
         return U_plus, impulses
+
+    def admissible_set(self, problem: ImpactProblem) -> AdmissibleSet:
+        """The admissible set the law's answers on ``problem`` are judged against
+        (docs/theory.md §2; a frictional law passes its friction coefficients,
+        docs/theory.md §16)."""
+        return problem.admissible_set()
 
     def residuals(self, structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
                   impulses: np.ndarray) -> dict[str, np.ndarray]:

@@ -12,15 +12,23 @@ from ..qp import backends
 from ..qp.certified import FAST_PATHS
 from .base import ImpactLaw
 from .complementarity import Fremond, Newton
+from .coulomb import Coulomb
 from .lzb import LZB
 from .moreau import Moreau
 from .reflection import ReflectionLaw
 from .sector import SectorLaw
 
 LAWS: tuple[type[ImpactLaw], ...] = (Moreau, Newton, Fremond, SectorLaw, ReflectionLaw, LZB)
-"""The law classes impactqp ships."""
+"""The law classes impactqp ships for frictionless contacts (the columns of the backend
+table)."""
 
-NAMED_LAWS: dict[str, type[ImpactLaw]] = {law.name: law for law in LAWS if law.by_name}
+FRICTIONAL_LAWS: tuple[type[ImpactLaw], ...] = (Coulomb,)
+"""The law classes impactqp ships for frictional contacts (docs/theory.md §16): solved
+through their local problem by the methods of :func:`~impactqp.solve_friction`, not by the
+QP backends, so they have no column in the backend table."""
+
+NAMED_LAWS: dict[str, type[ImpactLaw]] = {law.name: law for law in (*LAWS, *FRICTIONAL_LAWS)
+                                          if law.by_name}
 """The laws that problem and simulation files and the command line name, by name: the one
 table every reader of a law's name uses."""
 

@@ -33,11 +33,13 @@ __all__ = ["DEFAULT_TOL", "RESIDUAL_NAMES", "Certificate", "ResidualChecks",
 
 
 RESIDUAL_NAMES = ("momentum", "impulse_sign", "law_feasibility", "complementarity",
-                  "energy_balance", "duality_gap", "kinematic", "law_residual")
+                  "energy_balance", "duality_gap", "kinematic", "law_residual",
+                  "natural_map", "cone", "non_penetration")
 """Residuals a certificate may carry, readable as attributes (None when a law has not got
-one): the complementarity laws' six of :mod:`impactqp.kernels.residuals`, and γ⁺ ≥ 0 and the
+one): the complementarity laws' six of :mod:`impactqp.kernels.residuals`, γ⁺ ≥ 0 and the
 agreement with a closed form (``kinematic``, ``law_residual``) of the sector and reflection
-laws."""
+laws, and the friction checks of Coulomb's law (``natural_map``, ``cone``,
+``non_penetration``, docs/theory.md §16)."""
 
 
 @dataclass(frozen=True)
@@ -61,7 +63,10 @@ class Certificate(ResidualChecks):
       error (see :attr:`velocity_error_bound`); small complementarity residuals alone do
       not bound the velocities of ill-conditioned impacts, this does;
     - kinematic, law_residual (sector and reflection laws): γ⁺ ≥ 0, and γ⁺ against an
-      independent evaluation of the law.
+      independent evaluation of the law;
+    - natural_map, cone, non_penetration (Coulomb's law, docs/theory.md §16): the
+      natural-map error of the local problem recomputed from Λ, Λ in the friction cones,
+      and the Newton-shifted normal velocities of u⁺ ≥ 0, each against ‖q‖.
 
     Parameters
     ----------

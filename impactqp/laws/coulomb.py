@@ -1,7 +1,12 @@
-"""Coulomb's law of frictional impacts (docs/theory.md §16).
+"""Coulomb's law of frictional impacts with Newton's restitution in the normal
+(docs/theory.md §16).
 
-placeholder: the class, its coefficients and their validation only, so that the frictional
-Moreau–Jean step can be written against it; the law's solve replaces this file at merge.
+At each contact c (d = 2 or 3 columns of W, the normal first) the impulse Λ_c and the
+Newton-shifted contact velocity U_c = W_cᵀu⁺ + e_c γ⁻_n,c e_n satisfy De Saxcé's
+complementarity Λ_c ∈ K_μc ⟂ U_c + μ_c‖U_T,c‖e_n ∈ K*_μc, with M(u⁺ − u⁻) = WΛ. Eliminating
+u⁺ leaves the local problem U = GΛ + q of :class:`~impactqp.FrictionContactProblem`
+(G = WᵀM⁻¹W, q = Wᵀu⁻ plus e∘γ⁻_n on the normal rows), solved and certified by
+:func:`~impactqp.solve_friction`; u⁺ = u⁻ + M⁻¹WΛ.
 """
 
 from __future__ import annotations
@@ -11,32 +16,246 @@ from typing import Any
 import numpy as np
 
 from ..base.arrays import as_array
-from ..errors import InputError, RestitutionError
-from .base import ImpactLaw
+from ..errors import CertificateError, InputError, NonFiniteError, RestitutionError
+from ..model.admissible import AdmissibleSet
+from ..model.friction import FrictionContactProblem, certify_friction
+from ..model.friction_admissible import friction_coefficients
+from ..model.problem import ImpactProblem
+from ..model.residuals import impact_residuals, normalized_rows
+from ..model.structure import ImpactStructure
+from .base import Answer, ImpactLaw
+from .friction import FRICTION_BACKENDS, solve_friction
+
+__all__ = ["Coulomb", "local_problem"]
+
+SOLVE_TOL = 1e-10
+"""Tolerance the local problem is solved to first (a tenth of the default certificate's)."""
+
+LOOSE_TOL = 1e-7
+"""Tolerance tried when :data:`SOLVE_TOL` is not reached; the certificate at the caller's
+tolerance still decides whether the answer is returned."""
+
+
+def local_problem(structure: ImpactStructure, u_minus: np.ndarray, mu: np.ndarray,
+                  restitution: np.ndarray) -> tuple[FrictionContactProblem, np.ndarray]:
+    """The local problem of a frictional impact in each contact's own units
+    (docs/theory.md §8, §16).
+
+    Returns (problem, s): with G = WᵀM⁻¹W, q = Wᵀu⁻ + e∘γ⁻_n on the normal rows and
+    sᵢ = √G_nn of the contact of entry i, the problem Ũ = G̃ r + q̃ with G̃ = D G D,
+    q̃ = D q and D = diag(1/s): the contacts' columns scaled by 1/s_c, which changes no
+    cone, so its reaction r = sΛ solves the impact's problem U = GΛ + q, Ũ = DU. Velocities
+    are measured in contact units and r is a velocity, so the natural-map error does not
+    depend on the unit of mass or on the length of the columns.
+
+    Parameters
+    ----------
+    structure : ImpactStructure
+        With ``contact_dim`` 2 or 3 and at least one contact.
+    u_minus : (n,) ndarray
+    mu, restitution : (m,) ndarray
+        Per contact.
+    """
+    d = structure.contact_dim
+    q = np.array(structure.Wt_times(u_minus), dtype=float)
+    q[::d] *= 1.0 + restitution
+    G, s = structure.contact_delassus
+    q /= s
+    if not np.isfinite(q).all():
+        raise NonFiniteError("the local problem's free velocity q is not finite: u⁻ is "
+                             "beyond the floats in the contacts' units")
+    return FrictionContactProblem.of_checked(G, q, mu, d), s
+
+
+def _coefficient(name: str, value: Any) -> np.ndarray:
+    """A coefficient as a float array: one number or one per contact (a 1-D array)."""
+    arr = as_array(name, value)
+    if arr.ndim > 1:
+        raise InputError(f"{name} must be a number or one per contact, got shape {arr.shape}")
+    arr.setflags(write=False)
+    return arr
 
 
 class Coulomb(ImpactLaw):
-    """Coulomb friction in De Saxcé's form with Newton's restitution in the normal.
+    """Coulomb friction in De Saxcé's form with Newton's restitution in the normal
+    (docs/theory.md §16), for problems with frictional contacts (``contact_dim`` 2 or 3).
 
     Parameters
     ----------
     mu : float or (m,) array_like
         Friction coefficients, one for all contacts or one per contact, each ≥ 0.
     restitution : float or (m,) array_like
-        Newton's coefficients eᵢ ∈ [0, 1] of the normal velocities.
+        Newton's coefficients e_c ∈ [0, 1] of the normal velocities.
+    method : {"auto", "clarabel", "nsgs"}
+        The method of :func:`~impactqp.solve_friction` for the local problem.
+
+    Attributes
+    ----------
+    mu, restitution : ndarray
+        The coefficients as given (0-d for one number, (m,) per contact).
+
+    Raises
+    ------
+    InputError, NonFiniteError, RestitutionError
+        A negative, NaN or not numeric μ; e outside [0, 1]; an unknown method.
+
+    Notes
+    -----
+    A solution exists when W has independent columns, and for μ = 0 with one e (Moreau's
+    law); not always otherwise (μ = 0 with unequal eᵢ is local Newton), so an answer that
+    no method certifies is a CertificateError, never a claim that none exists.
+
+    A problem with frictionless contacts (``contact_dim = 1``) is refused: it has no
+    tangent columns, and ``iq.Newton(e)`` is the law there (the same as Coulomb's with
+    μ = 0 on the normal problem).
     """
 
     name = "coulomb"
     title = "Coulomb's law"
+    closed_form_backend = "solve_friction"
+    by_name = True
+    coefficient_keys = ("mu", "e")
+    coefficient_symbol = "(μ, e)"
+    needs_coefficients = True
+    always_solvable = False  # μ = 0 with unequal eᵢ is local Newton, which may have none
+    homogeneous = True
+    frictional = True
 
-    def __init__(self, mu: Any, restitution: Any = 0.0) -> None:
-        self.mu = as_array("mu", mu)
-        self.restitution = as_array("restitution", restitution)
-        for name, value in (("mu", self.mu), ("restitution", self.restitution)):
-            if value.ndim > 1:
-                raise InputError(f"{name} must be a number or one per contact, got shape "
-                                 f"{value.shape}")
+    def __init__(self, mu: Any, restitution: Any = 0.0, *, method: str = "auto") -> None:
+        self.mu = _coefficient("mu", mu)
+        self.restitution = _coefficient("restitution", restitution)
         if (self.mu < 0).any():
             raise InputError(f"mu must be ≥ 0, got {mu!r}")
         if not np.all((self.restitution >= 0) & (self.restitution <= 1)):
             raise RestitutionError(f"restitution must lie in [0, 1], got {restitution!r}")
+        if method not in FRICTION_BACKENDS:
+            raise InputError(f"method must be one of {', '.join(FRICTION_BACKENDS)}, got "
+                             f"{method!r}")
+        self.method = method
+        self._per_contact: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+    # --- coefficients -----------------------------------------------------------------
+    @classmethod
+    def from_coefficients(cls, coefficients: Any = None) -> Coulomb:
+        """Coulomb's law named in a file or on the command line: ``coefficients`` is the pair
+        (μ, e) of :attr:`coefficients` (the keys ``mu`` and ``e``), e None for the default 0.
+
+        Raises
+        ------
+        InputError, NonFiniteError, RestitutionError
+            No pair, or coefficients the law refuses.
+        """
+        if not isinstance(coefficients, tuple) or len(coefficients) != 2:
+            raise InputError("law 'coulomb' needs its coefficients as the pair (mu, e): mu "
+                             f"required, e optional (default 0); got {coefficients!r}")
+        mu, e = coefficients
+        if mu is None:
+            raise InputError("law 'coulomb' needs its friction coefficient 'mu'")
+        return cls(mu) if e is None else cls(mu, e)
+
+    @property
+    def coefficients(self) -> tuple[np.ndarray, np.ndarray]:
+        """(μ, e) as given."""
+        return self.mu, self.restitution
+
+    def per_contact(self, m: int) -> tuple[np.ndarray, np.ndarray]:
+        """(μ, e) as one entry per contact for ``m`` contacts, read-only and kept per m (the
+        law is immutable); ShapeError or RestitutionError when a per-contact array has
+        another length."""
+        found = self._per_contact.get(m)
+        if found is not None:
+            return found
+        mu = friction_coefficients(self.mu, m)
+        e = self.restitution
+        if e.ndim == 0:
+            e = np.full(m, float(e))
+        elif e.shape != (m,):
+            raise RestitutionError(f"restitution must be one number or one per contact "
+                                   f"({m},), got shape {e.shape}")
+        mu.setflags(write=False)
+        e.setflags(write=False)
+        self._per_contact[m] = mu, e
+        return mu, e
+
+    def coefficients_for(self, problem: ImpactProblem) -> tuple[np.ndarray, np.ndarray]:
+        return self.per_contact(problem.n_contacts)
+
+    def restrict(self, contacts: np.ndarray) -> Coulomb:
+        mu = self.mu if self.mu.ndim == 0 else self.mu[contacts]
+        e = self.restitution if self.restitution.ndim == 0 else self.restitution[contacts]
+        return Coulomb(mu, e, method=self.method)
+
+    def check(self, problem: ImpactProblem) -> None:
+        if problem.contact_dim == 1:
+            raise InputError("Coulomb's law needs frictional contacts: build the problem with "
+                             "contact_dim=2 (planar) or 3 (spatial) and d columns of W per "
+                             "contact; for frictionless contacts use iq.Newton(e)")
+        self.per_contact(problem.n_contacts)
+
+    def admissible_set(self, problem: ImpactProblem) -> AdmissibleSet:
+        """S with the law's friction cones (docs/theory.md §16)."""
+        return problem.admissible_set(mu=self.per_contact(problem.n_contacts)[0])
+
+    def local_problem(self, problem: ImpactProblem) -> tuple[FrictionContactProblem,
+                                                             np.ndarray]:
+        """The local problem of this impact in contact units and the units s
+        (:func:`local_problem`): its reaction r is sΛ."""
+        self.check(problem)
+        return local_problem(problem.structure, problem.u_minus,
+                             *self.per_contact(problem.n_contacts))
+
+    # --- solve ------------------------------------------------------------------------
+    def closed_form(self, problem: ImpactProblem) -> Answer:
+        """Solve the local problem (:func:`~impactqp.solve_friction`) and recover
+        u⁺ = u⁻ + M⁻¹WΛ."""
+        local, units = self.local_problem(problem)
+        try:
+            found = solve_friction(local, backend=self.method, tol=SOLVE_TOL)
+        except CertificateError:
+            found = solve_friction(local, backend=self.method, tol=LOOSE_TOL)
+        impulses = found.r / units
+        u_plus = problem.u_minus + problem.structure.impulse_velocity(impulses)
+        return Answer(u_plus, impulses, None)
+
+    # --- certificate ------------------------------------------------------------------
+    def residuals(self, structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
+                  impulses: np.ndarray) -> dict[str, Any]:
+        """The momentum residual every law shares and the friction checks of the local
+        problem recomputed from Λ (docs/theory.md §16): ``natural_map`` ‖F(sΛ)‖/‖q̃‖ and
+        ``cone`` (Λ in the friction cones) of the reduced problem in contact units, and
+        ``non_penetration`` ‖(−U_n/s)₊‖/‖q̃‖ of the Newton-shifted normal velocity of u⁺
+        itself."""
+        U_minus, U_plus, impulses = normalized_rows(U_minus, U_plus, impulses)
+        momentum = impact_residuals(structure, U_minus, U_plus, impulses)[1]["momentum"]
+        if np.ndim(U_minus) == 1:
+            return {"momentum": momentum,
+                    **self._friction_residuals(structure, U_minus, U_plus, impulses)}
+        rows = [self._friction_residuals(structure, *row)
+                for row in zip(U_minus, U_plus, impulses, strict=True)]
+        return {"momentum": momentum,
+                **{k: np.array([r[k] for r in rows]) for k in FRICTION_RESIDUALS}}
+
+    def _friction_residuals(self, structure: ImpactStructure, u_minus: np.ndarray,
+                            u_plus: np.ndarray, impulses: np.ndarray) -> dict[str, float]:
+        if structure.m == 0:
+            return dict.fromkeys(FRICTION_RESIDUALS, 0.0)
+        mu, e = self.per_contact(structure.n_contacts)
+        d = structure.contact_dim
+        local, units = local_problem(structure, u_minus, mu, e)
+        with np.errstate(over="ignore", invalid="ignore"):
+            checks = certify_friction(local, units * impulses).values
+            shifted_normal = (structure.Wt_times(u_plus)[::d] +
+                              e * structure.Wt_times(u_minus)[::d]) / units[::d]
+            q_norm = float(np.linalg.norm(local.q))
+            penetration = float(np.linalg.norm(np.minimum(shifted_normal, 0.0)))
+        return {"natural_map": checks["natural_map"], "cone": checks["cone"],
+                "non_penetration": penetration / (q_norm if q_norm > 0 else 1.0)}
+
+    def __repr__(self) -> str:
+        def show(a: np.ndarray) -> str:
+            return np.array2string(a, precision=6) if a.ndim else f"{float(a):g}"
+        return f"Coulomb(mu={show(self.mu)}, restitution={show(self.restitution)})"
+
+
+FRICTION_RESIDUALS = ("natural_map", "cone", "non_penetration")
+"""The friction checks of :meth:`Coulomb.residuals`, beside the shared momentum."""

@@ -14,7 +14,6 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-import clarabel
 import numpy as np
 import scipy.sparse as sp
 
@@ -23,12 +22,13 @@ from ..errors import CertificateError, InputError, SolverError
 from ..kernels.friction import modified_velocity, nsgs_rows, project_cones
 from ..kernels.friction_newton import solve_small
 from ..model.friction import FrictionCertificate, FrictionContactProblem, certify_friction
-from ..qp.backends.clarabel_ import run as run_clarabel
+from ..qp.cone_solve import solve_cone
+from ..qp.cones import ConeProgram, friction_cone_rows
 from .friction_newton import LSTSQ_MAX, NEWTON_STEPS, FrictionData, lstsq_newton, newton, scales
 
 __all__ = ["FRICTION_BACKENDS", "FrictionResult", "solve_friction"]
 
-FRICTION_BACKENDS = ("auto", "newton", "clarabel", "nsgs")
+FRICTION_BACKENDS = ("auto", "clarabel", "nsgs", "newton")
 """Methods of :func:`solve_friction`: ``newton`` (Alart–Curnier semismooth Newton from
 r = 0, then its damped variant), ``clarabel`` (SOCP fixed point, then Newton), ``nsgs``
 (projected Gauss–Seidel, then Newton) and ``auto`` (:data:`AUTO`)."""
@@ -106,7 +106,7 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     Parameters
     ----------
     problem : FrictionContactProblem
-    backend : {"auto", "newton", "clarabel", "nsgs"}
+    backend : {"auto", "clarabel", "nsgs", "newton"}
         ``newton``: Alart–Curnier semismooth Newton from r = 0; ``clarabel``: the fixed
         point of SOCPs, then Newton; ``nsgs``: projected Gauss–Seidel, then Newton;
         ``auto``: 100 NSGS sweeps, Newton from r = 0, the SOCP route, the damped Newton, the
@@ -198,34 +198,16 @@ def _solve_small(problem: FrictionContactProblem, tol: float,
 
 
 def _socp(P: sp.csc_matrix, c: np.ndarray, mu: np.ndarray, d: int) -> np.ndarray:
-    """min ½ rᵀPr + cᵀr over r ∈ K_μ (one cone per contact), by Clarabel.
+    """min ½ rᵀPr + cᵀr over r ∈ K_μ (one cone per contact): a cone program solved and
+    certified through the backend registry (Clarabel; docs/theory.md §9).
 
     Contacts with μ > 0 are second-order cones (μ r_n, r_T); frictionless ones a
     non-negative r_n and r_T = 0 (a zero cone), listed first."""
-    m = mu.size
-    free = np.flatnonzero(mu == 0.0)
-    rough = np.flatnonzero(mu > 0.0)
-    rows, cols, vals = [], [], []
-    row = 0
-    for c_ in free:  # r_n ≥ 0
-        rows.append(row), cols.append(c_ * d), vals.append(-1.0)
-        row += 1
-    for c_ in free:  # r_T = 0
-        for j in range(1, d):
-            rows.append(row), cols.append(c_ * d + j), vals.append(-1.0)
-            row += 1
-    for c_ in rough:  # (μ r_n, r_T) in the second-order cone
-        rows.append(row), cols.append(c_ * d), vals.append(-mu[c_])
-        for j in range(1, d):
-            rows.append(row + j), cols.append(c_ * d + j), vals.append(-1.0)
-        row += d
-    A = sp.csc_matrix((vals, (rows, cols)), shape=(row, m * d))
-    cones = []
-    if free.size:
-        cones += [clarabel.NonnegativeConeT(free.size), clarabel.ZeroConeT(free.size * (d - 1))]
-    cones += [clarabel.SecondOrderConeT(d) for _ in rough]
-    sol, _ = run_clarabel(P, c, A, np.zeros(row), cones, 1e-10)
-    return np.array(sol.x)
+    C, cones = friction_cone_rows(mu, d)
+    # an iterate of the fixed point (its end is judged by certify_friction): certified at
+    # 1e-6, what Clarabel's answers reach on rank-deficient W (3e-7 measured on PerioBox)
+    program = ConeProgram(P, c, -C, np.zeros(C.shape[0]), cones)
+    return solve_cone(program, "clarabel", tol=1e-10, accept=1e-6).x
 
 
 def _socp_route(data: FrictionData, r0: np.ndarray, tol: float) -> tuple[np.ndarray, int, bool]:

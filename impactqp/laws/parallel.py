@@ -86,7 +86,7 @@ def collapsible(problem: ImpactProblem, law: ImpactLaw) -> Groups | None:
     """The groups to collapse ``problem`` by, when ``law`` acts alike on every member of each
     group (Moreau's law; local Newton with one coefficient per group) and there are more
     contacts than degrees of freedom (fewer are answered as they are); else None."""
-    if problem.n_contacts <= problem.n_dof or type(law) not in (Moreau, Newton):
+    if problem.n_impulses <= problem.n_dof or type(law) not in (Moreau, Newton):
         return None
     groups = parallel_groups(problem.structure)
     if groups is None:

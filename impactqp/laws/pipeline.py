@@ -48,7 +48,7 @@ def _trivial(problem: ImpactProblem) -> Answer:
     exactly (γ⁻ = 0); a law with other data (a time-stepping law's previous velocity) may
     reject it, and its certificate decides."""
     u = problem.u_minus.copy()
-    return Answer(u, np.zeros(problem.n_contacts), u.copy())
+    return Answer(u, np.zeros(problem.n_impulses), u.copy())
 
 
 def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,

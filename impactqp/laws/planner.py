@@ -81,8 +81,21 @@ def validate(problem: Any, law: Any, backend: Any, form: Any, tol: Any) -> float
         check_backend(backend)
     check_form(law, form)
     tol = check_tol(tol)
+    if problem.structure.contact_dim != 1:
+        check_friction(problem, law)
     law.check(problem)
     return tol
+
+
+def check_friction(problem: ImpactProblem, law: ImpactLaw) -> None:
+    """InputError when ``problem`` has frictional contacts (``contact_dim`` > 1) and ``law``
+    is not a frictional law (docs/theory.md §16): the message says what to use instead."""
+    if problem.contact_dim > 1 and not law.frictional:
+        raise InputError(f"{law.title} is a frictionless law but the problem has frictional "
+                         f"contacts (contact_dim = {problem.contact_dim}): use "
+                         "iq.Coulomb(mu, restitution), or apply the law to "
+                         "problem.normal_problem(), the frictionless problem of the normal "
+                         "columns")
 
 
 def route(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str = "auto") -> str:

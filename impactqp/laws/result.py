@@ -125,9 +125,12 @@ class ImpactResult:
 
     @cached_property
     def admissible(self) -> Membership:
-        """Whether u⁺ ∈ S (exact test, docs/theory.md §2), with its residuals: the physical
-        verdict, separate from the certificate."""
-        return self.problem.admissible_set().contains(self.u_plus)
+        """Whether u⁺ ∈ S (exact test, docs/theory.md §2; with the law's friction cones for
+        frictional contacts, docs/theory.md §16), with its residuals: the physical verdict,
+        separate from the certificate."""
+        law = self.impact_law
+        S = self.problem.admissible_set() if law is None else law.admissible_set(self.problem)
+        return S.contains(self.u_plus)
 
     @cached_property
     def classification(self) -> Classification:

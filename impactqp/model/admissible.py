@@ -14,10 +14,8 @@ and u⁻ = 0 (S = {0}) is decided exactly.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
-import clarabel
 import numpy as np
 import scipy.sparse as sp
 
@@ -25,60 +23,19 @@ from ..base.arrays import as_vector, check_tol
 from ..base.checks import DEFAULT_TOL, UNIT_RANGE, NamedChecks
 from ..errors import InputError
 from ..kernels.nnls import solve_nnls
-from ..qp.backends.clarabel_ import run as run_clarabel
 from ..qp.certified import solve_in_forms
+from ..qp.cone_solve import solve_cone
+from ..qp.cones import Cone, ConeProgram
 from ..qp.lcp import solve_psd_lcp
 from ..qp.program import QPSolution
+from .friction_admissible import friction_coefficients_of, frictional_membership
+from .membership import METHODS, OPTIMIZER_TOL, Membership
 from .programs import impulse_program, preferred_forms, velocity_program
 from .residuals import law_residuals
 
-OPTIMIZER_TOL = 1e-6
-METHODS = ("exact", "optimizer")
-
-
-@dataclass(frozen=True)
-class Membership:
-    """Verdict on u ∈ S with the residual of each condition (dimensionless, docs/theory.md §2).
-
-    Attributes
-    ----------
-    member : bool
-        The verdict; the object itself is truthy exactly when it is True.
-    kinetic : float
-        min over Λ ≥ 0 of ‖u − u⁻ − M⁻¹WΛ‖ / ‖u⁻‖.
-    kinematic : float
-        Largest penetration velocity −γᵢ / (sᵢ‖u⁻‖), sᵢ = sqrt(Gᵢᵢ), or 0.
-    energetic : float
-        (‖u‖² − ‖u⁻‖²)₊ / ‖u⁻‖².
-    impulses : ndarray
-        A Λ ≥ 0 that best explains u − u⁻ (inf where Λ is beyond the float range: the
-        verdict, computed in order-one units, does not depend on it).
-    method : str
-        ``"exact"`` or ``"optimizer"``.
-    distance : float or None
-        With ``method="optimizer"``: ‖u − proj_S(u)‖ / ‖u⁻‖.
-    tol : float
-    """
-
-    member: bool
-    kinetic: float
-    kinematic: float
-    energetic: float
-    impulses: np.ndarray
-    method: str
-    tol: float
-    distance: float | None = None
-
-    def __bool__(self) -> bool:
-        return self.member
-
-    @property
-    def residuals(self) -> dict[str, float]:
-        return {"kinetic": self.kinetic, "kinematic": self.kinematic, "energetic": self.energetic}
-
-    def failed(self) -> list[str]:
-        """Names of the conditions that are violated beyond the tolerance."""
-        return [k for k, v in self.residuals.items() if v > self.tol]
+GRAZING = 1e-12
+"""Approach velocities −γᵢ⁻/(sᵢ‖u⁻‖) up to which a contact counts as not approaching in
+the SOCP of S (when none approaches, S = {u⁻})."""
 
 
 def best_impulses(problem: Any, du: np.ndarray) -> tuple[np.ndarray, float]:
@@ -119,18 +76,42 @@ def _best_impulses_unit(problem: Any, du: np.ndarray) -> tuple[np.ndarray, float
 
 
 class AdmissibleSet:
-    """The admissible set S of one impact problem (docs/theory.md §2).
+    """The admissible set S of one impact problem (docs/theory.md §2), with friction cones
+    for frictional contacts (docs/theory.md §16).
 
-    Obtain it by ``problem.admissible_set()``.
+    Obtain it by ``problem.admissible_set()``, or ``problem.admissible_set(mu=...)`` for a
+    problem with frictional contacts (``contact_dim`` 2 or 3).
 
     Parameters
     ----------
     problem : ImpactProblem
+    mu : float or (m,) array_like, optional
+        Friction coefficients, one or one per contact, each ≥ 0: required for frictional
+        contacts, refused for frictionless ones.
+
+    Attributes
+    ----------
+    mu : (m,) ndarray or None
+        The friction coefficients per contact (None for frictionless contacts).
+
+    Raises
+    ------
+    InputError, ShapeError, NonFiniteError
+        ``mu`` missing for frictional contacts or given for frictionless ones, of the wrong
+        length, negative, NaN.
     """
 
-    def __init__(self, problem: Any) -> None:
+    def __init__(self, problem: Any, mu: Any = None) -> None:
         self.problem = problem
         self.radius = problem.norm(problem.u_minus)
+        self.mu = friction_coefficients_of(problem, mu)
+
+    def _frictionless(self, what: str) -> None:
+        """InputError for what S with friction does not offer (yet): only ``contains``."""
+        if self.mu is not None:
+            raise InputError(f"{what} is only available for frictionless contacts; for "
+                             "frictional ones use contains(), or the frictionless S of "
+                             "problem.normal_problem()")
 
     def moreau_split(self, tol: float = DEFAULT_TOL) -> tuple[np.ndarray, np.ndarray]:
         """(z, z⊥) with z = prox_{T_C}(u⁻) in the metric M, the point of S of least kinetic
@@ -139,7 +120,7 @@ class AdmissibleSet:
         Solved like Moreau's law with ε = 0 (the same programs and exact fast paths), and
         certified by the same residuals.
         """
-        p = self.problem
+        p = self.problem.normal_problem()  # T_C is decided by the normal columns
         st = p.structure
         u = p.u_minus
         if st.m == 0 or not np.any(u):
@@ -174,7 +155,12 @@ class AdmissibleSet:
         u : (n,) array_like
         method : {"exact", "optimizer"}
             ``"exact"``: NNLS for the impulses plus explicit checks. ``"optimizer"``: the
-            distance from u to S by the SOCP of :meth:`project`.
+            distance from u to S by the SOCP of :meth:`project`. With friction
+            (docs/theory.md §16): ``"exact"`` takes Λ from the momentum equation when W has
+            independent columns (Λ unique) and projects it onto the friction cones, and
+            falls back to the cone program otherwise; ``"optimizer"`` always solves the cone
+            program for the kinetic condition (``distance`` is then None); the membership
+            says which was used.
         tol : float, optional
             Tolerance on the dimensionless residuals (default 1e-9 exact, 1e-6 optimizer).
         """
@@ -194,6 +180,8 @@ class AdmissibleSet:
                               (DEFAULT_TOL if method == "exact" else OPTIMIZER_TOL)
                               if tol is None else tol, distance=None if method == "exact"
                               else (0.0 if zero else float("inf")))
+        if self.mu is not None:
+            return frictional_membership(p, self.mu, u, method, tol)
         un, umn = u / c, p.u_minus / c  # the same S, in units of order one
         V = float(st.kinetic_norms(umn))
         lam, res = best_impulses(p, un - umn)
@@ -224,7 +212,8 @@ class AdmissibleSet:
         raise InputError("the SOCP of S needs a factor of M; pass a dense M or a diagonal one")
 
     def _conic(self, c: np.ndarray, point: np.ndarray | None = None) -> np.ndarray:
-        """Solve an SOCP over ξ = (u, Λ, t) ∈ S with Clarabel and return u, all in the
+        """Solve an SOCP over ξ = (u, Λ, t) ∈ S (a cone program, solved and certified
+        through the backend registry by Clarabel, docs/theory.md §9) and return u, all in the
         normalized units of :meth:`contains` (u⁻ divided by its largest entry, M by its
         largest diagonal entry, each column of W by its norm: the same S).
 
@@ -237,6 +226,12 @@ class AdmissibleSet:
         st = p.structure
         n, m = st.n, st.m
         u_minus = p.u_minus / float(np.abs(p.u_minus).max())
+        if np.all(st.Wt_times(u_minus) >= -GRAZING * st.contact_scale
+                  * float(st.kinetic_norms(u_minus))):
+            # no contact approaches: ‖u⁻ + M⁻¹WΛ‖² = ‖u⁻‖² + 2γ⁻ᵀΛ + ΛᵀGΛ > ‖u⁻‖² unless
+            # WΛ = 0, so S = {u⁻} (docs/theory.md §2), a set without interior on which
+            # no interior-point answer can be certified
+            return u_minus
         mu = float(abs(st.M).max())
         M = sp.csc_matrix(st.M) / mu
         W = sp.csc_matrix(st.W) @ sp.diags(1.0 / np.sqrt(np.asarray(
@@ -251,22 +246,21 @@ class AdmissibleSet:
                   [row0[:, :n], row0[:, n:n + m], row0[:, -1:]],
                   [-F, znm, zn1]]
         b = [np.asarray(M @ u_minus).ravel(), np.zeros(2 * m), [radius], np.zeros(n)]
-        cones = [clarabel.ZeroConeT(n), clarabel.NonnegativeConeT(2 * m),
-                 clarabel.SecondOrderConeT(n + 1)]
+        cones = [Cone("zero", n), Cone("nonnegative", 2 * m), Cone("soc", n + 1)]
         if point is not None:
             blocks += [[row0[:, :n], row0[:, n:n + m], sp.csc_matrix([[-1.0]])], [-F, znm, zn1]]
             b += [[0.0], -np.asarray(F @ point).ravel()]
-            cones.append(clarabel.SecondOrderConeT(n + 1))
+            cones.append(Cone("soc", n + 1))
             q = np.concatenate([np.zeros(n + m), [1.0]])
         else:
             blocks += [[row0[:, :n], row0[:, n:n + m], sp.csc_matrix([[-1.0]])]]
             b += [[0.0]]  # t ≥ 0 keeps the unused variable bounded
-            cones.append(clarabel.NonnegativeConeT(1))
+            cones.append(Cone("nonnegative", 1))
             q = np.concatenate([c, np.zeros(m), [1.0]])
-        A = sp.bmat(blocks, format="csc")
-        P = sp.csc_matrix((n + m + 1, n + m + 1))
-        sol, _ = run_clarabel(P, q, A, np.concatenate(b), cones, 1e-12)
-        return np.array(sol.x[:n])
+        program = ConeProgram(None, q, sp.bmat(blocks, format="csc"), np.concatenate(b), cones)
+        # certified to the accuracy the answers promise (OPTIMIZER_TOL): a set S without
+        # interior makes the multipliers grow without bound and the gap close slowly
+        return solve_cone(program, "clarabel", tol=1e-12, accept=OPTIMIZER_TOL).x[:n]
 
     def project(self, point: Any) -> np.ndarray:
         """Nearest point of S to ``point`` in the kinetic metric (an SOCP, Clarabel):
@@ -281,6 +275,7 @@ class AdmissibleSet:
         (n,) ndarray
             Accurate to about 1e-6 relative (an interior-point solution).
         """
+        self._frictionless("project")
         x = as_vector("point", point, self.problem.n_dof)
         c = float(np.abs(self.problem.u_minus).max(initial=0.0))
         if c == 0.0:
@@ -299,6 +294,7 @@ class AdmissibleSet:
         value : float
         u : (n,) ndarray
         """
+        self._frictionless("support")
         c = as_vector("c", c, self.problem.n_dof)
         scale = float(np.abs(self.problem.u_minus).max(initial=0.0))
         cn = float(np.abs(c).max(initial=0.0))
@@ -320,6 +316,7 @@ class AdmissibleSet:
         """
         import cvxpy as cp
 
+        self._frictionless("constraints")
         p = self.problem
         if tuple(getattr(u_var, "shape", ())) != (p.n_dof,):
             raise InputError(f"u_var must be a cvxpy expression of shape ({p.n_dof},), got "
@@ -332,4 +329,5 @@ class AdmissibleSet:
                 cp.SOC(cp.Constant(self.radius), self._mass_root() @ u_var)]
 
     def __repr__(self) -> str:
-        return f"AdmissibleSet(n_dof={self.problem.n_dof}, radius={self.radius:.6g})"
+        mu = "" if self.mu is None else f", mu={np.array2string(self.mu, precision=4)}"
+        return f"AdmissibleSet(n_dof={self.problem.n_dof}, radius={self.radius:.6g}{mu})"

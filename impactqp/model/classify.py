@@ -73,12 +73,18 @@ def classify(problem: ImpactProblem, u_plus: Any) -> Classification:
     Raises
     ------
     InputError
-        ``problem`` is not an ImpactProblem or ``u_plus`` is not a finite (n,) vector.
+        ``problem`` is not an ImpactProblem, has frictional contacts (the invariants are
+        those of the frictionless geometry: classify against ``problem.normal_problem()``),
+        or ``u_plus`` is not a finite (n,) vector.
     OutOfRangeError
         The intensity or the impulses do not fit in floats (the other invariants would).
     """
     if not isinstance(problem, ImpactProblem):
         raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
+    if problem.contact_dim > 1:
+        raise InputError("the classification (docs/theory.md §4) is that of frictionless "
+                         "impacts, whose u⁺ − u⁻ lies in the normal cone; for frictional "
+                         "contacts classify against problem.normal_problem()")
     u = as_vector("u_plus", u_plus, problem.n_dof)
     scale = max(float(np.abs(problem.u_minus).max(initial=0.0)),
                 float(np.abs(u).max(initial=0.0)))

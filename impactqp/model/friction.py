@@ -71,6 +71,16 @@ class FrictionContactProblem:
         self.contact_dim = d
         self.n_contacts = m
 
+    @classmethod
+    def of_checked(cls, W, q: np.ndarray, mu: np.ndarray,
+                   contact_dim: int) -> FrictionContactProblem:
+        """The problem of arrays impactqp has built and checked itself (W square of size
+        d·m and finite, q finite, μ ≥ 0 one per contact): no validation is repeated."""
+        problem = cls.__new__(cls)
+        problem.W, problem.q, problem.mu = W, q, mu
+        problem.contact_dim, problem.n_contacts = contact_dim, mu.size
+        return problem
+
     def velocity(self, r: np.ndarray) -> np.ndarray:
         """u = W r + q."""
         return np.asarray(self.W @ r).ravel() + self.q
@@ -134,6 +144,21 @@ def _ratio(num: float, den: float) -> float:
     return v if v == v else math.inf
 
 
+def _norm(x: np.ndarray) -> float:
+    """‖x‖₂ of a float vector (as numpy's norm computes it, √(x·x))."""
+    return math.sqrt(float(x @ x))
+
+
+def _candidate(name: str, value, n: int) -> np.ndarray:
+    """A candidate vector of length n as floats (NaN and infinity allowed: they fail the
+    certificate); a float vector impactqp made itself is taken as it is."""
+    if not (isinstance(value, np.ndarray) and value.dtype == np.float64 and value.ndim == 1):
+        value = as_array(name, value, ndim=1, allow_nonfinite=True)
+    if value.shape != (n,):
+        raise ShapeError(f"{name} must have shape ({n},), got {value.shape}")
+    return value
+
+
 def certify_friction(problem: FrictionContactProblem, r, u=None, *,
                      tol: float = 1e-8) -> FrictionCertificate:
     """Recompute the certificate of a candidate reaction ``r`` (and velocity ``u``).
@@ -151,22 +176,17 @@ def certify_friction(problem: FrictionContactProblem, r, u=None, *,
     """
     tol = check_tol(tol)
     n = problem.q.size
-    r = as_array("r", r, ndim=1, allow_nonfinite=True)
-    if r.shape != (n,):
-        raise ShapeError(f"r must have shape ({n},), got {r.shape}")
+    r = _candidate("r", r, n)
     u_w = problem.velocity(r)
-    qn = float(np.linalg.norm(problem.q))
+    qn = _norm(problem.q)
     q_scale = qn if qn > 0.0 else 1.0
     consistency = 0.0
     if u is not None:
-        u = as_array("u", u, ndim=1, allow_nonfinite=True)
-        if u.shape != (n,):
-            raise ShapeError(f"u must have shape ({n},), got {u.shape}")
-        consistency = _ratio(float(np.linalg.norm(u - u_w)), q_scale)
+        consistency = _ratio(_norm(_candidate("u", u, n) - u_w), q_scale)
     f2, comp, pen, cone = certificate_sums(r, u_w, problem.mu, problem.contact_dim)
     fn = math.sqrt(f2)
-    rn = float(np.linalg.norm(r))
-    un = float(np.linalg.norm(u_w))
+    rn = _norm(r)
+    un = _norm(u_w)
     values = {"natural_map": _ratio(fn, q_scale), "velocity": consistency,
               "cone": _ratio(math.sqrt(cone), rn)}
     reported = {"siconos_error": _ratio(fn, max(qn, rn, un)),

@@ -13,30 +13,42 @@ from .structure import ImpactStructure
 
 
 class ImpactProblem:
-    """One frictionless impact: M, W and the pre-impact velocity u⁻ (docs/theory.md §1).
+    """One impact: M, W and the pre-impact velocity u⁻ (docs/theory.md §1), with
+    frictionless contacts (the default) or frictional ones (``contact_dim`` 2 or 3,
+    docs/theory.md §16).
 
     Parameters
     ----------
     M : (n, n) array_like or scipy.sparse matrix
         Mass matrix, symmetric positive definite (the kinetic metric).
-    W : (n, m) array_like or scipy.sparse matrix
-        Generalized force directions of the closed contacts; ``m = 0`` means no contact.
+    W : (n, d·m) array_like or scipy.sparse matrix
+        Generalized force directions of the closed contacts, ``contact_dim = d`` columns per
+        contact: the normal first, then the tangents, the velocities of the contact point
+        along an orthonormal frame (docs/theory.md §16); no columns means no contact.
     u_minus : (n,) array_like
         Pre-impact generalized velocity. Kinematically inconsistent values (a closed contact
         already separating, γ⁻ᵢ > 0) are legal.
+    contact_dim : {1, 2, 3}
+        Columns of W per contact: 1 frictionless (the default; every law applies), 2 for
+        frictional contacts in the plane, 3 in space (only frictional laws such as
+        :class:`~impactqp.Coulomb` apply; :meth:`normal_problem` is the frictionless
+        problem of the normal columns).
     structure : ImpactStructure, optional
-        An already validated and factorized M and W to reuse (then M and W are ignored);
-        :meth:`from_structure` and :meth:`with_u_minus` pass it.
+        An already validated and factorized M and W to reuse (then M, W and
+        ``contact_dim`` are ignored); :meth:`from_structure` and :meth:`with_u_minus` pass
+        it.
 
     Raises
     ------
-    ShapeError, NonFiniteError, MassMatrixError
-        On malformed input; all are ``ValueError`` subclasses.
+    ShapeError, NonFiniteError, MassMatrixError, InputError
+        On malformed input (a column count of W that is not a multiple of ``contact_dim``
+        included); all are ``ValueError`` subclasses.
     """
 
-    def __init__(self, M: Matrix, W: Matrix, u_minus: Any, *,
+    def __init__(self, M: Matrix, W: Matrix, u_minus: Any, *, contact_dim: int = 1,
                  structure: ImpactStructure | None = None) -> None:
-        self.structure = structure if structure is not None else ImpactStructure(M, W)
+        self.structure = structure if structure is not None else \
+            ImpactStructure(M, W, contact_dim=contact_dim)
         self.u_minus = as_vector("u_minus", u_minus, self.structure.n)
         self.u_minus.setflags(write=False)
 
@@ -51,9 +63,14 @@ class ImpactProblem:
 
     # --- data ------------------------------------------------------------------------
     M = property(lambda self: self.structure.M, doc="Mass matrix (n, n).")
-    W = property(lambda self: self.structure.W, doc="Force directions (n, m).")
+    W = property(lambda self: self.structure.W, doc="Force directions (n, d·m).")
     n_dof = property(lambda self: self.structure.n, doc="Number of degrees of freedom n.")
-    n_contacts = property(lambda self: self.structure.m, doc="Number of closed contacts m.")
+    n_contacts = property(lambda self: self.structure.n_contacts,
+                          doc="Number of closed contacts m (the columns of W over d).")
+    n_impulses = property(lambda self: self.structure.m,
+                          doc="Entries of Λ: the columns of W, d per contact.")
+    contact_dim = property(lambda self: self.structure.contact_dim,
+                           doc="Columns of W per contact d: 1 frictionless, 2 or 3 frictional.")
     chain = property(lambda self: self.structure.chain, doc="ChainInfo for 1-D chains, else None.")
     delassus = property(lambda self: self.structure.delassus, doc="Delassus matrix G = WᵀM⁻¹W.")
 
@@ -97,14 +114,25 @@ class ImpactProblem:
     @cached_property
     def moreau_split(self) -> tuple[np.ndarray, np.ndarray]:
         """(z, z⊥): z = prox_{T_C}(u⁻) in the metric M and z⊥ = u⁻ − z (docs/theory.md §1,
-        docs/theory.md §3), by the exact projection of :meth:`AdmissibleSet.moreau_split`;
-        cached."""
-        return self.admissible_set().moreau_split()
+        docs/theory.md §3), by the exact projection of :meth:`AdmissibleSet.moreau_split`
+        (on the normal columns for frictional contacts); cached."""
+        return self.normal_problem().admissible_set().moreau_split()
 
-    def admissible_set(self) -> AdmissibleSet:
-        """The admissible set S of this impact (docs/theory.md §2)."""
-        return AdmissibleSet(self)
+    def normal_problem(self) -> ImpactProblem:
+        """The frictionless problem of the normal columns W[:, ::d] with the same M and u⁻
+        (itself when d = 1): what a frictionless law acts on, and what decides T_C and z
+        (docs/theory.md §16)."""
+        if self.contact_dim == 1:
+            return self
+        return ImpactProblem.from_structure(self.structure.normal_structure, self.u_minus)
+
+    def admissible_set(self, mu: Any = None) -> AdmissibleSet:
+        """The admissible set S of this impact (docs/theory.md §2); for frictional contacts
+        the friction coefficients ``mu`` (one or one per contact) are required and the
+        impulses lie in the friction cones (docs/theory.md §16)."""
+        return AdmissibleSet(self, mu)
 
     def __repr__(self) -> str:
         kind = "sparse" if self.structure.sparse else "dense"
-        return f"ImpactProblem(n_dof={self.n_dof}, n_contacts={self.n_contacts}, {kind})"
+        d = f", contact_dim={self.contact_dim}" if self.contact_dim > 1 else ""
+        return f"ImpactProblem(n_dof={self.n_dof}, n_contacts={self.n_contacts}{d}, {kind})"

@@ -17,9 +17,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
-from ..base.arrays import Matrix, as_dense, as_matrix
+from ..base.arrays import Matrix, as_count, as_dense, as_matrix
 from ..base.rowwise import row_max, row_sum
-from ..errors import MassMatrixError, ShapeError
+from ..errors import InputError, MassMatrixError, ShapeError
 from ..kernels.impact import pack
 
 
@@ -40,6 +40,17 @@ class ChainInfo:
     right_wall: bool = False
 
 
+def _check_contact_dim(value: object, chain: ChainInfo | None) -> int:
+    """``contact_dim`` as an int in {1, 2, 3}, or InputError (also for a frictional chain)."""
+    d = as_count("contact_dim", value)
+    if d not in (1, 2, 3):
+        raise InputError(f"contact_dim must be 1 (frictionless), 2 (planar friction) or 3 "
+                         f"(spatial friction), got {d}")
+    if chain is not None and d != 1:
+        raise InputError("a chain's contacts are frictionless: contact_dim must be 1")
+    return d
+
+
 class ImpactStructure:
     """M and W of an impact, validated and factorized once (docs/theory.md §1).
 
@@ -49,6 +60,10 @@ class ImpactStructure:
         Mass matrix, symmetric positive definite.
     W : (n, m) array_like or scipy.sparse matrix
         Generalized force directions, one column per closed contact; ``m = 0`` is allowed.
+    contact_dim : {1, 2, 3}
+        Columns of W per contact (docs/theory.md §16): 1 for frictionless contacts (one
+        normal column each, the default), 2 or 3 for frictional ones (the normal column
+        first, then the tangent columns; 2 in the plane). ``m`` counts columns either way.
     chain : ChainInfo, optional
         Marks W as the chain's directions
         (:func:`!impactqp.model.chain_structure.chain_directions`), which lets chains use
@@ -65,7 +80,12 @@ class ImpactStructure:
     _diag: np.ndarray | None = None
     """M's diagonal when M is stored as a diagonal (sparse diagonal M, chains), else None."""
 
-    def __init__(self, M: Matrix, W: Matrix, *, chain: ChainInfo | None = None) -> None:
+    contact_dim: int = 1
+    """Columns of W per contact: 1 frictionless, 2 or 3 frictional (docs/theory.md §16)."""
+
+    def __init__(self, M: Matrix, W: Matrix, *, chain: ChainInfo | None = None,
+                 contact_dim: int = 1) -> None:
+        contact_dim = _check_contact_dim(contact_dim, chain)
         M, W = as_matrix("M", M), as_matrix("W", W)
         self.sparse = sp.issparse(M) or sp.issparse(W)
         if self.sparse:
@@ -77,9 +97,14 @@ class ImpactStructure:
             W = np.zeros((n, 0))
         if W.ndim != 2 or W.shape[0] != n:
             raise ShapeError(f"W must have shape (n, m) = ({n}, m) to match M, got {W.shape}")
+        if W.shape[1] % contact_dim:
+            raise ShapeError(f"W has {W.shape[1]} columns, not a multiple of contact_dim = "
+                             f"{contact_dim}: give {contact_dim} columns per contact (the "
+                             "normal first, then the tangents)")
         self.M, self.W = M, W
         self.n, self.m = n, W.shape[1]
         self.chain = chain
+        self.contact_dim = contact_dim
         self._check_symmetric()
         self._factorize()
         col_norms = np.sqrt(np.asarray(abs(W).power(2).sum(axis=0)).ravel()) if self.sparse \
@@ -87,6 +112,21 @@ class ImpactStructure:
         if np.any(col_norms == 0):
             raise ShapeError(f"W column(s) {np.flatnonzero(col_norms == 0).tolist()} are zero: "
                              "every contact needs a non-zero force direction")
+
+    @property
+    def n_contacts(self) -> int:
+        """Number of contacts: the columns of W over :attr:`contact_dim`."""
+        return self.m // self.contact_dim
+
+    @cached_property
+    def normal_structure(self) -> ImpactStructure:
+        """The frictionless structure of the normal columns W[:, ::d] (itself when d = 1):
+        M and the normal directions, for what only the normals decide (T_C, z, γ_n ≥ 0)."""
+        d = self.contact_dim
+        if d == 1:
+            return self
+        W = self.W[:, ::d] if not self.sparse else sp.csc_matrix(self.W)[:, ::d]
+        return ImpactStructure(self.M, W)
 
     def _check_symmetric(self) -> None:
         M = self.M
@@ -250,6 +290,23 @@ class ImpactStructure:
             return B.T @ B
         G = np.asarray(self.W.T @ self.Minv_W)
         return 0.5 * (G + G.T)
+
+    @cached_property
+    def contact_delassus(self) -> tuple[Matrix, np.ndarray]:
+        """(G̃, s), kept: G in each frictional contact's own unit, G̃ = D G D with
+        D = diag(1/s) and sᵢ = √G_nn of the contact of entry i (docs/theory.md §16)."""
+        d = self.contact_dim
+        s = np.repeat(np.sqrt(self.delassus_diagonal[::d]), d)
+        G = self.delassus
+        if sp.issparse(G):
+            D = sp.diags(1.0 / s)
+            return sp.csc_matrix(D @ G @ D), s
+        return G / np.outer(s, s), s
+
+    @cached_property
+    def full_column_rank(self) -> bool:
+        """W has independent columns, so the Λ of M(u⁺ − u⁻) = WΛ is unique."""
+        return self.m <= self.n and int(np.linalg.matrix_rank(as_dense(self.W))) == self.m
 
     @cached_property
     def delassus_lu(self):

@@ -1,13 +1,16 @@
 """Systems to simulate (docs/theory.md §14): a bouncing ball, Newton's cradle on pendulums and
 a column of beads under gravity — all 1-D chains of balls in the sense of docs/theory.md §5,
-so the sector law and the O(N) isotonic path apply to their impacts."""
+so the sector law and the O(N) isotonic path apply to their impacts; and, with friction
+(docs/theory.md §17), a block on an incline, a sphere and a box on a floor."""
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
-from ..base.arrays import as_count, as_flag, as_real
+from ..base.arrays import as_count, as_flag, as_real, as_vector
 from ..errors import InputError
 from ..model.builders import chain_directions
 from ..model.structure import ChainInfo
@@ -138,3 +141,186 @@ def bead_chain(n_beads: int = 10, mass: float = 1.0, radius: float = 0.1, height
     q0 = height + spacing * np.arange(n)
     return LinearSystem(M, q0, np.full(n, velocity), np.full(n, -mass * gravity), H, b,
                         chain=info)
+
+
+def block_on_incline(angle: float, mass: float = 1.0, gravity: float = 9.81, dim: int = 2,
+                     position: float = 0.0, speed: float = 0.0, gap: float = 0.0,
+                     normal_speed: float = 0.0, twist: float = 0.0) -> LinearSystem:
+    """A block (a point mass) on a plane inclined by ``angle``, under gravity, with friction.
+
+    q is the block's position in a fixed frame whose last axis points up; the plane passes
+    through the origin and rises along the first axis. Its contact (``contact_dim`` =
+    ``dim``) has the plane's unit normal n = (−sin α, [0,] cos α) first and then the
+    tangents: in the plane the up-slope direction t = (cos α, sin α); in space the up-slope
+    direction (cos α, 0, sin α) and the horizontal (0, 1, 0), both turned about n by
+    ``twist`` (Coulomb's cone is isotropic, so the motion does not depend on it). The gap is
+    nᵀq. docs/theory.md §17 derives the Moreau–Jean motion in closed form.
+
+    Parameters
+    ----------
+    angle : float
+        α in radians, in [0, π/2).
+    mass, gravity : float
+        Positive mass and g ≥ 0.
+    dim : int
+        2 (the plane, q = (x, y)) or 3 (space, q = (x, y, z)).
+    position, speed : float
+        Initial distance and velocity up the slope.
+    gap, normal_speed : float
+        Initial height above the plane and velocity along n. A slightly negative ``gap``
+        (an overlap of, say, 10⁻⁹) keeps a resting contact closed under the activation rule
+        g + ½hγ ≤ 0 against the round-off of nᵀq.
+    twist : float
+        Angle (radians) of the tangents about the normal in space; unused in the plane.
+
+    Returns
+    -------
+    LinearSystem
+        n = ``dim`` degrees of freedom, one contact with ``contact_dim = dim``.
+    """
+    angle = as_real("angle", angle, low=0.0)
+    if not angle < 0.5 * np.pi:
+        raise InputError(f"angle must lie in [0, π/2) radians, got {angle!r}")
+    dim = as_count("dim", dim)
+    if dim not in (2, 3):
+        raise InputError(f"dim must be 2 (the plane) or 3 (space), got {dim}")
+    mass = as_real("mass", mass, positive=True)
+    gravity = as_real("gravity", gravity, low=0.0)
+    position, speed = as_real("position", position), as_real("speed", speed)
+    gap, normal_speed = as_real("gap", gap), as_real("normal_speed", normal_speed)
+    twist = as_real("twist", twist)
+    s, c = np.sin(angle), np.cos(angle)
+    if dim == 2:
+        normal, up = np.array([-s, c]), np.array([c, s])
+        tangents = [up]
+    else:
+        normal, up, side = np.array([-s, 0.0, c]), np.array([c, 0.0, s]), np.array([0., 1., 0.])
+        tangents = [np.cos(twist) * up + np.sin(twist) * side,
+                    -np.sin(twist) * up + np.cos(twist) * side]
+    H = np.column_stack([normal, *tangents])
+    weight = np.zeros(dim)
+    weight[-1] = -mass * gravity
+    q0 = position * up + gap * normal
+    v0 = speed * up + normal_speed * normal
+    return LinearSystem(mass * np.eye(dim), q0, v0, weight, H, contact_dim=dim)
+
+
+def rolling_sphere(mass: float = 1.0, radius: float = 0.1, gravity: float = 9.81,
+                   velocity: float = 1.0, spin: float = 0.0, height: float | None = None,
+                   vertical_velocity: float = 0.0, gap: float = 0.0) -> LinearSystem:
+    """A solid sphere on a horizontal floor in the plane, with friction at its lowest point.
+
+    q = (x, y, φ): the centre and the rotation angle (counter-clockwise), with
+    M = diag(m, m, I), I = 2/5 mR². The contact has the normal (0, 1, 0) (gap y − R) and the
+    tangent (1, 0, R): the slip velocity of the lowest point is ẋ + Rφ̇, zero when the
+    sphere rolls. docs/theory.md §17 derives sliding to rolling and the oblique bounce.
+
+    Parameters
+    ----------
+    mass, radius : float
+        Positive mass and radius R.
+    gravity : float
+        g ≥ 0, acting on y.
+    velocity, spin : float
+        Initial ẋ and angular velocity φ̇ (ω₀).
+    height : float, optional
+        Initial y of the centre (R + ``gap`` when omitted; at least R).
+    vertical_velocity : float
+        Initial ẏ.
+    gap : float
+        Initial gap of a sphere on the floor when ``height`` is omitted; a slightly negative
+        one keeps the contact closed under the activation rule against round-off.
+
+    Returns
+    -------
+    LinearSystem
+        Three degrees of freedom, one contact with ``contact_dim = 2``.
+    """
+    mass = as_real("mass", mass, positive=True)
+    radius = as_real("radius", radius, positive=True)
+    gravity = as_real("gravity", gravity, low=0.0)
+    velocity, spin = as_real("velocity", velocity), as_real("spin", spin)
+    vertical_velocity, gap = as_real("vertical_velocity", vertical_velocity), as_real("gap", gap)
+    if height is None:
+        height = radius + gap
+    else:
+        height = as_real("height", height)
+        if height < radius:
+            raise InputError(f"height must be at least the radius {radius!r}, got {height!r}")
+    M = np.diag([mass, mass, 0.4 * mass * radius**2])
+    H = np.array([[0.0, 1.0], [1.0, 0.0], [0.0, radius]])
+    return LinearSystem(M, [0.0, height, 0.0], [velocity, vertical_velocity, spin],
+                        [0.0, -mass * gravity, 0.0], H, [-radius], contact_dim=2)
+
+
+def box_on_floor(dim: int = 3, mass: float = 1.0, half_sizes: Any = None,
+                 gravity: float = 9.81, velocity: Any = 0.0, gap: float = 0.0) -> LinearSystem:
+    """A rigid box resting flat on a horizontal floor on its corners, with friction there.
+
+    Small rotations, linearized (constant H): in the plane q = (x, y, φ) and the box stands
+    on its two lower corners; in space q = (x, y, z, ρx, ρy, ρz) and it stands on its four
+    lower corners, the last coordinate axis pointing up. The contact at a corner p (relative
+    to the centre) has the columns (n; p × n) of the floor's normal and then of the
+    horizontal axes, so its velocity along a direction n is nᵀ(v + ω × p); the gap is the
+    corner's height. M = diag(m, …, I) with the box's principal moments of inertia. A box
+    sliding flat decelerates at μg until it stops (docs/theory.md §17).
+
+    Parameters
+    ----------
+    dim : int
+        2 (the plane) or 3 (space).
+    mass : float
+        Positive mass.
+    half_sizes : array_like, optional
+        Half the box's sides, horizontal first and the height last ((0.5, 0.25) in the plane,
+        (0.5, 0.4, 0.25) in space when omitted), each positive.
+    gravity : float
+        g ≥ 0.
+    velocity : float or (2,) array_like
+        The initial horizontal velocity of the centre (one number in the plane).
+    gap : float
+        Initial height of the corners above the floor; a slightly negative one keeps the
+        contacts closed under the activation rule against round-off.
+
+    Returns
+    -------
+    LinearSystem
+        3 (plane) or 6 (space) degrees of freedom; 2 or 4 contacts with ``contact_dim`` =
+        ``dim``.
+    """
+    dim = as_count("dim", dim)
+    if dim not in (2, 3):
+        raise InputError(f"dim must be 2 (the plane) or 3 (space), got {dim}")
+    mass = as_real("mass", mass, positive=True)
+    gravity, gap = as_real("gravity", gravity, low=0.0), as_real("gap", gap)
+    sizes = np.array([0.5, 0.25] if dim == 2 else [0.5, 0.4, 0.25]) if half_sizes is None \
+        else as_vector("half_sizes", half_sizes, dim)
+    if not (sizes > 0).all():
+        raise InputError(f"half_sizes must be positive, got {sizes.tolist()}")
+    horizontal = as_vector("velocity", np.atleast_1d(velocity), dim - 1)
+    height = sizes[-1]
+    axes = np.eye(dim)
+    directions = [axes[-1], *axes[:-1]]  # the normal first, then the horizontal tangents
+    if dim == 2:
+        a = sizes[0]
+        corners = [np.array([x, -height]) for x in (a, -a)]
+        inertia = [mass * (a**2 + height**2) / 3.0]
+    else:
+        a, b = sizes[0], sizes[1]
+        corners = [np.array([x, y, -height]) for x in (a, -a) for y in (b, -b)]
+        inertia = [mass * (b**2 + height**2) / 3.0, mass * (a**2 + height**2) / 3.0,
+                   mass * (a**2 + b**2) / 3.0]
+    def moment(p: np.ndarray, d: np.ndarray) -> np.ndarray:  # p × d (its z in the plane)
+        return np.cross(p, d) if dim == 3 else np.array([p[0] * d[1] - p[1] * d[0]])
+
+    columns = [np.concatenate([d, moment(p, d)]) for p in corners for d in directions]
+    M = np.diag([mass] * dim + inertia)
+    n = M.shape[0]
+    q0 = np.zeros(n)
+    q0[dim - 1] = height + gap
+    v0 = np.zeros(n)
+    v0[:dim - 1] = horizontal
+    weight = np.zeros(n)
+    weight[dim - 1] = -mass * gravity
+    return LinearSystem(M, q0, v0, weight, np.column_stack(columns),
+                        np.full(len(corners), -height), contact_dim=dim)

@@ -35,6 +35,7 @@ from ..errors import InputError, SolverError
 from ..laws.base import ImpactLaw
 from .clusters import ClusterCache
 from .impacts import ImpactEvent, ImpactSolver
+from .routing import check_frictionless
 from .smooth import Phase, check_solved, contact_accelerations, first_closing
 from .system import LinearSystem
 from .trajectory import Trajectory
@@ -121,11 +122,12 @@ def event_driven(system: LinearSystem, law: ImpactLaw, t_end: float, h: float | 
     Raises
     ------
     InputError
-        The initial state penetrates a contact (gap < −gap_tol).
+        The initial state penetrates a contact (gap < −gap_tol); friction.
     SolverError
         The ODE solver failed, more than ``max_events`` events, or events accumulating
         at one time that settling does not resolve.
     """
+    check_frictionless(system, law, "event-driven")
     n = system.n_dof
     cache = ClusterCache(system.M, system.H, system.chain)
     solver = ImpactSolver(cache, law, backend=backend, tol=tol)

@@ -11,9 +11,12 @@ from ..base.arrays import as_count, as_flag, as_real, check_tol
 from ..base.checks import DEFAULT_TOL
 from ..errors import InputError, NonFiniteStateError
 from ..laws.base import ImpactLaw
+from ..laws.coulomb import Coulomb
 from ..laws.planner import check_backend, check_law
 from ..model.problem import ImpactProblem
 from .event_driven import event_driven
+from .friction_step import check_friction_backend, coulomb_coefficients
+from .routing import check_frictionless
 from .system import LinearSystem
 from .time_stepping import moreau_jean
 from .trajectory import Trajectory
@@ -64,7 +67,8 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
     law : ImpactLaw
         ``iq.Moreau(eps)``, ``iq.Newton(e)`` (one coefficient, or one per contact of the
         system), ``iq.Fremond(E)`` (m × m), ``iq.SectorLaw()``, ``iq.ReflectionLaw()`` or any
-        :class:`impactqp.ImpactLaw`.
+        :class:`impactqp.ImpactLaw`; ``iq.Coulomb(mu, restitution)`` for a system with
+        ``contact_dim`` 2 or 3 (Moreau–Jean only, docs/theory.md §17).
     t_end : float
         Final time, after ``t0``.
     scheme : {"moreau-jean", "event-driven"}
@@ -78,7 +82,8 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
     t0 : float
         Initial time.
     backend, tol : str, float
-        For every impact problem, passed to :func:`impactqp.solve`.
+        For every impact problem, passed to :func:`impactqp.solve` (with Coulomb's law to
+        :func:`impactqp.solve_friction`: ``"auto"``, ``"clarabel"`` or ``"nsgs"``).
     progress : callable, optional
         Called with the simulated time now and then.
     **options
@@ -98,7 +103,8 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
     InputError
         Bad arguments (naming them); a law that does not fit the system's contacts (e.g.
         ``SectorLawError`` for the sector law on a chain with a wall); more than 10⁸ steps
-        (or output points) for ``h`` and ``t_end``.
+        (or output points) for ``h`` and ``t_end``; Coulomb's law on a frictionless system,
+        another law on a frictional one, or friction with ``scheme="event-driven"``.
     NonFiniteStateError
         A recorded state is NaN or infinite (the message gives the first such time).
     SolverError, CertificateError, NoSolutionError
@@ -108,9 +114,16 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
         raise InputError(f"system must be an impactqp LinearSystem, got "
                          f"{type(system).__name__}")
     check_law(law)
-    law.check(ImpactProblem.from_structure(system.structure, np.zeros(system.n_dof)))
     if scheme not in SCHEMES:
         raise InputError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
+    frictional = isinstance(law, Coulomb)
+    if frictional or system.contact_dim > 1:
+        if scheme != "moreau-jean":
+            check_frictionless(system, law, scheme)
+        if frictional:
+            coulomb_coefficients(law, system)
+    else:
+        law.check(ImpactProblem.from_structure(system.structure, np.zeros(system.n_dof)))
     t0 = as_real("t0", t0)
     t_end = as_real("t_end", t_end)
     if not t_end > t0:
@@ -123,7 +136,9 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
                          f"{steps:.3g} {what}, at most {MAX_STEPS:.0e}; raise h or shorten "
                          "the run")
     theta = as_real("theta", theta, low=0.0, high=1.0)
-    if law.forms or backend != law.closed_form_backend:
+    if frictional:
+        check_friction_backend(backend)
+    elif law.forms or backend != law.closed_form_backend:
         check_backend(backend)
     tol = check_tol(tol)
     if progress is not None and not callable(progress):

@@ -5,7 +5,9 @@
 with a constant symmetric positive definite mass matrix M (dense or scipy.sparse), one column
 of H per contact (the contact matrix W of every impact is H restricted to the closed contacts)
 and an external force that is a constant vector, a :class:`LinearForce` c − Kq, or any
-callable force(t, q, v).
+callable force(t, q, v). With friction (``contact_dim`` d = 2 or 3, docs/theory.md §17) H
+holds d columns per contact, the normal first and then the tangents; the gaps use the normal
+columns only.
 """
 
 from __future__ import annotations
@@ -16,12 +18,15 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..base.arrays import Matrix, as_matrix, as_vector
+from ..base.arrays import Matrix, as_count, as_matrix, as_vector
 from ..errors import InputError, MassMatrixError, NonFiniteStateError, ShapeError
 from ..model.builders import chain_directions
 from ..model.structure import ChainInfo, ImpactStructure
 
 Force = Callable[[float, np.ndarray, np.ndarray], Any]
+
+CONTACT_DIMS = (1, 2, 3)
+"""Columns of H per contact: frictionless, planar friction, spatial friction."""
 
 
 class LinearForce:
@@ -95,9 +100,10 @@ class LinearSystem:
     force : (n,) array_like, LinearForce or callable, optional
         External force: a constant vector, ``LinearForce(K, c)`` (c − Kq), or any callable
         ``force(t, q, v)`` returning an (n,) array. Zero when omitted.
-    H : (n, m) array_like or scipy.sparse matrix, optional
-        One column per contact: gap gᵢ = Hᵢᵀq + bᵢ, open when positive (docs/theory.md §12
-        for the sign). No contact when omitted.
+    H : (n, d·m) array_like or scipy.sparse matrix, optional
+        d = ``contact_dim`` columns per contact, the normal hᵢ first: gap gᵢ = hᵢᵀq + bᵢ, open
+        when positive (docs/theory.md §12 for the sign); then the d − 1 tangents of a
+        frictional contact (docs/theory.md §17). No contact when omitted.
     b : (m,) array_like, optional
         Gap offsets (zero when omitted).
     potential : callable, optional
@@ -106,7 +112,11 @@ class LinearSystem:
     chain : ChainInfo, optional
         Marks a 1-D chain of balls (docs/theory.md §5): M = diag(masses) and H in the column
         order of :func:`impactqp.chain`, checked here. Chains are what the sector law and the
-        O(N) isotonic path need.
+        O(N) isotonic path need. Frictionless systems only.
+    contact_dim : int
+        d, the columns of H per contact: 1 (frictionless, the default), 2 (normal and one
+        tangent, motion in the plane) or 3 (normal and two tangents, in space). A system with
+        d > 1 is simulated with ``iq.Coulomb(mu, restitution)``.
 
     Raises
     ------
@@ -116,7 +126,14 @@ class LinearSystem:
 
     def __init__(self, M: Matrix, q0: Any, v0: Any, force: Any = None, H: Matrix = None,
                  b: Any = None, *, potential: Callable[[np.ndarray], float] | None = None,
-                 chain: ChainInfo | None = None) -> None:
+                 chain: ChainInfo | None = None, contact_dim: int = 1) -> None:
+        d = as_count("contact_dim", contact_dim, minimum=1)
+        if d not in CONTACT_DIMS:
+            raise InputError(f"contact_dim must be one of {CONTACT_DIMS} (frictionless, planar "
+                             f"or spatial friction), got {d}")
+        if d > 1 and chain is not None:
+            raise InputError(f"chain marks frictionless chains of balls; a system with "
+                             f"contact_dim = {d} takes none")
         M = as_matrix("M", M)
         if M.ndim != 2 or M.shape[0] != M.shape[1] or M.shape[0] == 0:
             raise ShapeError(f"M must be a non-empty square (n, n) matrix, got shape {M.shape}")
@@ -125,12 +142,16 @@ class LinearSystem:
         if H.ndim != 2 or H.shape[0] != n:
             raise ShapeError(f"H must have shape (n, m) = ({n}, m), one column per contact, "
                              f"got {H.shape}")
+        if H.shape[1] % d:
+            raise ShapeError(f"H must hold contact_dim = {d} columns per contact (normal, then "
+                             f"tangents), got {H.shape[1]} columns")
         norms = np.asarray(abs(H).sum(axis=0)).ravel()
         if np.any(norms == 0):
             raise ShapeError(f"H column(s) {np.flatnonzero(norms == 0).tolist()[:5]} are zero: "
                              "every contact needs a non-zero direction")
+        self.contact_dim = d
         self.structure = ImpactStructure(M, H, chain=self._check_chain(chain, M, H))
-        n, m = self.structure.n, self.structure.m
+        n, m = self.structure.n, self.structure.m // d
         self.q0 = as_vector("q0", q0, n)
         self.v0 = as_vector("v0", v0, n)
         self.b = np.zeros(m) if b is None else as_vector("b", b, m)
@@ -142,7 +163,8 @@ class LinearSystem:
             self._potential = potential
         self.linear_force = force if isinstance(force, LinearForce) else None
         as_vector("force(0, q0, v0)", self.force(0.0, self.q0, self.v0), n)
-        self.Ht = sp.csr_matrix(self.H.T) if self.structure.sparse else np.asarray(self.H).T
+        normals = self.H[:, ::d]
+        self.Ht = sp.csr_matrix(normals.T) if self.structure.sparse else np.asarray(normals).T
 
     @staticmethod
     def _check_chain(chain: Any, M: Matrix, H: Matrix) -> ChainInfo | None:
@@ -164,18 +186,21 @@ class LinearSystem:
 
     # --- data ----------------------------------------------------------------------------
     M = property(lambda self: self.structure.M, doc="Mass matrix (n, n).")
-    H = property(lambda self: self.structure.W, doc="Contact directions (n, m).")
+    H = property(lambda self: self.structure.W,
+                 doc="Contact directions (n, d·m): per contact the normal, then the tangents.")
     n_dof = property(lambda self: self.structure.n, doc="Number of degrees of freedom n.")
-    n_contacts = property(lambda self: self.structure.m, doc="Number of contacts m.")
+    n_contacts = property(lambda self: self.structure.m // self.contact_dim,
+                          doc="Number of contacts m.")
     chain = property(lambda self: self.structure.chain, doc="ChainInfo of a 1-D chain, or None.")
 
     # --- contact geometry and energy -----------------------------------------------------
     def gaps(self, q: np.ndarray) -> np.ndarray:
-        """g = Hᵀq + b for a position or for every row of a (k, n) array."""
+        """g = Hᵀq + b (normal columns of H) for a position or every row of a (k, n) array."""
         return np.asarray(self.Ht @ np.asarray(q).T).T + self.b
 
     def contact_velocities(self, v: np.ndarray) -> np.ndarray:
-        """γ = Hᵀv (γᵢ > 0 opens contact i) for a velocity or every row of a (k, n) array."""
+        """γ = Hᵀv on the normal columns (γᵢ > 0 opens contact i) for a velocity or every row
+        of a (k, n) array."""
         return np.asarray(self.Ht @ np.asarray(v).T).T
 
     def force_at(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -218,4 +243,5 @@ class LinearSystem:
     def __repr__(self) -> str:
         kind = "chain" if self.chain is not None else \
             ("sparse" if self.structure.sparse else "dense")
-        return f"LinearSystem(n_dof={self.n_dof}, n_contacts={self.n_contacts}, {kind})"
+        dim = f", contact_dim={self.contact_dim}" if self.contact_dim > 1 else ""
+        return f"LinearSystem(n_dof={self.n_dof}, n_contacts={self.n_contacts}{dim}, {kind})"

@@ -13,14 +13,21 @@ uses:
    ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k``), giving v_{k+1} = u⁺;
 4. q_{k+1} = q_k + h((1 − θ)v_k + θv_{k+1}).
 
-Two loops run these steps. The compiled loop (:func:`impactqp.kernels.moreau_jean.run`)
-takes a run when :func:`compiled_applies` says so: a built-in complementarity law (Moreau,
-Newton, Frémond, by exact type), a constant or linear force, ``backend="auto"`` and a system
-small enough to be held dense. Every other run — a callable force, any other law (the sector
-and reflection laws, LZB, a user's law), a named backend, a large system — takes the Python
-loop, which solves each cluster through :func:`impactqp.solve`. A step whose compiled
-certificate fails is solved again by the Python loop's step (which raises what it raises),
-and the compiled loop resumes after it.
+Four loops run these steps, chosen by :func:`route`. A
+:class:`~impactqp.laws.coulomb.Coulomb` law on a system with ``contact_dim`` 2 or 3 takes a
+frictional loop (docs/theory.md §17): the compiled one
+(:class:`~impactqp.simulation.friction_loop.CompiledFriction`) under the conditions of the
+compiled loop below, else the Python loop with
+:class:`~impactqp.simulation.friction_step.FrictionStep` as its step; a Coulomb law on a
+frictionless system or another law on a frictional system are refused by name. The
+compiled loop (:func:`impactqp.kernels.moreau_jean.run`) takes a run when
+:func:`compiled_applies` says so: a built-in complementarity law (Moreau, Newton, Frémond,
+by exact type), a constant or linear force, ``backend="auto"`` and a system small enough to
+be held dense. Every other run — a callable force, any other law (the sector and reflection
+laws, LZB, a user's law), a named backend, a large system — takes the Python loop, which
+solves each cluster through :func:`impactqp.solve`. A step whose compiled certificate fails
+is solved again by the Python loop's step (which raises what it raises), and the compiled
+loop resumes after it.
 """
 
 from __future__ import annotations
@@ -32,33 +39,26 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.checks import DEFAULT_TOL
-from ..errors import InputError
 from ..kernels.moreau_jean import CHECKED, DONE, FAILED, run
 from ..kernels.residuals import RESIDUALS
 from ..laws.base import ImpactLaw
 from ..laws.certificate import Certificate
-from ..laws.complementarity import Fremond, Newton
-from ..laws.moreau import Moreau
 from ..laws.result import ImpactResult
 from ..model.problem import ImpactProblem
 from ..model.residuals import restitution_matrix
 from ..model.structure import ImpactStructure
 from .clusters import ClusterCache
+from .friction_loop import CompiledFriction
+from .friction_step import FrictionEvent, FrictionStep
 from .impacts import ImpactEvent, ImpactSolver
+from .routing import compiled_applies as compiled_applies  # re-exported: imported from here
+from .routing import route
 from .step_law import MoreauJeanStep
 from .system import LinearSystem
 from .trajectory import Trajectory
 
 LOOP_BACKEND = "compiled Moreau–Jean loop"
 """What answered an impact solved inside the compiled loop (its events' ``result.backend``)."""
-
-COMPILED_LAWS = (Moreau, Newton, Fremond)
-"""The laws the compiled loop takes, by exact type (a subclass may change the law)."""
-
-MAX_COMPILED = 400
-"""Most degrees of freedom and most contacts the compiled loop takes (it holds Ŵ⁻¹, Ŵ⁻¹H
-and HᵀŴ⁻¹H dense)."""
-
 
 def step_count(t0: float, t_end: float, h: float) -> int:
     """Number of steps of length h that reach t_end (at least one)."""
@@ -99,15 +99,16 @@ class _FreeVelocity:
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         return v - self.solver.solve_mass(self.residual(t, q, v))
 
-
-def compiled_applies(system: LinearSystem, law: ImpactLaw, backend: str) -> bool:
-    """Whether a run takes the compiled loop (the module docstring's rule): Moreau's,
-    Newton's or Frémond's law (exact types), a constant or linear force, ``backend="auto"``,
-    a dense system (M and H not scipy.sparse) with at least one contact and at most
-    :data:`MAX_COMPILED` degrees of freedom and contacts."""
-    return (backend == "auto" and type(law) in COMPILED_LAWS and not system.structure.sparse
-            and (system.constant_force is not None or system.linear_force is not None)
-            and 0 < system.n_contacts <= MAX_COMPILED and system.n_dof <= MAX_COMPILED)
+    def kernel_arrays(self, t0: float) -> tuple:
+        """(L of Ŵ = LLᵀ, K, c, Ŵ⁻¹r, linear): the force as the compiled loops take it, for
+        a linear force or (Ŵ⁻¹r formed once) a constant one."""
+        n = self.system.n_dof
+        if self.K is not None:
+            K = self.K.toarray() if sp.issparse(self.K) else self.K
+            return (self.solver.cholesky_factor, np.ascontiguousarray(K, dtype=float),
+                    self.constant, np.zeros(n), True)
+        shift = self.solver.solve_mass(self.residual(t0, self.system.q0, self.system.v0))
+        return np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0), shift, False
 
 
 def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
@@ -122,13 +123,16 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     system : LinearSystem
     law : ImpactLaw
         Any impact law; Moreau, Newton and Frémond act in the step form
-        ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k ≥ 0``, other laws map u⁻ = v_free to u⁺ = v_{k+1}.
+        ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k ≥ 0``, other laws map u⁻ = v_free to u⁺ = v_{k+1};
+        Coulomb (on a system with ``contact_dim`` 2 or 3) solves the local frictional
+        problem of docs/theory.md §17 on the closed contacts.
     t_end, h, theta : float
         Final time, step and θ ∈ [0, 1] (validated by :func:`~.simulate.simulate`).
     t0 : float
         Initial time.
     backend, tol : str, float
-        Passed to :func:`impactqp.solve` for every impact problem.
+        Passed to :func:`impactqp.solve` for every impact problem (to
+        :func:`impactqp.solve_friction` with Coulomb's law).
     record_every : int
         Keep every k-th step in the trajectory (the last step always).
     keep_events : bool
@@ -136,32 +140,47 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     progress : callable, optional
         Called with the current time now and then (a progress bar).
     compiled : bool, optional
-        Force the compiled loop (True; only where :func:`compiled_applies`) or the Python
-        loop (False); by default the rule of :func:`compiled_applies` decides.
+        Force the compiled loop (True; only where :func:`compiled_applies`, with Coulomb's
+        law where ``routing.friction_compiled_applies``) or the Python loop (False); by
+        default those rules decide.
 
     Returns
     -------
     Trajectory
-        ``settings["loop"]`` says which loop ran (``"compiled"`` or ``"python"``).
+        ``settings["loop"]`` says which loop ran (``"compiled"``, ``"python"`` or
+        ``"friction-compiled"`` or ``"friction"``); ``impulses`` has one column per column
+        of H.
+
+    Raises
+    ------
+    InputError
+        A law and system :func:`route` refuses.
+    CertificateError
+        A step no method certifies (with its time).
     """
+    loop = route(system, law, backend, compiled)
     free = _FreeVelocity(system, h, theta)
-    cache = ClusterCache(free.metric, system.H, system.chain)
-    solver = ImpactSolver(cache, law, backend=backend, tol=tol)
     steps = step_count(t0, t_end, h)
     kept = np.unique(np.append(np.arange(0, steps + 1, record_every), steps))
-    n, m = system.n_dof, system.n_contacts
+    n, m = system.n_dof, system.H.shape[1]
     T, Q, V = t0 + kept * h, np.empty((kept.size, n)), np.empty((kept.size, n))
     L = np.zeros((kept.size, m))
     Q[0], V[0] = system.q0, system.v0
     report = max(1, steps // 200)
-    use = compiled_applies(system, law, backend) if compiled is None else compiled
-    if use and not compiled_applies(system, law, backend):
-        raise InputError("compiled=True: the compiled loop does not take this run (a law, "
-                         "force, backend or size outside compiled_applies)")
-    step = _Step(system, free, solver, h, theta, t0)
-    if use:
+    step: _Step | FrictionStep
+    if loop.startswith("friction"):
+        step = FrictionStep(system, free, law, h, theta, t0, backend=backend, tol=tol)
+    else:
+        cache = ClusterCache(free.metric, system.H, system.chain)
+        step = _Step(system, free, ImpactSolver(cache, law, backend=backend, tol=tol),
+                     h, theta, t0)
+    events: list[ImpactEvent | FrictionEvent] | Callable[[], list[ImpactEvent]]
+    if loop == "compiled":
         events = _CompiledLoop(system, law, free, step, tol, keep_events).run(
             steps, kept, Q, V, L, report, progress)
+    elif loop == "friction-compiled":
+        events = CompiledFriction(step, keep_events).run(steps, kept, Q, V, L, report,
+                                                         progress)
     else:
         events = []
         q, v = system.q0.copy(), system.v0.copy()
@@ -180,7 +199,7 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     settings = {"h": h, "theta": theta, "t0": t0, "t_end": t_end, "steps": steps,
                 "backend": backend, "tol": tol, "record_every": record_every,
                 "keep_events": keep_events,
-                "activation": "g + h/2 γ <= 0", "loop": "compiled" if use else "python"}
+                "activation": "g + h/2 γ <= 0", "loop": loop}
     return Trajectory(system, law, "moreau-jean", T, Q, V, L, events, settings)
 
 
@@ -214,7 +233,7 @@ class _CompiledLoop:
                  step: _Step, tol: float, keep: bool) -> None:
         self.system, self.law, self.free, self.step = system, law, free, step
         self.tol, self.keep = tol, keep
-        n, m = system.n_dof, system.n_contacts
+        m = system.n_contacts
         Wh = np.ascontiguousarray(free.metric, dtype=float)
         H = np.ascontiguousarray(system.H, dtype=float)
         cache = step.solver.cache
@@ -227,14 +246,7 @@ class _CompiledLoop:
             MinvH, G = full.dense_Minv_W, np.asarray(full.delassus)
         Ht = sp.csr_matrix(H.T)
         Ht.sort_indices()
-        linear = free.K is not None
-        if linear:
-            K = free.K.toarray() if sp.issparse(free.K) else free.K
-            self.force = (free.solver.cholesky_factor, np.ascontiguousarray(K, dtype=float),
-                          free.constant, np.zeros(n), True)
-        else:
-            shift = free.solver.solve_mass(free.residual(step.t0, system.q0, system.v0))
-            self.force = (np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0), shift, False)
+        self.force = free.kernel_arrays(step.t0)
         pairs = np.argwhere(np.triu(Wh != 0.0, 1))
         E = law.step_restitution(np.arange(m))
         self.geometry = (Ht.indptr.astype(np.int64), Ht.indices.astype(np.int64),

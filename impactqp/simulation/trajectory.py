@@ -15,6 +15,7 @@ import numpy as np
 from ..base.outputs import output_file
 from ..errors import InputError
 from ..laws.base import ImpactLaw
+from .friction_step import FrictionEvent
 from .impacts import ImpactEvent
 from .system import LinearSystem
 
@@ -36,10 +37,12 @@ class Trajectory:
         before and just after every impact (event-driven; such times appear twice).
     q, v : (k, n) ndarray
         Positions and velocities.
-    impulses : (k, m) ndarray
+    impulses : (k, d·m) ndarray
         Contact impulses Λ of the step ending at that record (time-stepping), or of the
-        impact just before it (event-driven); zero elsewhere.
-    events : list of ImpactEvent
+        impact just before it (event-driven); zero elsewhere. One column per column of H:
+        with friction (``contact_dim`` d > 1) the normal and tangent components of each
+        contact.
+    events : list of ImpactEvent or FrictionEvent
         Every impact problem solved, in order, each with its certificate (a run may pass a
         callable that builds the list: it is called on first read).
     settings : dict
@@ -48,7 +51,8 @@ class Trajectory:
 
     def __init__(self, system: LinearSystem, law: ImpactLaw, scheme: str, t: np.ndarray,
                  q: np.ndarray, v: np.ndarray, impulses: np.ndarray,
-                 events: list[ImpactEvent] | Callable[[], list[ImpactEvent]],
+                 events: list[ImpactEvent | FrictionEvent]
+                 | Callable[[], list[ImpactEvent]],
                  settings: dict[str, Any]) -> None:
         self.system, self.law, self.scheme = system, law, scheme
         self.t, self.q, self.v, self.impulses = t, q, v, impulses
@@ -56,7 +60,7 @@ class Trajectory:
         self.settings = settings
 
     @property
-    def events(self) -> list[ImpactEvent]:
+    def events(self) -> list[ImpactEvent | FrictionEvent]:
         """Every impact problem solved, in order, each with its certificate."""
         if callable(self._events):
             self._events = self._events()
@@ -204,9 +208,11 @@ class Trajectory:
                                 potential_energy=self.potential_energy,
                                 meta=np.array(meta), **self.event_arrays())
             return path
-        n, m = self.system.n_dof, self.system.n_contacts
+        n, m, d = self.system.n_dof, self.system.n_contacts, self.system.contact_dim
+        impulses = [f"lambda{j}" for j in range(m)] if d == 1 else \
+            [f"lambda{j}_{part}" for j in range(m) for part in ("n", "t1", "t2")[:d]]
         header = (["t"] + [f"q{i}" for i in range(n)] + [f"v{i}" for i in range(n)]
-                  + [f"lambda{j}" for j in range(m)] + ["kinetic_energy", "potential_energy"])
+                  + impulses + ["kinetic_energy", "potential_energy"])
         table = np.column_stack([self.t, self.q, self.v, self.impulses, self.kinetic_energy,
                                  self.potential_energy])
         np.savetxt(path, table, fmt="%.17g", delimiter=",", header=",".join(header),

@@ -25,6 +25,7 @@ from ..errors import InputError, NonFiniteError
 from ..laws.base import ImpactLaw
 from ..laws.functions import moreau
 from ..laws.pipeline import solve
+from ..laws.planner import check_friction
 from ..laws.result import ImpactResult
 from ..model.problem import ImpactProblem
 from ..tables.piecewise_table import PiecewiseLinearTable
@@ -46,7 +47,10 @@ def sample_u_minus(problem: ImpactProblem, samples: int, rng: np.random.Generato
     Consistent samples: with independent W (G invertible) γ⁻ = −|Wᵀv'| is drawn from the
     folded normal of covariance G and u⁻ = v + M⁻¹WG⁻¹(γ⁻ − Wᵀv) keeps an isotropic part in
     ker Wᵀ; with redundant contacts u⁻ = −prox_{T_C}(v) (docs/theory.md §1), which lies in −T_C.
+    With frictional contacts only the normal velocities are constrained (W's normal
+    columns, docs/theory.md §16).
     """
+    problem = problem.normal_problem()  # only the normals (docs/theory.md §16)
     st = problem.structure
     W = as_dense(st.W)
     L = np.linalg.cholesky(as_dense(st.M)) if st.sparse else st.cholesky_factor
@@ -78,9 +82,10 @@ def run_law(law: Law, problem: ImpactProblem) -> np.ndarray:
 
 
 def admissibility_residuals(law: Law, problem: ImpactProblem, u_minus: np.ndarray,
-                            ) -> tuple[np.ndarray, np.ndarray, list[str | None]]:
+                            mu: Any = None) -> tuple[np.ndarray, np.ndarray, list[str | None]]:
     """Run ``law`` from every row of ``u_minus``; return u⁺ (k × n), the residuals (k × 3:
-    kinematic, kinetic, energetic) of the exact test u⁺ ∈ S, and per row the error the law
+    kinematic, kinetic, energetic) of the exact test u⁺ ∈ S (with the friction cones of
+    ``mu`` for frictional contacts, docs/theory.md §16), and per row the error the law
     raised (``"Type: message"``) or None. A row where the law raised, or answered a
     non-finite u⁺, gets u⁺ = NaN and residuals NaN; output that is no real vector of the
     right length (complex, strings, a wrong shape) is a broken law and raises."""
@@ -100,7 +105,7 @@ def admissibility_residuals(law: Law, problem: ImpactProblem, u_minus: np.ndarra
         except NonFiniteError as exc:
             errors[i] = f"{type(exc).__name__}: {exc}"
             continue
-        m = q.admissible_set().contains(u_plus[i])
+        m = q.admissible_set(mu).contains(u_plus[i])
         res[i] = m.kinematic, m.kinetic, m.energetic
     return u_plus, res, errors
 
@@ -127,7 +132,8 @@ def _pair_expansion(M: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
 def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 1000,
                seed: int = 0, consistent_only: bool = True, *,
                tol: float = DEFAULT_TOL, n_jobs: int = 1, client: Any = None,
-               progress: bool | None = None, verbose: bool | int = False) -> LawReport:
+               progress: bool | None = None, verbose: bool | int = False,
+               mu: Any = None) -> LawReport:
     """Check an impact law against S (docs/theory.md §2) and for non-expansiveness
     (docs/theory.md §6).
 
@@ -163,6 +169,11 @@ def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 10
         Progress bar on stderr (None: only on a terminal).
     verbose : bool or {0, 1, 2}
         impactqp's log on stderr while it runs (as :func:`impactqp.solve`).
+    mu : float or (m,) array_like, optional
+        For a problem with frictional contacts (``contact_dim`` 2 or 3): the friction
+        coefficients of S (docs/theory.md §16), by default those of a frictional law object
+        such as :class:`~impactqp.Coulomb`; required for a callable law. Consistent samples
+        then have γ⁻_n ≤ 0 on the normal columns only.
 
     Returns
     -------
@@ -183,16 +194,20 @@ def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 10
     if verbose:
         with verbosity(verbose):
             return verify_law(law, problem, samples, seed, consistent_only, tol=tol,
-                              n_jobs=n_jobs, client=client, progress=progress)
+                              n_jobs=n_jobs, client=client, progress=progress, mu=mu)
     if isinstance(law, PiecewiseLinearTable) or (hasattr(law, "cones") and hasattr(law, "G")):
         return certify_table_report(law, tol=tol)
-    if isinstance(law, ImpactLaw):
-        law = partial(_solve_with, law)
-    if not callable(law):
+    if not callable(law) and not isinstance(law, ImpactLaw):
         raise InputError(f"law must be an impact law, a callable or a piecewise-linear table, got "
                          f"{type(law).__name__}")
     if not isinstance(problem, ImpactProblem):
         raise InputError(f"problem must be an ImpactProblem, got {type(problem).__name__}")
+    if isinstance(law, ImpactLaw):
+        check_friction(problem, law)
+        if mu is None and problem.contact_dim > 1:
+            mu = law.admissible_set(problem).mu
+        law = partial(_solve_with, law)
+    problem.admissible_set(mu)  # μ checked against the problem before any sample
     if not isinstance(samples, (int, np.integer)) or samples < 2:
         raise InputError(f"samples must be an integer ≥ 2, got {samples!r}")
     seed = as_count("seed", seed)
@@ -203,7 +218,8 @@ def verify_law(law: Any, problem: ImpactProblem | None = None, samples: int = 10
     u_minus = sample_u_minus(problem, samples, rng, consistent_only=consistent_only)
     chunks = split(samples, n_jobs, client=client, min_chunk=16)
     parts = run_chunks(lambda span: admissibility_residuals(law, problem, u_minus[span.start:
-                                                                                 span.stop]),
+                                                                                 span.stop],
+                                                            mu),
                        chunks, n_jobs=n_jobs, client=client, desc="verify_law",
                        progress=progress)
     u_plus = np.concatenate([part[0] for part in parts])

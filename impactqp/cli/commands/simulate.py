@@ -53,7 +53,9 @@ SYSTEMS = {
     "bead_chain": ("n_beads", "mass", "radius", "height", "spacing", "gravity", "velocity"),
     "linear": ("M", "q0", "v0", "force", "stiffness", "H", "b"),
 }
-LAWS = {name: law.coefficient_key for name, law in NAMED_LAWS.items()}
+LAWS = {name: law.coefficient_key for name, law in NAMED_LAWS.items() if not law.frictional}
+"""The laws a simulation file names: frictionless ones (its systems have no frictional
+contacts yet)."""
 SIMULATION = ("scheme", "t_end", "h", "theta", "t0", "backend", "record_every", "keep_events",
               "gap_tol", "rest_velocity", "method", "rtol", "atol", "max_events")
 

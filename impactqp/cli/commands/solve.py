@@ -1,7 +1,9 @@
 """``impactqp solve FILE``: apply an impact law to a problem file and report the result.
 
 The law and its coefficients come from the file unless ``--law`` / ``--eps`` / ``--e`` /
-``--E`` say otherwise. Without any, Moreau's law with ε = 0 is used (docs/theory.md §3).
+``--E`` / ``--mu`` say otherwise. Without any, Moreau's law with ε = 0 is used
+(docs/theory.md §3), or Coulomb's law for frictional contacts (docs/theory.md §16), whose μ
+the file or ``--mu`` must give.
 """
 
 from __future__ import annotations
@@ -12,8 +14,11 @@ from typing import Any
 import numpy as np
 
 from ...errors import InputError
-from ...io.files import COEFFICIENT_KEYS, LAWS, ProblemFile, load_problem
+from ...io.file_laws import COEFFICIENT_KEYS, KNOWN_COEFFICIENTS, LAWS
+from ...io.files import ProblemFile, load_problem
 from ...laws.catalogue import NAMED_LAWS, law_named
+from ...laws.coulomb import Coulomb
+from ...laws.friction import FRICTION_BACKENDS
 from ...laws.pipeline import solve
 from ...laws.result import ImpactResult
 from ...model.problem import ImpactProblem
@@ -36,28 +41,46 @@ def parse_numbers(flag: str, text: str) -> float | np.ndarray:
 
 
 def choose_law(args: argparse.Namespace, content: ProblemFile) -> tuple[str, Any]:
-    """The law and coefficients: command-line flags override the file (which may have none)."""
-    law = args.law or content.law or "moreau"
-    flags = {"eps": args.eps, "e": args.e, "E": args.E}
-    given = [k for k, v in flags.items() if v is not None]
-    wanted = COEFFICIENT_KEYS.get(law)
-    if any(k != wanted for k in given):
-        uses = ", ".join(f"--{key} with {name}" for name, key in COEFFICIENT_KEYS.items())
-        raise InputError(f"--{given[0]} does not apply to law {law!r}; use {uses}")
-    if given:
-        return law, parse_numbers(f"--{wanted}", flags[wanted])
-    coefficients = content.coefficients if law == content.law else None
-    if coefficients is None and NAMED_LAWS[law].needs_coefficients:
-        raise InputError(f"law {law!r} needs its coefficients: put {wanted!r} in the file or "
-                         f"pass --{wanted}")
-    return law, coefficients
+    """The law and coefficients: command-line flags override the file (which may have none).
+    A law of several coefficients (Coulomb's μ and e) takes each from its flag or else from
+    the file; the first of its keys is required when the law needs coefficients."""
+    frictional = content.problem.contact_dim > 1
+    law = args.law or content.law or ("coulomb" if frictional else "moreau")
+    keys = COEFFICIENT_KEYS.get(law, ())
+    flags = {key: getattr(args, key) for key in KNOWN_COEFFICIENTS}
+    stray = [k for k, v in flags.items() if v is not None and k not in keys]
+    if stray:
+        uses = ", ".join(f"--{key} with {' or '.join(laws)}"
+                         for key, laws in KNOWN_COEFFICIENTS.items())
+        raise InputError(f"--{stray[0]} does not apply to law {law!r}; use {uses}")
+    if not keys:
+        return law, None
+    in_file = content.coefficients if law == content.law else None
+    if len(keys) == 1:
+        in_file = (in_file,)
+    elif in_file is None:
+        in_file = (None,) * len(keys)
+    values = tuple(value if flags[key] is None else parse_numbers(f"--{key}", flags[key])
+                   for key, value in zip(keys, in_file, strict=True))
+    if values[0] is None and NAMED_LAWS[law].needs_coefficients:
+        raise InputError(f"law {law!r} needs its coefficients: put {keys[0]!r} in the file or "
+                         f"pass --{keys[0]}")
+    if len(keys) == 1:
+        return law, values[0]
+    return law, None if all(v is None for v in values) else values
 
 
 def solve_law(problem: ImpactProblem, law: str, coefficients: Any,
               backend: str = "auto") -> ImpactResult:
-    """Apply the law called ``law`` (docs/theory.md §3, §6, §10) through :func:`impactqp.solve`,
-    with exactly its checks (a closed-form law refuses a named backend, as in Python)."""
-    return solve(problem, law_named(law, coefficients), backend)
+    """Apply the law called ``law`` (docs/theory.md §3, §6, §10, §16) through
+    :func:`impactqp.solve`, with exactly its checks (a closed-form law refuses a named
+    backend, as in Python); for Coulomb's law ``backend`` is the method of its local problem
+    (:data:`~impactqp.laws.friction.FRICTION_BACKENDS`)."""
+    impact_law = law_named(law, coefficients)
+    if isinstance(impact_law, Coulomb):
+        impact_law = Coulomb(impact_law.mu, impact_law.restitution, method=backend)
+        backend = "auto"
+    return solve(problem, impact_law, backend)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -75,10 +98,17 @@ def run(args: argparse.Namespace) -> int:
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("solve", help="apply an impact law to a problem file (.json/.toml)")
     p.add_argument("file", help="problem file (.json or .toml)")
-    p.add_argument("--law", choices=LAWS, help="impact law (default: the file's, else moreau)")
+    p.add_argument("--law", choices=LAWS, help="impact law (default: the file's, else moreau, "
+                                               "or coulomb for frictional contacts)")
     p.add_argument("--eps", help="Moreau's restitution ε in [0, 1]")
-    p.add_argument("--e", help="Newton's coefficients: one number or one per contact, e.g. 0.5,0.8")
+    p.add_argument("--e", help="Newton's coefficients (newton, and the normal restitution of "
+                               "coulomb, default 0): one number or one per contact, e.g. "
+                               "0.5,0.8")
     p.add_argument("--E", help="Frémond's matrix, rows separated by ';', e.g. '0.5,0;0,0.5'")
-    p.add_argument("--backend", default="auto", help="QP backend (default auto)")
+    p.add_argument("--mu", help="Coulomb's friction coefficients ≥ 0: one number or one per "
+                                "contact, e.g. 0.3")
+    p.add_argument("--backend", default="auto",
+                   help="QP backend (default auto); for coulomb the method of its local "
+                        f"problem: {', '.join(FRICTION_BACKENDS)}")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=run)

@@ -2,12 +2,15 @@
 
 A backend is a module with ``solve(qp, *, tol, solver=None) -> QPSolution`` and, where it
 serves only some programs, ``unsuitable(qp) -> str | None`` (why it cannot take ``qp``).
-Backends that solve many right-hand sides at once also have ``solve_many``. Backends know
-programs only (:mod:`impactqp.qp.program`), never impacts or laws (docs/theory.md §9).
+Backends that solve many right-hand sides at once also have ``solve_many``; backends that
+take cone programs (:mod:`impactqp.qp.cones`) have ``solve_cone(program, *, tol, solver,
+options) -> ConeSolution``. Backends know programs only (:mod:`impactqp.qp.program`), never
+impacts or laws (docs/theory.md §9).
 
 Each entry declares the program forms it serves (``"velocity"``: general ``Ax ≥ b``;
-``"impulse"``: ``x ≥ 0``, an LCP), whether its answers are exact (no polishing needed),
-and what it is for. :func:`available_backends` lists them with their install state.
+``"impulse"``: ``x ≥ 0``, an LCP; ``"cone"``: a :class:`~impactqp.qp.cones.ConeProgram`),
+whether its answers are exact (no polishing needed), and what it is for.
+:func:`available_backends` lists them with their install state.
 """
 
 from __future__ import annotations
@@ -19,9 +22,15 @@ from functools import cache
 from types import ModuleType
 
 from ...errors import BackendUnsuitableError, InputError, UnknownBackendError
+from ..cones import ConeProgram
 from ..program import QuadraticProgram
 
 FORMS = ("velocity", "impulse")
+"""The forms of quadratic programs (the ``form=`` of :func:`impactqp.solve`)."""
+
+CONE = "cone"
+"""The form of cone programs (:class:`~impactqp.qp.cones.ConeProgram`), served by the
+entries that list it among their forms."""
 
 
 @dataclass(frozen=True)
@@ -39,7 +48,7 @@ class Backend:
     install : str
         What to install when it is missing.
     forms : tuple of str
-        Program forms served (see :data:`FORMS`).
+        Program forms served (see :data:`FORMS`, and :data:`CONE` for cone programs).
     exact : bool
         Answers are exact active-set solutions (never polished).
     serves : str
@@ -79,12 +88,12 @@ REGISTRY: dict[str, Backend] = {b.name: b for b in (
             "active-set enumeration, at most 14 constraints: the reference"),
     Backend("nnls", "nnls_", "numba", "numba", ("impulse",), True,
             "compiled NNLS on the Cholesky-scaled impulse form: dense, at most 400 contacts"),
-    Backend("clarabel", "clarabel_", "clarabel", "clarabel", FORMS, False,
+    Backend("clarabel", "clarabel_", "clarabel", "clarabel", FORMS + (CONE,), False,
             "Clarabel's own API (interior point), sparse",
             options="attributes of clarabel.DefaultSettings (max_iter, tol_gap_abs, ...)"),
     Backend("osqp", "osqp_", "osqp", "osqp", FORMS, False, "OSQP (operator splitting), sparse",
             options="OSQP settings of its setup (max_iter, eps_abs, rho, ...)"),
-    Backend("cvxpy", "cvxpy_", "cvxpy", "cvxpy", FORMS, False,
+    Backend("cvxpy", "cvxpy_", "cvxpy", "cvxpy", FORMS + (CONE,), False,
             "any solver installed for cvxpy ('cvxpy:SOLVER'; default Clarabel)",
             sub_solver="optional",
             options="keyword arguments of cvxpy's Problem.solve for the solver"),
@@ -178,8 +187,16 @@ def check_options(backend: str, options: object) -> dict[str, object]:
     return dict(options)
 
 
-def unsuitable(entry: Backend, qp: QuadraticProgram, form: str) -> str | None:
+def cone_backends() -> tuple[str, ...]:
+    """Names of the backends that take cone programs (:data:`CONE` among their forms)."""
+    return tuple(b.name for b in REGISTRY.values() if CONE in b.forms)
+
+
+def unsuitable(entry: Backend, qp: QuadraticProgram | ConeProgram, form: str) -> str | None:
     """Why ``entry`` cannot solve ``qp`` (a program of ``form``), or None when it can."""
+    if form == CONE and CONE not in entry.forms:
+        return (f"{entry.name!r} does not solve cone programs; the backends that take cones "
+                "are " + ", ".join(map(repr, cone_backends())))
     if form not in entry.forms:
         return f"{entry.name!r} does not solve the {form} form (it serves: {entry.serves})"
     module = load(entry)
@@ -187,7 +204,7 @@ def unsuitable(entry: Backend, qp: QuadraticProgram, form: str) -> str | None:
     return None if check is None else check(qp)
 
 
-def check_suitable(entry: Backend, qp: QuadraticProgram, form: str) -> None:
+def check_suitable(entry: Backend, qp: QuadraticProgram | ConeProgram, form: str) -> None:
     """Raise BackendUnsuitableError naming why ``entry`` cannot take ``qp``."""
     reason = unsuitable(entry, qp, form)
     if reason is not None:

@@ -1,7 +1,8 @@
 """Clarabel through its own Python API (no cvxpy in the loop).
 
 Ax ≥ b is passed as −Ax + s = −b with s in the non-negative cone; Clarabel's dual z of
-that cone is then the multiplier y ≥ 0 of Ax ≥ b.
+that cone is then the multiplier y ≥ 0 of Ax ≥ b. A cone program
+(:class:`~impactqp.qp.cones.ConeProgram`) is Clarabel's own standard form and goes in as it is.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...errors import InputError, SolverError
+from ..cones import ConeProgram, ConeSolution
 from ..program import QPSolution, QuadraticProgram
 
 _GOOD = {"Solved": "solved", "AlmostSolved": "solved_inaccurate"}
@@ -63,3 +65,18 @@ def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None
                       [clarabel.NonnegativeConeT(qp.n_constraints)], tol, options)
     return QPSolution(x=np.array(sol.x), y=np.array(sol.z), status=status, backend="clarabel",
                       iterations=int(sol.iterations))
+
+
+_CONE_TYPES = {"zero": clarabel.ZeroConeT, "nonnegative": clarabel.NonnegativeConeT,
+               "soc": clarabel.SecondOrderConeT}
+
+
+def solve_cone(program: ConeProgram, *, tol: float = 1e-10, solver: str | None = None,
+               options: dict | None = None) -> ConeSolution:
+    """Solve a cone program in Clarabel's standard form (the same convention as
+    :class:`~impactqp.qp.cones.ConeProgram`: Ax + s = b, s ∈ K, z ∈ K*)."""
+    P = sp.csc_matrix((program.n_vars, program.n_vars)) if program.P is None else program.P
+    cones = [_CONE_TYPES[cone.kind](cone.size) for cone in program.cones]
+    sol, status = run(P, program.c, program.A, program.b, cones, tol, options)
+    return ConeSolution(x=np.array(sol.x), z=np.array(sol.z), s=np.array(sol.s), status=status,
+                        backend="clarabel", iterations=int(sol.iterations))

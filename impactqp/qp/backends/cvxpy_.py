@@ -4,6 +4,10 @@ Programs that carry a ``cache_owner`` are compiled once per (owner, tag, solver)
 ``cp.Parameter`` (DPP): later solves on the same structure pay only the re-solve. The cache
 holds the owner weakly, so it disappears with the problem structure. The parameter sits in
 the linear term only (a parametrized quadratic term would make cvxpy build dense tensors).
+
+Cone programs (:class:`~impactqp.qp.cones.ConeProgram`) are built with fixed data each time
+(no parameter), the second-order cones of one size as one ``cp.SOC`` over rows; any conic
+solver of cvxpy takes them (Clarabel by default, ECOS or SCS by name).
 """
 
 from __future__ import annotations
@@ -12,8 +16,10 @@ import weakref
 
 import cvxpy as cp
 import numpy as np
+import scipy.sparse as sp
 
 from ...errors import InputError, SolverError, UnknownBackendError
+from ..cones import ConeProgram, ConeSolution
 from ..program import QPSolution, QuadraticProgram
 from . import tolerance_options
 
@@ -57,23 +63,73 @@ def _compiled(qp: QuadraticProgram, solver: str | None):
     return entry[0]
 
 
-def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None,
-          options: dict | None = None) -> QPSolution:
+def _solver_name(solver: str | None) -> str:
+    """cvxpy's name of ``solver`` (the default for None), or UnknownBackendError."""
     if solver is not None and solver.upper() not in cp.installed_solvers():
         raise UnknownBackendError(f"backend 'cvxpy:{solver}': that solver is not installed "
                                   "for cvxpy; installed: "
                                   f"{', '.join(cp.installed_solvers())}")
-    name = solver.upper() if solver else DEFAULT_SOLVER
-    prob, x, c, con = _compiled(qp, name)
-    c.value = np.asarray(qp.c, dtype=float)
+    return solver.upper() if solver else DEFAULT_SOLVER
+
+
+def _run(prob: cp.Problem, x: cp.Variable, name: str, tol: float,
+         options: dict | None) -> str:
+    """Solve ``prob`` with solver ``name``; the solver's name as cvxpy reports it."""
     try:
         prob.solve(solver=name, **{**tolerance_options(name, tol), **(options or {})})
     except TypeError as exc:  # a keyword the solver does not take
         raise InputError(f"cvxpy ({name}) options {options}: {exc}") from exc
     except (cp.error.SolverError, ValueError) as exc:
-        raise SolverError(f"cvxpy ({solver or 'default'}) failed: {exc}") from exc
+        raise SolverError(f"cvxpy ({name}) failed: {exc}") from exc
     if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:
-        raise SolverError(f"cvxpy ({solver or 'default'}) ended with status {prob.status!r}")
-    used = prob.solver_stats.solver_name if prob.solver_stats else (solver or "default")
+        raise SolverError(f"cvxpy ({name}) ended with status {prob.status!r}")
+    return prob.solver_stats.solver_name if prob.solver_stats else name
+
+
+def solve(qp: QuadraticProgram, *, tol: float = 1e-10, solver: str | None = None,
+          options: dict | None = None) -> QPSolution:
+    name = _solver_name(solver)
+    prob, x, c, con = _compiled(qp, name)
+    c.value = np.asarray(qp.c, dtype=float)
+    used = _run(prob, x, name, tol, options)
     return QPSolution(x=np.asarray(x.value, float), y=np.asarray(con.dual_value, float),
                       status=prob.status, backend=f"cvxpy:{used}")
+
+
+def solve_cone(program: ConeProgram, *, tol: float = 1e-10, solver: str | None = None,
+               options: dict | None = None) -> ConeSolution:
+    """Solve a cone program through cvxpy; the multipliers are read back in the program's
+    convention (Px + c + Aᵀz = 0, z ∈ K*)."""
+    name = _solver_name(solver)
+    A = sp.csr_matrix(program.A)
+    b = program.b
+    x = cp.Variable(program.n_vars)
+    parts: list[tuple[np.ndarray, cp.Constraint]] = []
+    for key, rows in program.blocks.items():
+        size = int(key.split(":")[1]) if key.startswith("soc:") else 0
+        if key == "zero":  # A x = b: cvxpy's multiplier of this equation is z itself
+            parts.append((rows, A[rows] @ x == b[rows]))
+        elif key == "nonnegative" or size == 1:  # a second-order cone of size 1 is t ≥ 0
+            parts.append((rows, b[rows] - A[rows] @ x >= 0))
+        else:  # one cp.SOC for all cones of this size: t_j ≥ ‖w_j‖, row j of W
+            idx = rows.reshape(-1, size)
+            t = b[idx[:, 0]] - A[idx[:, 0]] @ x
+            w = b[idx[:, 1:].ravel()] - A[idx[:, 1:].ravel()] @ x
+            parts.append((idx, cp.SOC(t, cp.reshape(w, (idx.shape[0], size - 1), order="C"),
+                                      axis=1)))
+    objective = program.c @ x
+    if program.P is not None:
+        objective = objective + 0.5 * cp.quad_form(x, cp.psd_wrap(program.P))
+    prob = cp.Problem(cp.Minimize(objective), [con for _, con in parts])
+    used = _run(prob, x, name, tol, options)
+    z = np.zeros(program.n_constraints)
+    for rows, con in parts:
+        if isinstance(con, cp.SOC):
+            t_dual, w_dual = con.dual_value
+            z[rows[:, 0]] = np.ravel(t_dual)
+            z[rows[:, 1:]] = np.reshape(w_dual, (rows.shape[0], -1))
+        else:
+            z[rows] = con.dual_value
+    xv = np.asarray(x.value, float)
+    return ConeSolution(x=xv, z=z, s=b - A @ xv, status=prob.status, backend=f"cvxpy:{used}",
+                        iterations=getattr(prob.solver_stats, "num_iters", None))

@@ -1,0 +1,244 @@
+"""One Moreau–Jean step with Coulomb friction (docs/theory.md §17).
+
+On the contacts the step predicts closed (gᵢ(q_k) + ½hγᵢ(v_k) ≤ 0, the frictionless loop's
+rule), the local problem of docs/theory.md §15,
+
+    u = W r + q,    W = H_AᵀŴ⁻¹H_A,    q = H_Aᵀv_free + e ∘ γ_k (on the normal rows),
+
+is solved and certified by :func:`impactqp.solve_friction`; then v_{k+1} = v_free + Ŵ⁻¹H_A r
+and u is the local velocity H_Aᵀv_{k+1} shifted by eγ_k on the normal rows, as Newton's law
+at velocity level reads it (Siconos' NewtonImpactFrictionNSL).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cached_property, partial
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..base.checks import NamedChecks
+from ..errors import CertificateError, InputError, ShapeError
+from ..kernels.friction import project_cones
+from ..laws.coulomb import Coulomb
+from ..laws.friction import FRICTION_BACKENDS, FrictionResult, solve_friction
+from ..model.friction import FrictionCertificate, FrictionContactProblem
+from .system import LinearSystem
+
+NEEDS_TANGENTS = ("Coulomb friction needs tangent columns: build the LinearSystem with "
+                  "contact_dim=2 (plane) or 3 (space), H holding the normal and then the "
+                  "tangents of each contact")
+"""The refusal of Coulomb's law on a frictionless system."""
+
+MAX_CACHED = 4096
+"""Closed sets whose W and Ŵ⁻¹H_A are kept per run; the cache starts afresh when full."""
+
+
+def coulomb_coefficients(law: Coulomb, system: LinearSystem) -> tuple[np.ndarray, np.ndarray]:
+    """(μ, e), one of each per contact of ``system``, from the law's scalars or vectors.
+
+    Raises
+    ------
+    InputError
+        A system without friction columns (``contact_dim`` 1).
+    ShapeError
+        μ or e given per contact for another number of contacts.
+    """
+    if system.contact_dim == 1:
+        raise InputError(NEEDS_TANGENTS)
+    m = system.n_contacts
+    out = []
+    for name, value in (("mu", law.mu), ("restitution", law.restitution)):
+        value = np.asarray(value, dtype=float)
+        if value.ndim == 1 and value.size != m:
+            raise ShapeError(f"Coulomb's {name} must be one number or one per contact "
+                             f"({m}), got {value.size} values")
+        out.append(np.broadcast_to(value, (m,)).copy())
+    return out[0], out[1]
+
+
+def check_friction_backend(backend: str) -> str:
+    """``backend`` when :func:`impactqp.solve_friction` takes it, else InputError."""
+    if backend not in FRICTION_BACKENDS:
+        raise InputError(f"with Coulomb friction backend must be one of {FRICTION_BACKENDS} "
+                         f"(the methods of solve_friction), got {backend!r}")
+    return backend
+
+
+@dataclass(frozen=True)
+class StepMembership(NamedChecks):
+    """u⁺ ∈ S of a frictional step, proven by the reaction r as witness (docs/theory.md §17):
+
+    - kinetic: ‖Ŵ(u⁺ − u⁻) − H_A P_K(r)‖ / ‖H_A P_K(r)‖ (u⁺ − u⁻ is an impulse from the
+      friction cones, P_K the projection onto them);
+    - kinematic: largest −γ⁺ᵢ/(sᵢ‖u⁻‖) on the closed contacts, or 0 (no penetrating normal
+      velocity; sᵢ² = Wᵢᵢ of the normal row, ‖·‖ the Ŵ-norm);
+    - energetic: (‖u⁺‖² − ‖u⁻‖²)₊ / ‖u⁻‖² in the Ŵ-norm (no kinetic energy gained).
+
+    Truthy when each is within ``tol``.
+    """
+
+    def __bool__(self) -> bool:
+        return self.ok
+
+
+class FrictionEvent:
+    """One frictional Moreau–Jean step with closed contacts, with its certificate.
+
+    Parameters
+    ----------
+    time : float
+        The end of the step.
+    contacts : ndarray
+        The closed contacts, ascending; their d components each are the rows of the local
+        problem, in that order.
+    problem : FrictionContactProblem
+        W, q and μ of the step.
+    result : FrictionResult
+        The certified answer of :func:`impactqp.solve_friction`.
+    u_minus, u_plus : ndarray
+        v_free and v_{k+1}.
+    verdict : callable
+        Computes the ``StepMembership`` of the step (called on first read of
+        :attr:`admissible`).
+
+    Attributes
+    ----------
+    kind : str
+        ``"step"``.
+    dofs : ndarray
+        Every degree of freedom of the system (the step is one local problem).
+    settled : ndarray
+        Empty (event-driven settling does not apply).
+    """
+
+    kind = "step"
+    law = "coulomb"
+
+    def __init__(self, time: float, contacts: np.ndarray, problem: FrictionContactProblem,
+                 result: FrictionResult, u_minus: np.ndarray, u_plus: np.ndarray,
+                 verdict: Callable[[], StepMembership]) -> None:
+        self.time, self.contacts, self.problem, self.result = time, contacts, problem, result
+        self.u_minus, self.u_plus = u_minus, u_plus
+        self.dofs = np.arange(u_minus.size)
+        self.settled = np.zeros(0, dtype=int)
+        self._verdict = verdict
+
+    impulses = property(lambda self: self.result.r, doc="r on the closed contacts' components.")
+
+    @property
+    def certificate(self) -> FrictionCertificate:
+        """The recomputed certificate of the local problem."""
+        return self.result.certificate
+
+    @property
+    def certified(self) -> bool:
+        """The certificate's verdict (True for every recorded event)."""
+        return bool(self.result.certificate.ok)
+
+    @cached_property
+    def admissible(self) -> StepMembership:
+        """u⁺ ∈ S of the step, with r as witness (a ``StepMembership``)."""
+        return self._verdict()
+
+    def __repr__(self) -> str:
+        return (f"FrictionEvent(t={self.time:.12g}, contacts={self.contacts.tolist()[:6]}, "
+                f"certificate={'ok' if self.certified else 'FAILED'})")
+
+
+class FrictionStep:
+    """One step of the frictional loop: (q_{k+1}, v_{k+1}, r or None, events) from (q_k, v_k).
+
+    Parameters
+    ----------
+    system : LinearSystem
+        With ``contact_dim`` 2 or 3.
+    free : callable
+        v_free(t, q, v) of the θ-method, with its iteration matrix ``metric`` and its
+        factorization ``solver`` (the frictionless loop's ``_FreeVelocity``).
+    law : Coulomb
+    h, theta, t0 : float
+    backend : str
+        Method of :func:`impactqp.solve_friction`.
+    tol : float
+        Certificate tolerance of every local problem.
+    """
+
+    def __init__(self, system: LinearSystem, free, law: Coulomb, h: float, theta: float,
+                 t0: float, *, backend: str = "auto", tol: float = 1e-8) -> None:
+        self.system, self.free = system, free
+        self.h, self.theta, self.t0 = h, theta, t0
+        self.mu, self.e = coulomb_coefficients(law, system)
+        self.backend, self.tol = check_friction_backend(backend), tol
+        self.d = system.contact_dim
+        self.impulse_size = system.n_contacts * self.d
+        self._cache: dict[bytes, tuple[np.ndarray, ...]] = {}
+
+    def local(self, contacts: np.ndarray) -> tuple[np.ndarray, ...]:
+        """(columns, H_A, Ŵ⁻¹H_A, W = H_AᵀŴ⁻¹H_A) of a closed set (H_A dense), formed once
+        per set."""
+        key = contacts.tobytes()
+        hit = self._cache.get(key)
+        if hit is None:
+            if len(self._cache) >= MAX_CACHED:
+                self._cache.clear()
+            d = self.d
+            cols = (contacts[:, None] * d + np.arange(d)).ravel()
+            H = self.system.H[:, cols]
+            H = H.toarray() if sp.issparse(H) else np.asarray(H, dtype=float)
+            MinvH = self.free.solver.solve_mass(H)
+            W = H.T @ MinvH
+            hit = (cols, H, np.ascontiguousarray(MinvH), 0.5 * (W + W.T))
+            self._cache[key] = hit
+        return hit
+
+    def __call__(self, k: int, q: np.ndarray, v: np.ndarray,
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, list[FrictionEvent]]:
+        h, theta, system, d = self.h, self.theta, self.system, self.d
+        gamma = system.contact_velocities(v)
+        closed = system.gaps(q) + (0.5 * h) * gamma <= 0.0
+        v_free = self.free(self.t0 + k * h, q, v)
+        v_next, lam, events = v_free, None, []
+        if closed.any():
+            contacts = np.flatnonzero(closed)
+            cols, H, MinvH, W = self.local(contacts)
+            q_loc = H.T @ v_free
+            q_loc[::d] += self.e[contacts] * gamma[contacts]
+            if np.any(q_loc[::d] < 0.0):  # else r = 0 is exact (docs/theory.md §17)
+                time = self.t0 + (k + 1) * h
+                problem = FrictionContactProblem(W, q_loc, self.mu[contacts], contact_dim=d)
+                try:
+                    result = solve_friction(problem, backend=self.backend, tol=self.tol)
+                except CertificateError as exc:
+                    raise CertificateError(f"the frictional Moreau–Jean step ending at "
+                                           f"t = {time:.12g} (contacts "
+                                           f"{contacts.tolist()[:8]}): {exc}") from exc
+                v_next = v_free + MinvH @ result.r
+                lam = np.zeros(self.impulse_size)
+                lam[cols] = result.r
+                verdict = partial(self.membership, contacts, v_free, v_next, result.r)
+                events = [FrictionEvent(time, contacts, problem, result, v_free, v_next,
+                                        verdict)]
+        return q + h * ((1.0 - theta) * v + theta * v_next), v_next, lam, events
+
+    def membership(self, contacts: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
+                   r: np.ndarray) -> StepMembership:
+        """The verdict of :class:`StepMembership` for one recorded step."""
+        _, H, _, W = self.local(contacts)
+        d = self.d
+        metric = self.free.metric
+        impulse = H @ project_cones(r, self.mu[contacts], d)
+        miss = float(np.linalg.norm(np.asarray(metric @ (u_plus - u_minus)).ravel() - impulse))
+        scale = float(np.linalg.norm(impulse))
+        kinetic = miss / scale if scale > 0 else (0.0 if miss == 0 else np.inf)
+        norm_minus = float(u_minus @ np.asarray(metric @ u_minus).ravel())
+        norm_plus = float(u_plus @ np.asarray(metric @ u_plus).ravel())
+        gamma = H[:, ::d].T @ u_plus
+        s = np.sqrt(np.diag(W)[::d])
+        ref = np.sqrt(norm_minus) if norm_minus > 0 else 1.0
+        kinematic = max(0.0, float(np.max(-gamma / (s * ref))))
+        energetic = max(0.0, norm_plus - norm_minus) / (norm_minus if norm_minus > 0 else 1.0)
+        return StepMembership({"kinetic": kinetic, "kinematic": kinematic,
+                               "energetic": energetic}, self.tol)
