@@ -10,15 +10,19 @@ import scipy.sparse as sp
 
 import impactqp as iq
 from impactqp.kernels.friction import (
+    alart_curnier,
     modified_velocity,
     modified_velocity_jacobian,
     natural_map,
     project_cones,
     projection_jacobian,
 )
+from impactqp.kernels.friction_newton import lu_solve, solve_small
+from impactqp.laws import friction as friction_law
+from impactqp.laws import friction_newton
 from impactqp.model.friction import certify_friction
 
-BACKENDS = ("auto", "clarabel", "nsgs")
+BACKENDS = ("auto", "newton", "clarabel", "nsgs")
 
 
 def random_problem(m: int, d: int, mu: float, seed: int, skew: float = 0.0):
@@ -56,7 +60,28 @@ def test_one_contact_closed_forms(case, backend: str) -> None:
     res = iq.solve_friction(problem, backend=backend)
     assert res.certificate.ok and res.error <= 1e-8
     np.testing.assert_allclose(res.r, r, atol=1e-8)
-    np.testing.assert_allclose(res.u, u, atol=1e-8)
+    np.testing.assert_allclose(res.u, u, atol=1e-8 * np.linalg.norm(q))  # ABH: ‖F‖ ≤ tol‖q‖
+
+
+@pytest.mark.parametrize("case", CLOSED)
+def test_one_contact_closed_forms_in_the_compiled_call(case) -> None:
+    """A dense W of one contact is answered by the compiled call, to the closed form; the
+    Alart–Curnier function vanishes at the closed form and not beside it."""
+    w, q, mu, r, u = case
+    d = len(q)
+    problem = iq.FrictionContactProblem(np.diag(w), q, mu, contact_dim=d)
+    res = iq.solve_friction(problem)
+    assert res.backend == "kernel" and res.certificate.ok
+    np.testing.assert_allclose(res.r, r, atol=1e-8)
+    mus, rho = np.array([mu]), np.array([1.0 / np.mean(w)])
+    A, B = np.empty((1, d, d)), np.empty((1, d, d))
+    zero = alart_curnier(np.array(r, float), np.array(u, float), mus, rho, d, False, A, B)
+    np.testing.assert_allclose(zero, 0.0, atol=1e-15)
+    for j in range(d):
+        bad = np.array(r, float)
+        bad[j] += 1e-3
+        ub = np.diag(w) @ bad + q
+        assert np.linalg.norm(alart_curnier(bad, ub, mus, rho, d, False, A, B)) > 1e-5
 
 
 def test_sliding_reaction_on_the_cone_opposite_to_the_slip() -> None:
@@ -123,26 +148,83 @@ def test_rank_deficient_W_with_a_known_solution(mu: float) -> None:
             np.testing.assert_allclose(res.u, u, atol=1e-6 * qn)
 
 
-def test_auto_falls_back_to_the_socp_route() -> None:
+def general_route(problem):
+    """``auto`` without the compiled call of a few contacts."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(friction_law, "SMALL_CONTACTS", 0)
+        return iq.solve_friction(problem)
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.5])
+def test_least_squares_newton_agrees_with_newton_on_alart_curnier(mu: float) -> None:
+    """The last-resort least-squares Newton on F and the Newton on Φ, each from a few NSGS
+    sweeps, on a rank-deficient W: both certify, and their velocities agree."""
+    rng = np.random.default_rng(12)
+    m, d = 6, 3
+    H = rng.standard_normal((m * d // 2, m * d))
+    problem = iq.FrictionContactProblem(H.T @ H / 9.0, H.T @ rng.standard_normal(9), mu)
+    data = friction_newton.FrictionData(problem)
+    start = friction_law._nsgs_route(data, np.zeros(m * d), 1e-8, 5)[0]
+    found = [friction_newton.lstsq_newton(data, start, 1e-8),
+             friction_newton.newton(data, start, 1e-8)]
+    for r, _, ok in found:
+        assert ok and certify_friction(problem, r).ok
+    u = [problem.velocity(r) for r, _, _ in found]
+    np.testing.assert_allclose(u[0], u[1], atol=1e-6 * np.linalg.norm(problem.q))
+
+
+def test_ill_conditioned_problem_general_route_and_kernel() -> None:
     """An ill-conditioned global problem reduced to local form (W = HᵀM⁻¹H, M's masses over
-    six decades, μ = 1) where 100 NSGS sweeps and Newton do not certify: ``auto`` goes on to
-    the SOCP route, warm-started, and its velocities are those of the SOCP route from zero."""
+    six decades, μ = 1): ``auto`` by the general route (W sparse) and by the compiled call
+    (W dense) certify velocities that are those of the SOCP route from zero."""
     rng = np.random.default_rng(4)
     m, d = 6, 3
     H = rng.standard_normal((12, m * d))
     W = H.T @ np.diag(np.logspace(0, -6, 12)) @ H
-    problem = iq.FrictionContactProblem(W, H.T @ rng.standard_normal(12), 1.0)
-    auto = iq.solve_friction(problem)
-    assert auto.certificate.ok and auto.backend == "clarabel+newton"
+    q = H.T @ rng.standard_normal(12)
+    problem = iq.FrictionContactProblem(sp.csr_matrix(W), q, 1.0)
+    general = general_route(problem)
+    assert general.certificate.ok and general.backend != "kernel"
+    dense = iq.solve_friction(iq.FrictionContactProblem(W, q, 1.0))
+    assert dense.certificate.ok and dense.backend == "kernel"
     cold = iq.solve_friction(problem, backend="clarabel")
-    np.testing.assert_allclose(auto.u, cold.u, atol=1e-6 * np.linalg.norm(problem.q))
+    for res in (general, dense):
+        np.testing.assert_allclose(res.u, cold.u, atol=1e-6 * np.linalg.norm(q))
+
+
+@pytest.mark.parametrize("m", [1, 2, 4, 9])
+@pytest.mark.parametrize("d", [2, 3])
+def test_compiled_call_agrees_with_the_general_route(m: int, d: int) -> None:
+    """The compiled call against the general route (W sparse) and the SOCP route: the
+    velocities agree."""
+    for seed in range(3):
+        dense = random_problem(m, d, [0.1, 0.5, 1.0][seed], seed=40 + seed, skew=0.01 * seed)
+        sparse = iq.FrictionContactProblem(sp.csr_matrix(dense.W), dense.q, dense.mu,
+                                           contact_dim=d)
+        qn = np.linalg.norm(dense.q)
+        a, b = iq.solve_friction(dense), general_route(sparse)
+        c = iq.solve_friction(dense, backend="clarabel")
+        assert a.backend == "kernel" and b.backend != "kernel"
+        assert a.certificate.ok and b.certificate.ok
+        np.testing.assert_allclose(a.u, b.u, atol=1e-6 * qn)
+        np.testing.assert_allclose(a.u, c.u, atol=1e-6 * qn)
+
+
+def test_compiled_call_refuses_a_problem_without_solution() -> None:
+    """W = 0 and q_n < 0: the compiled call says it did not get there (and the general route
+    then raises, see below); its r is no answer."""
+    W, q, mu = np.zeros((3, 3)), np.array([-1.0, 0.0, 0.0]), np.array([0.5])
+    r = np.empty(3)
+    _, ok = solve_small(W, q, mu, np.ones(1), 3, 1e-8, r, 50, 100, 10)
+    assert not ok
+    assert not certify_friction(iq.FrictionContactProblem(W, q, mu), r).ok
 
 
 def test_sparse_W_gives_the_dense_answer() -> None:
     dense = random_problem(5, 3, 0.3, seed=11)
     sparse = iq.FrictionContactProblem(sp.csr_matrix(dense.W), dense.q, dense.mu)
     a, b = iq.solve_friction(dense), iq.solve_friction(sparse)
-    assert b.certificate.ok
+    assert b.certificate.ok and a.backend == b.backend == "kernel"
     np.testing.assert_allclose(a.u, b.u, atol=1e-7 * np.linalg.norm(dense.q))
 
 
@@ -162,6 +244,8 @@ def test_no_solution_is_a_certificate_error() -> None:
     problem = iq.FrictionContactProblem(np.zeros((3, 3)), [-1.0, 0.0, 0.0], 0.5)
     with pytest.raises(iq.CertificateError, match="natural_map|clarabel"):
         iq.solve_friction(problem)
+    with pytest.raises(iq.CertificateError, match="newton-damped: .*natural_map"):
+        iq.solve_friction(problem, backend="newton")
 
 
 # --- the certificate ----------------------------------------------------------------------------
@@ -229,6 +313,41 @@ def test_jacobians_match_finite_differences(d: int) -> None:
             e[j::d] = h
             fd = (f(x + e, mu, d) - f(x - e, mu, d)).reshape(m, d) / (2 * h)
             np.testing.assert_allclose(J[:, :, j], fd, atol=1e-6)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_alart_curnier_jacobian_matches_finite_differences(d: int) -> None:
+    """dΦ/dr = A + B W (A, B the kernel's blocks) against central differences of
+    r ↦ Φ(r, W r + q), at points where every contact is off its kinks."""
+    rng = np.random.default_rng(30 + d)
+    m = 40
+    problem = random_problem(m, d, 0.5, seed=d, skew=0.05)
+    W, q = problem.W, problem.q
+    mu = rng.uniform(0.1, 1.5, m)
+    rho = rng.uniform(0.5, 2.0, m)
+    r = rng.standard_normal(m * d)
+    A, B = np.empty((m, d, d)), np.empty((m, d, d))
+    alart_curnier(r, W @ r + q, mu, rho, d, True, A, B)
+    J = sp.block_diag(list(A)).toarray() + sp.block_diag(list(B)).toarray() @ W
+    h = 1e-7
+    for j in range(m * d):
+        e = np.zeros(m * d)
+        e[j] = h
+        up, down = r + e, r - e
+        fd = (alart_curnier(up, W @ up + q, mu, rho, d, False, A, B)
+              - alart_curnier(down, W @ down + q, mu, rho, d, False, A, B)) / (2 * h)
+        np.testing.assert_allclose(J[:, j], fd, atol=1e-6)
+
+
+def test_lu_solve_against_numpy() -> None:
+    rng = np.random.default_rng(8)
+    for n in (1, 3, 12):
+        J = rng.standard_normal((n, n))
+        b = rng.standard_normal(n)
+        x = b.copy()
+        assert lu_solve(J.copy(), x)
+        np.testing.assert_allclose(x, np.linalg.solve(J, b), rtol=1e-10, atol=1e-12)
+    assert not lu_solve(np.zeros((2, 2)), np.ones(2))
 
 
 def test_natural_map_vanishes_at_a_solution_only() -> None:

@@ -1,6 +1,7 @@
 """Coulomb friction of local contact problems: the one definition of the projection onto the
 friction cone, of De Saxcé's modified velocity, of the natural map and of their derivatives,
-and a projected Gauss–Seidel over the contacts (docs/theory.md §15).
+Alart–Curnier's function with its derivative, and a projected Gauss–Seidel over the contacts
+(docs/theory.md §15).
 
 Vectors are flat, d entries per contact (d = 2 or 3), the normal first: contact c occupies
 ``[c·d, c·d + d)``. K_μ = {r : ‖r_T‖ ≤ μ r_n} is the Coulomb cone and its projection has a
@@ -162,8 +163,78 @@ def modified_velocity_jacobian(u, mu, d):
 
 
 @kernel
+def alart_curnier(r, u, mu, rho, d, jac, A, B):
+    """Alart–Curnier's function Φ of docs/theory.md §15 contact by contact, with the scale ρ_c
+    of each contact: Φ_n = r_n − (r_n − ρu_n)₊ and Φ_T = r_T − P_D(r_T − ρu_T) on the disc D
+    of radius μ(r_n − ρu_n)₊. When ``jac``, an element of its Jacobian is written into A and
+    B, one d × d block per contact: dΦ_c = A_c dr_c + B_c du_c (the branch the formula takes
+    on a kink). Returns Φ."""
+    m = mu.size
+    Phi = np.empty_like(r)
+    for c in range(m):
+        k = c * d
+        rh = rho[c]
+        if jac:
+            for i in range(d):
+                for j in range(d):
+                    A[c, i, j] = 0.0
+                    B[c, i, j] = 0.0
+        xn = r[k] - rh * u[k]
+        active = xn > 0.0
+        pn = xn if active else 0.0
+        Phi[k] = r[k] - pn
+        if jac:
+            if active:
+                B[c, 0, 0] = rh
+            else:
+                A[c, 0, 0] = 1.0
+        radius = mu[c] * pn
+        t2 = 0.0
+        for j in range(1, d):
+            xj = r[k + j] - rh * u[k + j]
+            t2 += xj * xj
+        t = np.sqrt(t2)
+        if t <= radius:  # sticking: Φ_T = ρ u_T
+            for j in range(1, d):
+                Phi[k + j] = rh * u[k + j]
+                if jac:
+                    B[c, j, j] = rh
+            continue
+        s = radius / t
+        for i in range(1, d):
+            wi = (r[k + i] - rh * u[k + i]) / t
+            Phi[k + i] = r[k + i] - radius * wi
+            if not jac:
+                continue
+            if active:
+                A[c, i, 0] = -mu[c] * wi
+                B[c, i, 0] = mu[c] * rh * wi
+            for j in range(1, d):
+                wj = (r[k + j] - rh * u[k + j]) / t
+                proj = (1.0 if i == j else 0.0) - wi * wj
+                A[c, i, j] = (1.0 if i == j else 0.0) - s * proj
+                B[c, i, j] = s * rh * proj
+    return Phi
+
+
+@kernel
 def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
-    """Projected Gauss–Seidel over the contacts (docs/theory.md §15), updating ``r`` in place.
+    """:func:`nsgs_rows` for a dense W (every entry taken as stored)."""
+    n = r.size
+    indptr = np.arange(0, n * n + 1, n)
+    indices = np.empty(n * n, dtype=np.int64)
+    for i in range(n):
+        for j in range(n):
+            indices[i * n + j] = j
+    return nsgs_rows(indptr, indices, np.ascontiguousarray(W).ravel(), q, mu, d, r, tol,
+                     max_sweeps, local_iters)
+
+
+@kernel
+def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
+    """Projected Gauss–Seidel over the contacts (docs/theory.md §15), updating ``r`` in place;
+    W given by its compressed rows (``indptr``, ``indices``, ``data``: scipy's CSR arrays),
+    so that a sweep costs the entries of W.
 
     Each contact's local problem (the others held) is solved by the projected fixed point
     r_c ← P_{K_μ}(r_c − ρ ũ_c) with ρ = 1/‖W_cc‖_F; the sweeps stop when ‖F‖ ≤ tol·‖q‖.
@@ -180,6 +251,14 @@ def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
     uc = np.empty(d)
     mc = np.empty(d)
     base = np.empty(d)  # q_c + Σ_{j≠c} W_cj r_j
+    Wcc = np.zeros((m, d, d))  # the diagonal blocks
+    for c in range(m):
+        k = c * d
+        for i in range(d):
+            for p in range(indptr[k + i], indptr[k + i + 1]):
+                j = indices[p] - k
+                if 0 <= j < d:
+                    Wcc[c, i, j] += data[p]
     err = np.inf
     for sweep in range(max_sweeps):
         for c in range(m):
@@ -187,21 +266,21 @@ def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
             rho = 0.0
             for i in range(d):
                 for j in range(d):
-                    rho += W[k + i, k + j] * W[k + i, k + j]
+                    rho += Wcc[c, i, j] * Wcc[c, i, j]
             rho = 1.0 / np.sqrt(rho) if rho > 0.0 else 1.0
             for i in range(d):
                 v = q[k + i]
-                for j in range(n):
-                    v += W[k + i, j] * r[j]
+                for p in range(indptr[k + i], indptr[k + i + 1]):
+                    v += data[p] * r[indices[p]]
                 for j in range(d):
-                    v -= W[k + i, k + j] * r[k + j]
+                    v -= Wcc[c, i, j] * r[k + j]
                 base[i] = v
                 rc[i] = r[k + i]
             for _ in range(local_iters):
                 for i in range(d):
                     v = base[i]
                     for j in range(d):
-                        v += W[k + i, k + j] * rc[j]
+                        v += Wcc[c, i, j] * rc[j]
                     uc[i] = v
                 modified_contact(uc, mu[c], 0, d, mc)
                 for i in range(d):
@@ -219,8 +298,8 @@ def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
                 r[k + i] = rc[i]
         for i in range(n):
             v = q[i]
-            for j in range(n):
-                v += W[i, j] * r[j]
+            for p in range(indptr[i], indptr[i + 1]):
+                v += data[p] * r[indices[p]]
             u[i] = v
         F = natural_map(r, u, mu, d)
         err = np.sqrt(np.sum(F * F)) / qn

@@ -1,0 +1,180 @@
+"""Newton's method on Alart–Curnier's function for a dense W, and the compiled call that
+solves a local frictional problem of a few contacts whole (docs/theory.md §15).
+
+:func:`solve_small` is to frictional contacts what :mod:`impactqp.kernels.impact` is to
+frictionless impacts: one call, no Python object per step, microseconds for one to four
+contacts. It returns whether its answer is within half the tolerance of the certificate's
+figure; the caller certifies it (:func:`impactqp.model.friction.certify_friction`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .friction import alart_curnier, natural_map, nsgs, project_cones
+from .jit import inline_kernel, kernel
+
+
+@kernel
+def lu_solve(J, b):
+    """Solve J x = b in place by Gaussian elimination with partial pivoting (J is overwritten,
+    b receives x); False when a pivot is zero or not finite."""
+    n = b.size
+    for k in range(n):
+        p = k
+        big = abs(J[k, k])
+        for i in range(k + 1, n):
+            if abs(J[i, k]) > big:
+                p, big = i, abs(J[i, k])
+        if not big > 0.0 or not np.isfinite(big):
+            return False
+        if p != k:
+            for j in range(n):
+                J[k, j], J[p, j] = J[p, j], J[k, j]
+            b[k], b[p] = b[p], b[k]
+        for i in range(k + 1, n):
+            f = J[i, k] / J[k, k]
+            if f != 0.0:
+                for j in range(k + 1, n):
+                    J[i, j] -= f * J[k, j]
+                b[i] -= f * b[k]
+    for i in range(n - 1, -1, -1):
+        v = b[i]
+        for j in range(i + 1, n):
+            v -= J[i, j] * b[j]
+        b[i] = v / J[i, i]
+    return True
+
+
+@inline_kernel
+def affine(W, r, q, out):
+    """out = W r + q by plain loops (for the few unknowns here, cheaper than a BLAS call)."""
+    for i in range(q.size):
+        v = q[i]
+        for j in range(r.size):
+            v += W[i, j] * r[j]
+        out[i] = v
+    return out
+
+
+@kernel
+def abh_error(W, q, mu, d, r, qn):
+    """‖F(r)‖/qn with u = W r + q (W dense)."""
+    F = natural_map(r, affine(W, r, q, np.empty_like(q)), mu, d)
+    return np.sqrt(np.sum(F * F)) / qn
+
+
+@kernel
+def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
+    """Semismooth Newton on Alart–Curnier's function for a dense W, updating ``r`` in place:
+    the iteration of ``impactqp.laws.friction_newton.newton`` (docs/theory.md §15), its steps
+    (J + λI)Δ = −Φ solved by :func:`lu_solve`. Once within tolerance it takes one step more
+    and keeps it if it is better (near a solution a step gains digits quadratically: the few
+    contacts of a time step are answered to round-off, not just to the tolerance). Returns
+    (steps done, whether the projected r, left in ``r``, is within tol/2 in ‖F‖/‖q‖)."""
+    n = r.size
+    m = mu.size
+    qn = np.sqrt(np.sum(q * q))
+    if qn == 0.0:
+        qn = 1.0
+    A = np.empty((m, d, d))
+    B = np.empty((m, d, d))
+    J = np.empty((n, n))
+    scale = np.sqrt(np.sum(alart_curnier(np.zeros(n), q, mu, rho, d, False, A, B) ** 2))
+    if scale == 0.0:
+        scale = 1.0
+    u = affine(W, r, q, np.empty(n))
+    u_try = np.empty(n)
+    r_try = np.empty(n)
+    phi = alart_curnier(r, u, mu, rho, d, True, A, B)
+    f = np.sqrt(np.sum(phi * phi))
+    steps = 0
+    kept = np.empty(n)  # the first projected r within tolerance
+    kept_error = np.inf
+    kept_at = max_steps
+    while True:
+        F = natural_map(r, u, mu, d)
+        if np.sqrt(np.sum(F * F)) <= 0.5 * tol * qn:
+            rp = project_cones(r, mu, d)
+            error = abh_error(W, q, mu, d, rp, qn)
+            if error <= 0.5 * tol:
+                if kept_error <= 0.5 * tol or error == 0.0:  # the step more is taken
+                    r[:] = rp if error < kept_error else kept
+                    return steps, True
+                kept[:] = rp
+                kept_error = error
+                kept_at = steps
+        if steps == max_steps or steps > kept_at:  # the step more did not do better
+            break
+        steps += 1
+        shift = kappa * min(f / scale, 1e-2)
+        for c in range(m):
+            k = c * d
+            for i in range(d):
+                for col in range(n):
+                    v = 0.0
+                    for j in range(d):
+                        v += B[c, i, j] * W[k + j, col]
+                    J[k + i, col] = v
+                for j in range(d):
+                    J[k + i, k + j] += A[c, i, j]
+                J[k + i, k + i] += shift
+        step = -phi
+        if not lu_solve(J, step):
+            break
+        t = 1.0
+        while t > 1e-8:
+            for i in range(n):
+                r_try[i] = r[i] + t * step[i]
+            affine(W, r_try, q, u_try)
+            phi_try = alart_curnier(r_try, u_try, mu, rho, d, False, A, B)
+            f_try = np.sqrt(np.sum(phi_try * phi_try))
+            if f_try <= (1.0 - 1e-4 * t) * f:
+                break
+            t *= 0.5
+        if not t > 1e-8:
+            break  # no descent: stalled
+        r[:] = r_try
+        u[:] = u_try
+        phi = alart_curnier(r, u, mu, rho, d, True, A, B)
+        f = f_try
+    if kept_error <= 0.5 * tol:  # the step more failed: the r within tolerance
+        r[:] = kept
+        return steps, True
+    return steps, False
+
+
+@kernel
+def _accept(W, q, mu, d, r, tol):
+    """Whether P_K(r) is within tol/2 in ‖F‖/‖q‖; r is replaced by P_K(r) when it is."""
+    qn = np.sqrt(np.sum(q * q))
+    rp = project_cones(r, mu, d)
+    if abh_error(W, q, mu, d, rp, qn if qn > 0.0 else 1.0) <= 0.5 * tol:
+        r[:] = rp
+        return True
+    return False
+
+
+@kernel
+def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
+    """A local problem of a few contacts (dense W) in one compiled call, into ``r``: Newton
+    from r = 0, then NSGS followed by Newton, then the damped Newton (shift factor 10) from
+    r = 0 — the order of ``auto`` without the cone programs (docs/theory.md §15).
+    Returns (iterations, whether the projected r left in ``r`` is within tol/2 in ‖F‖/‖q‖);
+    the caller certifies it."""
+    r[:] = 0.0
+    its, ok = newton_dense(W, q, mu, rho, d, r, tol, 1.0, newton_steps)
+    if ok:
+        return its, True
+    r[:] = 0.0
+    done, _ = nsgs(W, q, mu, d, r, 0.5 * tol, sweeps, local_iters)
+    its += done
+    if _accept(W, q, mu, d, r, tol):
+        return its, True
+    more, ok = newton_dense(W, q, mu, rho, d, r, tol, 1.0, newton_steps)
+    its += more
+    if ok:
+        return its, True
+    r[:] = 0.0
+    more, ok = newton_dense(W, q, mu, rho, d, r, tol, 10.0, newton_steps)
+    return its + more, ok
