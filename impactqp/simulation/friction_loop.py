@@ -7,15 +7,14 @@ the kernel recorded, on first read."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from functools import partial
 
 import numpy as np
 
 from ..kernels.friction_loop import HEAD, run
-from ..kernels.moreau_jean import DONE, FAILED
 from ..laws.friction import FrictionResult
 from ..model.friction import FrictionContactProblem, certify_friction
+from .compiled_driver import CompiledDriver
 from .friction_step import FrictionEvent, FrictionStep
 
 LOOP_BACKEND = "compiled frictional loop"
@@ -29,7 +28,7 @@ TARGET = 1e-4
 certificate (and, on well-conditioned steps, at round-off)."""
 
 
-class CompiledFriction:
+class CompiledFriction(CompiledDriver):
     """A frictional run through :func:`impactqp.kernels.friction_loop.run`.
 
     Parameters
@@ -42,8 +41,9 @@ class CompiledFriction:
     """
 
     def __init__(self, step: FrictionStep, keep: bool) -> None:
-        self.step, self.keep = step, keep
+        self.step, self.keep, self.kernel = step, keep, run
         system, free = step.system, step.free
+        self.q0, self.v0 = system.q0, system.v0
         d, m = step.d, system.n_contacts
         _, H, MinvH, G = step.local(np.arange(m))
         self.geometry = (np.ascontiguousarray(H[:, ::d].T), system.b, np.ascontiguousarray(H.T))
@@ -67,51 +67,13 @@ class CompiledFriction:
         return (2 * events + 64, 2 * contacts + 64 * m, 2 * entries + 64 * m * d,
                 2 * dofs + 64 * n)
 
-    def _grow(self) -> None:
-        """More room in every event buffer, keeping what is recorded."""
-        e, c, r, u = (int(x) for x in self.counts)
-        new = self._buffers(*self._room(e, c, r, u))
-        for old, fresh, used in zip(self.buffers, new, (e, c, r, r, u, u)):
-            fresh[:used] = old[:used]
-        self.buffers = new
+    @staticmethod
+    def _used(events: int, contacts: int, entries: int, dofs: int) -> tuple[int, ...]:
+        """Entries in use of (head, contacts, q, r, u⁻, u⁺)."""
+        return events, contacts, entries, entries, dofs, dofs
 
-    def run(self, steps: int, kept: np.ndarray, Q: np.ndarray, V: np.ndarray, L: np.ndarray,
-            report: int, progress: Callable[[float], None] | None,
-            ) -> Callable[[], list[FrictionEvent]] | list[FrictionEvent]:
-        """Fill Q, V, L (rows ``kept``) over ``steps`` steps; returns the events (a builder
-        called on first read) or [] without ``keep``."""
-        step, h, t0 = self.step, self.step.h, self.step.t0
-        q, v = step.system.q0.copy(), step.system.v0.copy()
-        k, row, first, reported = 0, 1, 0, 0
-        while k < steps:
-            stop = steps if progress is None else min(steps, (k // report + 1) * report)
-            status, k, row = run(q, v, k, stop, row, h, step.theta, *self.geometry,
-                                 *self.force, *self.products, *self.coefficients, kept,
-                                 Q, V, L, self.keep, *self.buffers, self.counts)
-            if status == FAILED:  # the Python step: solve_friction, which raises if it must
-                self._close(first)
-                q_next, v_next, lam, new = step(k, q, v)
-                q[:], v[:] = q_next, v_next
-                if self.keep:
-                    self.pieces.append(new)
-                first = int(self.counts[0])
-                k += 1
-                if row < kept.size and kept[row] == k:
-                    Q[row], V[row] = q, v
-                    L[row] = 0.0 if lam is None else lam
-                    row += 1
-            elif status != DONE:  # the event buffers are full
-                self._grow()
-            if progress is not None and k % report == 0 and k > reported:
-                progress(t0 + k * h)
-                reported = k
-        self._close(first)
-        return self._events if self.keep else []
-
-    def _close(self, first: int) -> None:
-        """Mark the kernel's events since ``first`` as the next piece of the list."""
-        if self.keep and self.counts[0] > first:
-            self.pieces.append((first, int(self.counts[0])))
+    def kernel_data(self) -> tuple:
+        return (*self.geometry, *self.force, *self.products, *self.coefficients)
 
     def _events(self) -> list[FrictionEvent]:
         """The FrictionEvents of the run, in order, each with the certificate of

@@ -39,7 +39,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.checks import DEFAULT_TOL
-from ..kernels.moreau_jean import CHECKED, DONE, FAILED, run
+from ..kernels.moreau_jean import CHECKED, run
 from ..kernels.residuals import RESIDUALS
 from ..laws.base import ImpactLaw
 from ..laws.certificate import Certificate
@@ -48,6 +48,7 @@ from ..model.problem import ImpactProblem
 from ..model.residuals import restitution_matrix
 from ..model.structure import ImpactStructure
 from .clusters import ClusterCache
+from .compiled_driver import CompiledDriver
 from .friction_loop import CompiledFriction
 from .friction_step import FrictionEvent, FrictionStep
 from .impacts import ImpactEvent, ImpactSolver
@@ -224,7 +225,7 @@ class _Step:
         return q + h * ((1.0 - theta) * v + theta * v_next), v_next, lam, new
 
 
-class _CompiledLoop:
+class _CompiledLoop(CompiledDriver):
     """The arrays of :func:`impactqp.kernels.moreau_jean.run`, formed once per run, the calls
     of the kernel (resumed after a step solved by the Python loop or after enlarging the
     event buffers) and the events built from what the kernel recorded."""
@@ -232,7 +233,8 @@ class _CompiledLoop:
     def __init__(self, system: LinearSystem, law: ImpactLaw, free: _FreeVelocity,
                  step: _Step, tol: float, keep: bool) -> None:
         self.system, self.law, self.free, self.step = system, law, free, step
-        self.tol, self.keep = tol, keep
+        self.tol, self.keep, self.kernel = tol, keep, run
+        self.q0, self.v0 = system.q0, system.v0
         m = system.n_contacts
         Wh = np.ascontiguousarray(free.metric, dtype=float)
         H = np.ascontiguousarray(system.H, dtype=float)
@@ -281,52 +283,14 @@ class _CompiledLoop:
         n, m = self.system.n_dof, self.system.n_contacts
         return 2 * events + n + 64, 2 * dofs + n + 256, 2 * contacts + m + 256
 
-    def _grow(self) -> None:
-        """More room in every event buffer (:meth:`_room`), keeping what is recorded."""
-        e, d, c = (int(x) for x in self.counts)
-        new = self._buffers(*self._room(e, d, c))
-        for a, b, used in zip(self.buffers, new, (e, e, d, c, d, d, d, c)):
-            b[:used] = a[:used]
-        self.buffers = new
+    @staticmethod
+    def _used(events: int, dofs: int, contacts: int) -> tuple[int, ...]:
+        """Entries in use of (head, residuals, dofs, contacts, u⁻, u⁺, v_k, Λ)."""
+        return events, events, dofs, contacts, dofs, dofs, dofs, contacts
 
-    def run(self, steps: int, kept: np.ndarray, Q: np.ndarray, V: np.ndarray, L: np.ndarray,
-            report: int, progress: Callable[[float], None] | None,
-            ) -> Callable[[], list[ImpactEvent]] | list[ImpactEvent]:
-        """Fill Q, V, L (rows ``kept``) over ``steps`` steps; returns the events (a builder
-        called on first read) or [] without ``keep``."""
-        step, h, t0 = self.step, self.step.h, self.step.t0
-        q, v = self.system.q0.copy(), self.system.v0.copy()
-        k, row, first, reported = 0, 1, 0, 0
-        while k < steps:
-            stop = steps if progress is None else min(steps, (k // report + 1) * report)
-            status, k, row = run(q, v, k, stop, row, h, step.theta, *self.geometry,
-                                 *self.force, *self.impacts, self.passive, *self.chain,
-                                 self.tol, kept,
-                                 Q, V, L, self.keep, *self.buffers, self.counts)
-            if status == FAILED:  # the Python loop's step, whose solve raises what it raises
-                self._close(first)
-                q_next, v_next, lam, new = step(k, q, v)
-                q[:], v[:] = q_next, v_next
-                if self.keep:
-                    self.pieces.append(new)
-                first = int(self.counts[0])
-                k += 1
-                if row < kept.size and kept[row] == k:
-                    Q[row], V[row] = q, v
-                    L[row] = 0.0 if lam is None else lam
-                    row += 1
-            elif status != DONE:  # the event buffers are full
-                self._grow()
-            if progress is not None and k % report == 0 and k > reported:
-                progress(t0 + k * h)
-                reported = k
-        self._close(first)
-        return self._events if self.keep else []
-
-    def _close(self, first: int) -> None:
-        """Mark the kernel's events since ``first`` as the next piece of the list."""
-        if self.keep and self.counts[0] > first:
-            self.pieces.append((first, int(self.counts[0])))
+    def kernel_data(self) -> tuple:
+        return (*self.geometry, *self.force, *self.impacts, self.passive, *self.chain,
+                self.tol)
 
     def _events(self) -> list[ImpactEvent]:
         """The ImpactEvents of the run, in order: each recorded cluster with its problem,
