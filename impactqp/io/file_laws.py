@@ -13,7 +13,7 @@ from ..errors import ProblemFileError
 from ..laws.catalogue import NAMED_LAWS
 from ..laws.complementarity import check_restitution
 from ..laws.moreau import check_eps
-from ..model.friction_admissible import friction_coefficients
+from ..model.friction import friction_coefficients
 
 LAWS = tuple(NAMED_LAWS)
 COEFFICIENT_KEYS: dict[str, tuple[str, ...]] = {

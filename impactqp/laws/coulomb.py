@@ -18,8 +18,7 @@ import numpy as np
 from ..base.arrays import as_array
 from ..errors import CertificateError, InputError, NonFiniteError, RestitutionError
 from ..model.admissible import AdmissibleSet
-from ..model.friction import FrictionContactProblem, certify_friction
-from ..model.friction_admissible import friction_coefficients
+from ..model.friction import FrictionContactProblem, certify_friction, friction_coefficients
 from ..model.problem import ImpactProblem
 from ..model.residuals import impact_residuals, normalized_rows
 from ..model.structure import ImpactStructure

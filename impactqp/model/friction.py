@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -19,7 +20,29 @@ from ..base.checks import NamedChecks
 from ..errors import InputError, ShapeError
 from ..kernels.friction import certificate_sums
 
-__all__ = ["FrictionCertificate", "FrictionContactProblem", "certify_friction"]
+__all__ = ["FrictionCertificate", "FrictionContactProblem", "certify_friction",
+           "friction_coefficients"]
+
+
+def friction_coefficients(value: Any, n_contacts: int, name: str = "mu") -> np.ndarray:
+    """Friction coefficients as one per contact: a number spread over the contacts or an
+    (m,) array, each finite and ≥ 0.
+
+    Raises
+    ------
+    NonFiniteError, ShapeError, InputError
+        NaN or infinity, a length other than ``n_contacts``, a negative coefficient.
+    """
+    mu = as_array(name, value)
+    if mu.ndim == 0:
+        mu = np.full(n_contacts, float(mu))
+    if mu.shape != (n_contacts,):
+        raise ShapeError(f"{name} must be one number or one per contact ({n_contacts},), got "
+                         f"shape {mu.shape}")
+    if (mu < 0).any():
+        raise InputError(f"{name} must be ≥ 0, got {mu[mu < 0][0]} at contact "
+                         f"{int(np.argmax(mu < 0))}")
+    return mu
 
 
 class FrictionContactProblem:
@@ -56,15 +79,7 @@ class FrictionContactProblem:
         if W.ndim != 2 or W.shape != (n, n):
             raise ShapeError(f"W must have shape ({n}, {n}) to match q, got {W.shape}")
         m = n // d
-        mu = as_array("mu", mu)
-        if mu.ndim == 0:
-            mu = np.full(m, float(mu))
-        if mu.shape != (m,):
-            raise ShapeError(f"mu must be one number or one per contact ({m},), got "
-                             f"shape {mu.shape}")
-        if (mu < 0).any():
-            raise InputError(f"mu must be ≥ 0, got {mu[mu < 0][0]} at contact "
-                             f"{int(np.argmax(mu < 0))}")
+        mu = friction_coefficients(mu, m)
         self.W = W
         self.q = q
         self.mu = mu

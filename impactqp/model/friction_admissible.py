@@ -23,12 +23,13 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..base.arrays import as_array, as_dense
+from ..base.arrays import as_dense
 from ..base.checks import DEFAULT_TOL
-from ..errors import InputError, ShapeError
+from ..errors import InputError
 from ..kernels.friction import project_cones
 from ..qp.cone_solve import solve_cone
 from ..qp.cones import Cone, ConeProgram, friction_cone_rows
+from .friction import friction_coefficients
 from .membership import OPTIMIZER_TOL, Membership
 
 __all__ = ["cone_least_squares", "friction_coefficients", "friction_coefficients_of",
@@ -36,27 +37,6 @@ __all__ = ["cone_least_squares", "friction_coefficients", "friction_coefficients
 
 SOCP_TOL = 1e-12
 """Clarabel's tolerance for the distance program (its objective is the distance itself)."""
-
-
-def friction_coefficients(value: Any, n_contacts: int, name: str = "mu") -> np.ndarray:
-    """Friction coefficients as one per contact: a number spread over the contacts or an
-    (m,) array, each finite and ≥ 0.
-
-    Raises
-    ------
-    NonFiniteError, ShapeError, InputError
-        NaN or infinity, a length other than ``n_contacts``, a negative coefficient.
-    """
-    mu = as_array(name, value)
-    if mu.ndim == 0:
-        mu = np.full(n_contacts, float(mu))
-    if mu.shape != (n_contacts,):
-        raise ShapeError(f"{name} must be one number or one per contact ({n_contacts},), got "
-                         f"shape {mu.shape}")
-    if (mu < 0).any():
-        raise InputError(f"{name} must be ≥ 0, got {mu[mu < 0][0]} at contact "
-                         f"{int(np.argmax(mu < 0))}")
-    return mu
 
 
 def friction_coefficients_of(problem: Any, mu: Any) -> np.ndarray | None:
