@@ -55,9 +55,10 @@ NSGS_SWEEPS = 20000
 """Most sweeps of the projected Gauss–Seidel."""
 NSGS_SHORT = 100
 """Sweeps of the projected Gauss–Seidel that ``auto`` tries first (cheap where it works)."""
-NSGS_LOCAL = 10
+NSGS_LOCAL = 3
 """Most projected fixed-point steps on one contact's local problem per sweep (more are
-wasted while the other contacts still move: 100 made the sweeps 3 to 5 times slower)."""
+wasted while the other contacts still move: on the FCLib problems 10 took as many sweeps as
+3 and cost up to 2.5 times more; 1 took more sweeps on some)."""
 SMALL_CONTACTS = 32
 """Most contacts of a problem that ``auto`` first solves in one compiled call, W made dense
 (:func:`impactqp.kernels.friction_newton.solve_small`: dense Newton and NSGS, no cone
