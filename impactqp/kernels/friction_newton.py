@@ -16,6 +16,22 @@ from .jit import inline_kernel, kernel
 
 
 @kernel
+def scales(diagonal, d):
+    """ρ_c of each contact's Alart–Curnier function (docs/theory.md §15): 1 over the mean of
+    W_cc's diagonal (1 where that mean is not positive), from W's ``diagonal``."""
+    m = diagonal.size // d
+    rho = np.ones(m)
+    for c in range(m):
+        mean = 0.0
+        for j in range(d):
+            mean += diagonal[c * d + j]
+        mean /= d
+        if mean > 0.0:
+            rho[c] = 1.0 / mean
+    return rho
+
+
+@kernel
 def lu_solve(J, b):
     """Solve J x = b in place by Gaussian elimination with partial pivoting (J is overwritten,
     b receives x); False when a pivot is zero or not finite."""

@@ -20,11 +20,11 @@ import scipy.sparse as sp
 from ..base.arrays import check_tol
 from ..errors import CertificateError, InputError, SolverError
 from ..kernels.friction import modified_velocity, nsgs_rows, project_cones
-from ..kernels.friction_newton import solve_small
+from ..kernels.friction_newton import scales, solve_small
 from ..model.friction import FrictionCertificate, FrictionContactProblem, certify_friction
 from ..qp.cone_solve import solve_cone
 from ..qp.cones import ConeProgram, friction_cone_rows
-from .friction_newton import LSTSQ_MAX, NEWTON_STEPS, FrictionData, lstsq_newton, newton, scales
+from .friction_newton import LSTSQ_MAX, NEWTON_STEPS, FrictionData, lstsq_newton, newton
 
 __all__ = ["FRICTION_BACKENDS", "FrictionResult", "solve_friction"]
 

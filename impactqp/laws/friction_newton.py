@@ -19,6 +19,7 @@ from ..kernels.friction import (
     project_cones,
     projection_jacobian,
 )
+from ..kernels.friction_newton import scales
 from ..model.friction import FrictionContactProblem
 
 NEWTON_STEPS = 50
@@ -27,13 +28,6 @@ LSTSQ_STEPS = 60
 """Most steps of the least-squares Newton."""
 LSTSQ_MAX = 600
 """Most unknowns d·m for the least-squares Newton (a dense QR per step: 0.1 s at 858)."""
-
-
-def scales(diagonal: np.ndarray, d: int) -> np.ndarray:
-    """ρ_c of each contact's Alart–Curnier function: 1 over the mean of W_cc's diagonal
-    (1 where that mean is not positive)."""
-    mean = diagonal.reshape(-1, d).mean(axis=1)
-    return 1.0 / np.where(mean > 0.0, mean, 1.0)
 
 
 class FrictionData:
