@@ -196,7 +196,7 @@ def _solve_small(problem: FrictionContactProblem, tol: float,
                           problem.contact_dim, tol, r, NEWTON_STEPS, NSGS_SHORT, NSGS_LOCAL)
     if not ok:
         return None
-    u = problem.velocity(r)
+    u = W @ r + problem.q  # the dense product; the certificate recomputes it from problem.W
     cert = certify_friction(problem, r, u, tol=tol)
     if not cert.ok:
         return None
