@@ -11,13 +11,15 @@ import scipy.sparse as sp
 import impactqp as iq
 from impactqp.kernels.friction import (
     alart_curnier,
+    local_steps,
     modified_velocity,
     modified_velocity_jacobian,
     natural_map,
+    nsgs_rows,
     project_cones,
     projection_jacobian,
 )
-from impactqp.kernels.friction_newton import lu_solve, solve_small
+from impactqp.kernels.friction_newton import lu_solve, scales, solve_small
 from impactqp.laws import friction as friction_law
 from impactqp.laws import friction_newton
 from impactqp.model.friction import certify_friction
@@ -348,6 +350,30 @@ def test_lu_solve_against_numpy() -> None:
         assert lu_solve(J.copy(), x)
         np.testing.assert_allclose(x, np.linalg.solve(J, b), rtol=1e-10, atol=1e-12)
     assert not lu_solve(np.zeros((2, 2)), np.ones(2))
+
+
+def test_nsgs_reports_the_error_of_the_reaction_it_leaves() -> None:
+    # ‖F‖ is evaluated only every few sweeps: the sweeps and error returned must still be
+    # those of the r left behind, whether the tolerance is met or the sweeps run out
+    p = random_problem(15, 3, 0.5, 4)
+    W = sp.csr_matrix(p.W)
+    qn = np.linalg.norm(p.q)
+    for tol, sweeps in ((1e-6, 5000), (1e-14, 37)):
+        r = np.zeros(p.q.size)
+        done, err = nsgs_rows(W.indptr, W.indices, W.data, p.q, p.mu, 3, r, tol, sweeps, 3)
+        exact = np.linalg.norm(natural_map(r, p.W @ r + p.q, p.mu, 3)) / qn
+        assert err == pytest.approx(exact, rel=1e-12)
+        assert (err <= tol and done < sweeps) if tol == 1e-6 else (err > tol and done == sweeps)
+
+
+def test_local_steps_and_scales_closed_forms() -> None:
+    # W_cc = diag(a, b, b) plus a skew part: ρ_c = 2/(a + b) from its symmetric part; the
+    # Alart–Curnier scale is 1 over the mean of the diagonal, 1 where that is not positive
+    blocks = np.array([[[2.0, 0.3, 0.0], [-0.3, 6.0, 0.0], [0.0, 0.0, 6.0]],
+                       [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]])
+    np.testing.assert_allclose(local_steps(blocks), [2.0 / 8.0, 1.0])
+    np.testing.assert_allclose(scales(np.array([2.0, 6.0, 7.0, -1.0, 0.0, 0.0]), 3),
+                               [1.0 / 5.0, 1.0])
 
 
 def test_natural_map_vanishes_at_a_solution_only() -> None:
