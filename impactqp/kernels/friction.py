@@ -223,10 +223,13 @@ def alart_curnier(r, u, mu, rho, d, jac, A, B):
 @kernel
 def local_steps(Wcc):
     """The step ρ_c of each contact's projected fixed point in :func:`nsgs_rows`:
-    2/(λ_min + λ_max) of the symmetric part of W_cc (1 where that is not positive)."""
+    2/(λ_min + λ_max) of the symmetric part of W_cc (1 where that is not positive or W_cc
+    not finite)."""
     m = Wcc.shape[0]
     rhos = np.ones(m)
     for c in range(m):
+        if not np.all(np.isfinite(Wcc[c])):
+            continue
         lam = np.linalg.eigvalsh(0.5 * (Wcc[c] + Wcc[c].T))
         if lam[-1] + lam[0] > 0.0:
             rhos[c] = 2.0 / (lam[-1] + lam[0])
