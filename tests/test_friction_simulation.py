@@ -419,3 +419,14 @@ def test_the_motion_does_not_depend_on_the_unit_of_mass(mass, loop):
     light = run(box_on_floor(3, velocity=(2.0, 1.5), gap=OVERLAP), Coulomb(0.4), 0.3, loop,
                 h=1e-2)
     assert np.abs(box.v - light.v).max() < 1e-7  # rank-deficient W: to the tolerance
+
+
+def test_the_laws_own_method_solves_the_steps():
+    # Coulomb(method=...) is the method of every step unless simulate names a backend
+    system = rolling_sphere(velocity=1.0, gap=OVERLAP)
+    tr = simulate(system, Coulomb(0.3, method="clarabel"), 0.05, h=1e-2)
+    assert tr.settings["loop"] == "friction"
+    assert all(ev.result.backend.startswith("clarabel") for ev in tr.events)
+    tr = simulate(system, Coulomb(0.3, method="clarabel"), 0.05, h=1e-2, backend="nsgs")
+    assert all(ev.result.backend.startswith("nsgs") for ev in tr.events)
+    assert simulate(system, Coulomb(0.3), 0.05, h=1e-2).settings["loop"] == "friction-compiled"

@@ -59,6 +59,12 @@ def coulomb_coefficients(law: Coulomb, system: LinearSystem) -> tuple[np.ndarray
     return out[0], out[1]
 
 
+def step_backend(law: Coulomb, backend: str) -> str:
+    """The method of :func:`impactqp.solve_friction` a frictional run uses: ``backend``, or
+    the law's own ``method`` when ``backend`` is ``"auto"``."""
+    return law.method if backend == "auto" else backend
+
+
 def check_friction_backend(backend: str) -> str:
     """``backend`` when :func:`impactqp.solve_friction` takes it, else InputError."""
     if backend not in FRICTION_BACKENDS:
@@ -167,7 +173,7 @@ class FrictionStep:
     law : Coulomb
     h, theta, t0 : float
     backend : str
-        Method of :func:`impactqp.solve_friction`.
+        Method of :func:`impactqp.solve_friction` (``"auto"``: the law's ``method``).
     tol : float
         Certificate tolerance of every local problem.
     """
@@ -177,7 +183,7 @@ class FrictionStep:
         self.system, self.free = system, free
         self.h, self.theta, self.t0 = h, theta, t0
         self.mu, self.e = coulomb_coefficients(law, system)
-        self.backend, self.tol = check_friction_backend(backend), tol
+        self.backend, self.tol = check_friction_backend(step_backend(law, backend)), tol
         self.d = system.contact_dim
         self.impulse_size = system.n_contacts * self.d
         self._cache: dict[bytes, tuple[np.ndarray, ...]] = {}
