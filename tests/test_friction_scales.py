@@ -43,3 +43,22 @@ def test_coulomb_batches_rows_far_from_order_one():
     single = iq.solve(problem, law).u_plus
     np.testing.assert_allclose(batch.u_plus / np.array([1.0, 1e200, 1e-200])[:, None],
                                np.tile(single, (3, 1)), rtol=1e-12)
+
+
+@pytest.mark.parametrize("mass", [1e-12, 1e-8, 1.0, 1e8, 1e12])
+def test_s_with_friction_does_not_depend_on_the_unit_of_mass(mass):
+    # a planar box on two corners (3 dof, 4 columns: Λ not unique, the cone program decides):
+    # the distance program is posed in contact units; in raw units its interior-point
+    # answer was not certified at M × 1e8 and called a certified answer inadmissible at 1e-12
+    a, b = 0.5, 0.25
+    M = np.diag([1.0, 1.0, (a * a + b * b) / 3]) * mass
+    W = np.column_stack([[0.0, 1.0, -a], [1.0, 0.0, b], [0.0, 1.0, a], [1.0, 0.0, b]])
+    problem = iq.ImpactProblem(M, W, [1.0, -1.0, 0.3], contact_dim=2)
+    result = iq.solve(problem, iq.Coulomb(0.3, 0.2))
+    membership = result.admissible
+    assert membership.method == "optimizer" and membership.member
+    assert membership.kinetic < 1e-9
+    np.testing.assert_allclose(membership.impulses, result.impulses,
+                               atol=1e-6 * np.abs(result.impulses).max())
+    outside = problem.admissible_set(mu=0.3).contains(result.u_plus + [0.0, 0.0, 1.0])
+    assert not outside.member
