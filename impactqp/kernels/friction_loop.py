@@ -27,7 +27,7 @@ import numpy as np
 
 from .friction import certificate_sums, nsgs, project_cones
 from .jit import kernel
-from .moreau_jean import DONE, FAILED, FULL, _free_velocity
+from .moreau_jean import DONE, FAILED, FULL, _free_velocity, end_step
 
 LOCAL_ITERATIONS = 5
 """Most projected fixed-point iterations on one contact per Gauss–Seidel sweep (5: a few
@@ -185,12 +185,5 @@ def run(q, v, k_first, k_stop, row, h, theta, Hn, b, Ht, chol, K, c, shift, line
                 counts[1] += closed
                 counts[2] += na
                 counts[3] += n
-        for j in range(n):
-            q[j] += h * ((1.0 - theta) * v[j] + theta * vn[j])
-            v[j] = vn[j]
-        if row < kept.size and kept[row] == k + 1:
-            Q[row, :] = q
-            V[row, :] = v
-            L[row, :] = lam
-            row += 1
+        row = end_step(q, v, vn, lam, h, theta, k, row, kept, Q, V, L)
     return DONE, k_stop, row
