@@ -9,8 +9,11 @@ one-call forms :func:`moreau`, :func:`newton`, :func:`fremond`, :func:`sector_la
 :func:`sector_law_batch`), the law verifier :func:`verify_law`, LCPs with symmetric matrices
 (:func:`solve_lcp`), the geometric classification (:func:`classify`) and motion with any
 law (:class:`LinearSystem`, :func:`simulate`), and the dispersive LZB model of multiple
-impacts (:class:`LZB`) beside the rigid laws (:func:`compare_chain`). The theory and the
-conventions are in docs/theory.md of the repository.
+impacts (:class:`LZB`) beside the rigid laws (:func:`compare_chain`). Frictional impacts
+(``contact_dim`` 2 or 3, :class:`Coulomb`), frictional motion, and FCLib's local contact
+problems (:class:`FrictionContactProblem`, :func:`solve_friction`, :func:`load_fclib`) are
+certified the same way. The theory and the conventions are in docs/theory.md of the
+repository.
 """
 
 from importlib.metadata import PackageNotFoundError, version

@@ -398,3 +398,35 @@ def test_records_and_events_can_be_thinned(loop):
     assert np.array_equal(thin.t, full.t[rows]) and thin.events == []
     assert np.array_equal(thin.q, full.q[rows]) and np.array_equal(thin.impulses,
                                                                     full.impulses[rows])
+
+
+# --- units: the same motion whatever the unit of mass ------------------------------------------
+@pytest.mark.parametrize("mass", [1e-12, 1e12])
+def test_the_motion_does_not_depend_on_the_unit_of_mass(mass, loop):
+    # each step's local problem is posed in its contacts' own units (docs/theory.md §17): in
+    # raw units, with impulses 1e12 times the velocities, r − ũ rounded to r and a step whose
+    # normal velocity was still 5e-5 of ‖q‖ into the floor passed the natural-map check
+    reference = run(rolling_sphere(velocity=1.0, gap=OVERLAP), Coulomb(0.3), 0.5, loop,
+                    h=1e-2)
+    heavy = run(rolling_sphere(mass=mass, velocity=1.0, gap=OVERLAP), Coulomb(0.3), 0.5, loop,
+                h=1e-2)
+    assert np.abs(heavy.v - reference.v).max() < 1e-9
+    assert np.allclose(heavy.impulses, mass * reference.impulses, rtol=1e-9,
+                       atol=1e-9 * mass * np.abs(reference.impulses).max())
+    assert all(ev.certified for ev in heavy.events)
+    box = run(box_on_floor(3, mass=mass, velocity=(2.0, 1.5), gap=OVERLAP), Coulomb(0.4), 0.3,
+              loop, h=1e-2)
+    light = run(box_on_floor(3, velocity=(2.0, 1.5), gap=OVERLAP), Coulomb(0.4), 0.3, loop,
+                h=1e-2)
+    assert np.abs(box.v - light.v).max() < 1e-7  # rank-deficient W: to the tolerance
+
+
+def test_the_laws_own_method_solves_the_steps():
+    # Coulomb(method=...) is the method of every step unless simulate names a backend
+    system = rolling_sphere(velocity=1.0, gap=OVERLAP)
+    tr = simulate(system, Coulomb(0.3, method="clarabel"), 0.05, h=1e-2)
+    assert tr.settings["loop"] == "friction"
+    assert all(ev.result.backend.startswith("clarabel") for ev in tr.events)
+    tr = simulate(system, Coulomb(0.3, method="clarabel"), 0.05, h=1e-2, backend="nsgs")
+    assert all(ev.result.backend.startswith("nsgs") for ev in tr.events)
+    assert simulate(system, Coulomb(0.3), 0.05, h=1e-2).settings["loop"] == "friction-compiled"

@@ -84,7 +84,7 @@ def membership_report(problem: ImpactProblem, u_plus: np.ndarray, *,
         "u_plus": u_plus, "admissible": exact.member, "tolerance": exact.tol,
         "conditions": {c: {"residual": exact.residuals[c], "ok": exact.residuals[c] <= exact.tol}
                        for c in CONDITIONS},
-        "failed": exact.failed(), "impulses": exact.impulses,
+        "failed": exact.failed(), "impulses": exact.impulses, "method": exact.method,
     }
     if optimizer:
         opt = S.contains(u_plus, method="optimizer")
@@ -160,11 +160,15 @@ def format_verdict(report: dict[str, Any], source: str = "") -> str:
     if opt["distance"] is None:  # with friction: the cone program of the kinetic condition
         test = "optimizer (cone program for Λ in the friction cones"
         figure = ""
+        first = ("exact test (Λ from the impact equation, projected onto the friction cones"
+                 if report["method"] == "exact" else
+                 "test (Λ not unique: cone program for Λ in the friction cones")
     else:
         test, figure = "optimizer (SOCP distance to S", f"{opt['distance']:.1e}, "
+        first = "exact test (NNLS + explicit checks"
     lines = [
         f"{source}: candidate u⁺ = {vector_text(report['u_plus'])}",
-        f"exact test (NNLS + explicit checks, tol {report['tolerance']:.0e}):",
+        f"{first}, tol {report['tolerance']:.0e}):",
         *_conditions_text(report),
         f"{test}, tol {opt['tolerance']:.0e}): "
         f"{figure}{'in S' if opt['admissible'] else 'not in S'}{agree}",

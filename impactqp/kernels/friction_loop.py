@@ -27,7 +27,7 @@ import numpy as np
 
 from .friction import certificate_sums, nsgs, project_cones
 from .jit import kernel
-from .moreau_jean import DONE, FAILED, FULL, _free_velocity
+from .moreau_jean import DONE, FAILED, FULL, _free_velocity, end_step
 
 LOCAL_ITERATIONS = 5
 """Most projected fixed-point iterations on one contact per Gauss–Seidel sweep (5: a few
@@ -40,8 +40,8 @@ first velocity entry, sweeps."""
 
 @kernel
 def run(q, v, k_first, k_stop, row, h, theta, Hn, b, Ht, chol, K, c, shift, linear, MinvH,
-        G, mu, e, d, tol, target, sweeps, kept, Q, V, L, keep, ev_head, ev_contacts, ev_q,
-        ev_r, ev_um, ev_up, counts):
+        G, units, mu, e, d, tol, target, sweeps, kept, Q, V, L, keep, ev_head, ev_contacts,
+        ev_q, ev_r, ev_um, ev_up, counts):
     """Steps k_first … k_stop − 1 of a frictional Moreau–Jean run (module docstring), in place.
 
     Parameters
@@ -62,6 +62,10 @@ def run(q, v, k_first, k_stop, row, h, theta, Hn, b, Ht, chol, K, c, shift, line
         The force, as :func:`impactqp.kernels.moreau_jean.run` takes it.
     MinvH, G : (n, d·m), (d·m, d·m) float arrays
         Ŵ⁻¹H and HᵀŴ⁻¹H of all contacts.
+    units : (d·m,) float array
+        s_c = √G_nn of each row's contact: the step's local problem is gathered, solved and
+        checked in contact units (W̃ = DWD, q̃ = Dq, D = diag(1/s); docs/theory.md §16, §17),
+        its reaction r̃ = s·r.
     mu, e : (m,) float arrays
         Friction and restitution coefficients.
     d : int
@@ -79,7 +83,7 @@ def run(q, v, k_first, k_stop, row, h, theta, Hn, b, Ht, chol, K, c, shift, line
         contacts, first entry in ``ev_q``/``ev_r``, first entry in ``ev_um``/``ev_up``,
         sweeps done.
     ev_contacts, ev_q, ev_r, ev_um, ev_up : arrays
-        The closed contacts, q, r, v_free and v_{k+1} of each recorded step.
+        The closed contacts, q̃, r̃ (contact units), v_free and v_{k+1} of each recorded step.
     counts : (4,) int array
         Used entries of (ev_head, ev_contacts, ev_q, ev_um), updated.
 
@@ -126,16 +130,16 @@ def run(q, v, k_first, k_stop, row, h, theta, Hn, b, Ht, chol, K, c, shift, line
             s = 0.0
             for j in range(n):
                 s += Ht[cols[t], j] * vf[j]
-            qa[t] = s
+            qa[t] = s / units[cols[t]]
         for t in range(closed):
-            qa[t * d] += e[cons[t]] * gam[cons[t]]
+            qa[t * d] += e[cons[t]] * gam[cons[t]] / units[cols[t * d]]
             if qa[t * d] < 0.0:
                 approaching = True
         if approaching:  # else r = 0 solves the step exactly
             Wa = np.empty((na, na))
             for s_ in range(na):
                 for t in range(na):
-                    Wa[s_, t] = G[cols[s_], cols[t]]
+                    Wa[s_, t] = G[cols[s_], cols[t]] / (units[cols[s_]] * units[cols[t]])
             mua = np.empty(closed)
             for t in range(closed):
                 mua[t] = mu[cons[t]]
@@ -157,10 +161,10 @@ def run(q, v, k_first, k_stop, row, h, theta, Hn, b, Ht, chol, K, c, shift, line
             for j in range(n):
                 w = vf[j]
                 for t in range(na):
-                    w += MinvH[j, cols[t]] * r[t]
+                    w += MinvH[j, cols[t]] * r[t] / units[cols[t]]
                 vn[j] = w
             for t in range(na):
-                lam[cols[t]] = r[t]
+                lam[cols[t]] = r[t] / units[cols[t]]
             if keep:
                 e0, c0, q0, u0 = counts[0], counts[1], counts[2], counts[3]
                 ev_head[e0, 0] = k + 1
@@ -181,12 +185,5 @@ def run(q, v, k_first, k_stop, row, h, theta, Hn, b, Ht, chol, K, c, shift, line
                 counts[1] += closed
                 counts[2] += na
                 counts[3] += n
-        for j in range(n):
-            q[j] += h * ((1.0 - theta) * v[j] + theta * vn[j])
-            v[j] = vn[j]
-        if row < kept.size and kept[row] == k + 1:
-            Q[row, :] = q
-            V[row, :] = v
-            L[row, :] = lam
-            row += 1
+        row = end_step(q, v, vn, lam, h, theta, k, row, kept, Q, V, L)
     return DONE, k_stop, row

@@ -31,7 +31,7 @@ import numpy as np
 from .active_set import SOLVED, cholesky_solve, lcp_psd_work
 from .chain import project
 from .clusters import group, group_work
-from .jit import kernel
+from .jit import inline_kernel, kernel
 from .residuals import chain_step_residuals, dense_step_residuals
 
 DONE, FAILED, FULL = 0, 1, 2
@@ -158,6 +158,22 @@ def _solve_chain(D, C, um, vp, up, lam, s, masses, inverse, left, right, e, tol,
         if not res[x] <= tol:  # NaN fails
             return False
     return True
+
+
+@inline_kernel
+def end_step(q, v, vn, lam, h, theta, k, row, kept, Q, V, L):
+    """The end of step k of both Moreau–Jean loops: q_{k+1} = q_k + h((1 − θ)v_k + θv_{k+1}),
+    v ← v_{k+1}, and the record row of step k + 1 (q, v and the impulses ``lam``) when it
+    is kept; returns the next record row."""
+    for i in range(q.size):
+        q[i] = q[i] + h * ((1.0 - theta) * v[i] + theta * vn[i])
+        v[i] = vn[i]
+    if row < kept.size and kept[row] == k + 1:
+        Q[row, :] = q
+        V[row, :] = v
+        L[row, :] = lam
+        row += 1
+    return row
 
 
 @kernel
@@ -331,14 +347,5 @@ def run(q, v, k_first, k_stop, row, h, theta, Ht_ptr, Ht_idx, Ht_val, b, Wh, cho
                     counts[0] += 1
                     counts[1] += nc
                     counts[2] += mc
-        for i in range(n):  # 4. q_{k+1}, v_{k+1}
-            q[i] = q[i] + h * ((1.0 - theta) * v[i] + theta * vn[i])
-            v[i] = vn[i]
-        if row < kept.size and kept[row] == k + 1:
-            for i in range(n):
-                Q[row, i] = q[i]
-                V[row, i] = v[i]
-            for i in range(m):
-                L[row, i] = lam_all[i]
-            row += 1
+        row = end_step(q, v, vn, lam_all, h, theta, k, row, kept, Q, V, L)  # 4.
     return DONE, k_stop, row

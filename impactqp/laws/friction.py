@@ -19,10 +19,15 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import check_tol
-from ..errors import CertificateError, InputError, SolverError
+from ..errors import CertificateError, InputError, OutOfRangeError, SolverError
 from ..kernels.friction import modified_velocity, nsgs_rows, project_cones
 from ..kernels.friction_newton import scales, solve_small
-from ..model.friction import FrictionCertificate, FrictionContactProblem, certify_friction
+from ..model.friction import (
+    QUANTITY_RANGE,
+    FrictionCertificate,
+    FrictionContactProblem,
+    certify_friction,
+)
 from ..qp.cone_solve import solve_cone
 from ..qp.cones import ConeProgram, friction_cone_rows
 from .friction_newton import LSTSQ_MAX, NEWTON_STEPS, FrictionData, lstsq_newton, newton
@@ -137,6 +142,9 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     if backend not in FRICTION_BACKENDS:
         raise InputError(f"backend must be one of {', '.join(FRICTION_BACKENDS)}, got "
                          f"{backend!r}")
+    c = float(np.abs(problem.q).max())
+    if c > 0.0 and not QUANTITY_RANGE[0] < c < QUANTITY_RANGE[1]:
+        return _rescaled(problem, c, backend, tol)
     start = time.perf_counter()
     if backend == "auto" and problem.n_contacts <= SMALL_CONTACTS:
         small = _solve_small(problem, tol, start)
@@ -184,6 +192,28 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
             best, r_best = cert, r
     raise CertificateError("no method certified the frictional contact problem at tol "
                            f"{tol:.0e}: " + "; ".join(failures))
+
+
+def _rescaled(problem: FrictionContactProblem, c: float, backend: str,
+              tol: float) -> FrictionResult:
+    """The problem solved with q/c, c = max|qᵢ| far from 1, and scaled back: r is positively
+    homogeneous in q (docs/theory.md §15), so r(q) = c·r(q/c); certified on the problem as
+    given (:data:`~impactqp.model.friction.QUANTITY_RANGE`)."""
+    start = time.perf_counter()
+    unit = FrictionContactProblem.of_checked(problem.W, problem.q / c, problem.mu,
+                                             problem.contact_dim)
+    found = solve_friction(unit, backend=backend, tol=tol)
+    with np.errstate(over="ignore", invalid="ignore"):
+        r = found.r * c
+        u = problem.velocity(r)
+    if not (np.isfinite(r).all() and np.isfinite(u).all()):
+        raise OutOfRangeError(f"the reaction or velocity of this problem (‖q‖∞ = {c:.3g}) is "
+                              "beyond the floats")
+    cert = certify_friction(problem, r, u, tol=tol)
+    if not cert.ok:
+        raise CertificateError(f"the answer scaled back from ‖q‖∞ = 1 fails: {cert.summary()}")
+    return FrictionResult(r, u, cert.error, cert, found.iterations,
+                          time.perf_counter() - start, found.backend)
 
 
 def _solve_small(problem: FrictionContactProblem, tol: float,

@@ -159,6 +159,10 @@ def _ratio(num: float, den: float) -> float:
     return v if v == v else math.inf
 
 
+QUANTITY_RANGE = (1e-100, 1e100)
+"""max|qᵢ| within which the certificate's sums of squares are formed as given."""
+
+
 def _norm(x: np.ndarray) -> float:
     """‖x‖₂ of a float vector (as numpy's norm computes it, √(x·x))."""
     return math.sqrt(float(x @ x))
@@ -192,12 +196,22 @@ def certify_friction(problem: FrictionContactProblem, r, u=None, *,
     tol = check_tol(tol)
     n = problem.q.size
     r = _candidate("r", r, n)
-    u_w = problem.velocity(r)
-    qn = _norm(problem.q)
+    q = problem.q
+    if u is not None:
+        u = _candidate("u", u, n)
+    # every figure is a ratio, invariant under (r, u, q) → (r, u, q)/c: far from order one
+    # (‖q‖² would underflow or overflow) they are computed in units of c = max|qᵢ|
+    c = float(np.abs(q).max())
+    if c > 0.0 and not QUANTITY_RANGE[0] < c < QUANTITY_RANGE[1]:
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            q, r = q / c, r / c
+            u = None if u is None else u / c
+    u_w = np.asarray(problem.W @ r).ravel() + q
+    qn = _norm(q)
     q_scale = qn if qn > 0.0 else 1.0
     consistency = 0.0
     if u is not None:
-        consistency = _ratio(_norm(_candidate("u", u, n) - u_w), q_scale)
+        consistency = _ratio(_norm(u - u_w), q_scale)
     f2, comp, pen, cone = certificate_sums(r, u_w, problem.mu, problem.contact_dim)
     fn = math.sqrt(f2)
     rn = _norm(r)

@@ -101,8 +101,11 @@ def frictional_membership(problem: Any, mu: np.ndarray, u: np.ndarray, method: s
     exact = method == "exact" and st.full_column_rank
     if exact:
         lam = project_cones(np.linalg.lstsq(B, b, rcond=None)[0], mu, d)
-    else:
-        lam = cone_least_squares(B, b, mu, d)
+    else:  # in contact units (Λ̃_c = s_cΛ_c/V, one factor a contact: the cones stay), so
+        # the interior-point solver sees an order-one program whatever the unit of mass
+        units = np.repeat(st.contact_scale[::d], d)
+        units = np.where(units > 0.0, units, 1.0)
+        lam = cone_least_squares(B / units, b / V, mu, d) * (V / units)
     kinetic = float(np.linalg.norm(B @ lam - b)) / V
     gamma_n = st.Wt_times(un)[::d]
     s_n = st.contact_scale[::d]

@@ -45,10 +45,11 @@ class CompiledFriction(CompiledDriver):
         system, free = step.system, step.free
         self.q0, self.v0 = system.q0, system.v0
         d, m = step.d, system.n_contacts
-        _, H, MinvH, G = step.local(np.arange(m))
+        _, H, MinvH, G, units = step.local(np.arange(m))
+        self.units = units
         self.geometry = (np.ascontiguousarray(H[:, ::d].T), system.b, np.ascontiguousarray(H.T))
         self.force = free.kernel_arrays(step.t0)
-        self.products = (MinvH, np.ascontiguousarray(G))
+        self.products = (MinvH, np.ascontiguousarray(G), units)
         self.coefficients = (step.mu, step.e, d, step.tol, TARGET * step.tol, SWEEPS)
         self.buffers = self._buffers(*(self._room(0, 0, 0, 0) if keep else (0, 0, 0, 0)))
         self.counts = np.zeros(4, dtype=np.int64)
@@ -89,7 +90,8 @@ class CompiledFriction(CompiledDriver):
                 k1, c0, a, r0, u0, sweeps = (int(x) for x in head[e])
                 closed = contacts[c0:c0 + a].copy()
                 cols = (closed[:, None] * d + np.arange(d)).ravel()
-                W = self.products[1][np.ix_(cols, cols)]  # what the kernel gathered
+                s = self.units[cols]  # the kernel's problem, in contact units
+                W = self.products[1][np.ix_(cols, cols)] / np.outer(s, s)
                 problem = FrictionContactProblem(W, qs[r0:r0 + a * d].copy(), step.mu[closed],
                                                  contact_dim=d)
                 r = rs[r0:r0 + a * d].copy()
@@ -97,7 +99,7 @@ class CompiledFriction(CompiledDriver):
                 cert = certify_friction(problem, r, u, tol=step.tol)
                 result = FrictionResult(r, u, cert.error, cert, sweeps, 0.0, LOOP_BACKEND)
                 um, up = ums[u0:u0 + n].copy(), ups[u0:u0 + n].copy()
-                verdict = partial(step.membership, closed, um, up, r)
-                out.append(FrictionEvent(step.t0 + k1 * step.h, closed, problem, result, um,
-                                         up, verdict))
+                verdict = partial(step.membership, closed, um, up, r / s)
+                out.append(FrictionEvent(step.t0 + k1 * step.h, closed, problem, result, s,
+                                         um, up, verdict))
         return out

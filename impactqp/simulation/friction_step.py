@@ -59,6 +59,12 @@ def coulomb_coefficients(law: Coulomb, system: LinearSystem) -> tuple[np.ndarray
     return out[0], out[1]
 
 
+def step_backend(law: Coulomb, backend: str) -> str:
+    """The method of :func:`impactqp.solve_friction` a frictional run uses: ``backend``, or
+    the law's own ``method`` when ``backend`` is ``"auto"``."""
+    return law.method if backend == "auto" else backend
+
+
 def check_friction_backend(backend: str) -> str:
     """``backend`` when :func:`impactqp.solve_friction` takes it, else InputError."""
     if backend not in FRICTION_BACKENDS:
@@ -95,9 +101,13 @@ class FrictionEvent:
         The closed contacts, ascending; their d components each are the rows of the local
         problem, in that order.
     problem : FrictionContactProblem
-        W, q and μ of the step.
+        W, q and μ of the step in contact units: the rows of contact c divided by
+        s_c = √W_nn (docs/theory.md §16, §17), so that reactions and velocities are
+        measured alike.
     result : FrictionResult
-        The certified answer of :func:`impactqp.solve_friction`.
+        The certified answer of :func:`impactqp.solve_friction` to ``problem``.
+    units : ndarray
+        s_c of each row: the impulses are ``result.r / units``.
     u_minus, u_plus : ndarray
         v_free and v_{k+1}.
     verdict : callable
@@ -118,15 +128,17 @@ class FrictionEvent:
     law = "coulomb"
 
     def __init__(self, time: float, contacts: np.ndarray, problem: FrictionContactProblem,
-                 result: FrictionResult, u_minus: np.ndarray, u_plus: np.ndarray,
-                 verdict: Callable[[], StepMembership]) -> None:
+                 result: FrictionResult, units: np.ndarray, u_minus: np.ndarray,
+                 u_plus: np.ndarray, verdict: Callable[[], StepMembership]) -> None:
         self.time, self.contacts, self.problem, self.result = time, contacts, problem, result
+        self.units = units
         self.u_minus, self.u_plus = u_minus, u_plus
         self.dofs = np.arange(u_minus.size)
         self.settled = np.zeros(0, dtype=int)
         self._verdict = verdict
 
-    impulses = property(lambda self: self.result.r, doc="r on the closed contacts' components.")
+    impulses = property(lambda self: self.result.r / self.units,
+                        doc="The impulses on the closed contacts' components.")
 
     @property
     def certificate(self) -> FrictionCertificate:
@@ -161,7 +173,7 @@ class FrictionStep:
     law : Coulomb
     h, theta, t0 : float
     backend : str
-        Method of :func:`impactqp.solve_friction`.
+        Method of :func:`impactqp.solve_friction` (``"auto"``: the law's ``method``).
     tol : float
         Certificate tolerance of every local problem.
     """
@@ -171,14 +183,15 @@ class FrictionStep:
         self.system, self.free = system, free
         self.h, self.theta, self.t0 = h, theta, t0
         self.mu, self.e = coulomb_coefficients(law, system)
-        self.backend, self.tol = check_friction_backend(backend), tol
+        self.backend, self.tol = check_friction_backend(step_backend(law, backend)), tol
         self.d = system.contact_dim
         self.impulse_size = system.n_contacts * self.d
         self._cache: dict[bytes, tuple[np.ndarray, ...]] = {}
 
     def local(self, contacts: np.ndarray) -> tuple[np.ndarray, ...]:
-        """(columns, H_A, Ŵ⁻¹H_A, W = H_AᵀŴ⁻¹H_A) of a closed set (H_A dense), formed once
-        per set."""
+        """(columns, H_A, Ŵ⁻¹H_A, W = H_AᵀŴ⁻¹H_A, s) of a closed set (H_A dense), formed once
+        per set: s holds each row's contact unit s_c = √W_nn (1 where W_nn = 0), in which
+        the step's local problem is posed (docs/theory.md §16, §17)."""
         key = contacts.tobytes()
         hit = self._cache.get(key)
         if hit is None:
@@ -190,7 +203,10 @@ class FrictionStep:
             H = H.toarray() if sp.issparse(H) else np.asarray(H, dtype=float)
             MinvH = self.free.solver.solve_mass(H)
             W = H.T @ MinvH
-            hit = (cols, H, np.ascontiguousarray(MinvH), 0.5 * (W + W.T))
+            W = 0.5 * (W + W.T)
+            units = np.sqrt(np.diag(W)[::d])
+            units = np.repeat(np.where(units > 0.0, units, 1.0), d)
+            hit = (cols, H, np.ascontiguousarray(MinvH), W, units)
             self._cache[key] = hit
         return hit
 
@@ -203,30 +219,32 @@ class FrictionStep:
         v_next, lam, events = v_free, None, []
         if closed.any():
             contacts = np.flatnonzero(closed)
-            cols, H, MinvH, W = self.local(contacts)
+            cols, H, MinvH, W, units = self.local(contacts)
             q_loc = H.T @ v_free
             q_loc[::d] += self.e[contacts] * gamma[contacts]
             if np.any(q_loc[::d] < 0.0):  # else r = 0 is exact (docs/theory.md §17)
                 time = self.t0 + (k + 1) * h
-                problem = FrictionContactProblem(W, q_loc, self.mu[contacts], contact_dim=d)
+                problem = FrictionContactProblem(W / np.outer(units, units), q_loc / units,
+                                                 self.mu[contacts], contact_dim=d)
                 try:
                     result = solve_friction(problem, backend=self.backend, tol=self.tol)
                 except CertificateError as exc:
                     raise CertificateError(f"the frictional Moreau–Jean step ending at "
                                            f"t = {time:.12g} (contacts "
                                            f"{contacts.tolist()[:8]}): {exc}") from exc
-                v_next = v_free + MinvH @ result.r
+                r = result.r / units
+                v_next = v_free + MinvH @ r
                 lam = np.zeros(self.impulse_size)
-                lam[cols] = result.r
-                verdict = partial(self.membership, contacts, v_free, v_next, result.r)
-                events = [FrictionEvent(time, contacts, problem, result, v_free, v_next,
-                                        verdict)]
+                lam[cols] = r
+                verdict = partial(self.membership, contacts, v_free, v_next, r)
+                events = [FrictionEvent(time, contacts, problem, result, units, v_free,
+                                        v_next, verdict)]
         return q + h * ((1.0 - theta) * v + theta * v_next), v_next, lam, events
 
     def membership(self, contacts: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
                    r: np.ndarray) -> StepMembership:
         """The verdict of :class:`StepMembership` for one recorded step."""
-        _, H, _, W = self.local(contacts)
+        _, H, _, W, _ = self.local(contacts)
         d = self.d
         metric = self.free.metric
         impulse = H @ project_cones(r, self.mu[contacts], d)

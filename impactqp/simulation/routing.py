@@ -11,7 +11,7 @@ from ..laws.base import ImpactLaw
 from ..laws.complementarity import Fremond, Newton
 from ..laws.coulomb import Coulomb
 from ..laws.moreau import Moreau
-from .friction_step import NEEDS_TANGENTS, check_friction_backend
+from .friction_step import NEEDS_TANGENTS, check_friction_backend, step_backend
 from .system import LinearSystem
 
 COMPILED_LAWS = (Moreau, Newton, Fremond)
@@ -68,7 +68,7 @@ def route(system: LinearSystem, law: ImpactLaw, backend: str, compiled: bool | N
                          f"columns: simulate it with iq.Coulomb(mu, restitution), or build "
                          f"it with contact_dim=1 from the normal columns for {law!r}")
     if frictional:
-        check_friction_backend(backend)
+        backend = check_friction_backend(step_backend(law, backend))
         fits = friction_compiled_applies(system, backend)
         use = fits if compiled is None else compiled
         if use and not fits:

@@ -150,8 +150,9 @@ class LinearSystem:
             raise ShapeError(f"H column(s) {np.flatnonzero(norms == 0).tolist()[:5]} are zero: "
                              "every contact needs a non-zero direction")
         self.contact_dim = d
-        self.structure = ImpactStructure(M, H, chain=self._check_chain(chain, M, H))
-        n, m = self.structure.n, self.structure.m // d
+        self.structure = ImpactStructure(M, H, chain=self._check_chain(chain, M, H),
+                                         contact_dim=d)
+        n, m = self.structure.n, self.structure.n_contacts
         self.q0 = as_vector("q0", q0, n)
         self.v0 = as_vector("v0", v0, n)
         self.b = np.zeros(m) if b is None else as_vector("b", b, m)
@@ -189,8 +190,7 @@ class LinearSystem:
     H = property(lambda self: self.structure.W,
                  doc="Contact directions (n, d·m): per contact the normal, then the tangents.")
     n_dof = property(lambda self: self.structure.n, doc="Number of degrees of freedom n.")
-    n_contacts = property(lambda self: self.structure.m // self.contact_dim,
-                          doc="Number of contacts m.")
+    n_contacts = property(lambda self: self.structure.n_contacts, doc="Number of contacts m.")
     chain = property(lambda self: self.structure.chain, doc="ChainInfo of a 1-D chain, or None.")
 
     # --- contact geometry and energy -----------------------------------------------------
