@@ -65,6 +65,9 @@ NSGS_MORE = 2000
 """Most sweeps ``nsgs-short`` adds when Newton did not finish in the time the first sweeps'
 rate predicts they need (KaplasTower: 1100 sweeps reach 1e-8 in 0.17 s, while Newton from
 100 sweeps takes 20 steps, 0.35 s); it adds none when that prediction is above this."""
+QUICK_POLISH = 4
+"""Newton steps ``nsgs-short`` tries before sweeping on when its sweeps predict they reach
+the tolerance within :data:`NSGS_MORE` more (Newton converges in a few steps when it does)."""
 NSGS_LOCAL = 3
 """Most projected fixed-point steps on one contact's local problem per sweep (more are
 wasted while the other contacts still move: on the FCLib problems 10 took as many sweeps as
@@ -170,7 +173,7 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
             elif method == "nsgs-short":
                 r, its, polished = _short_nsgs_route(data, tol)
             else:
-                r, its, _, _ = _nsgs_route(data, r_best, tol, NSGS_SWEEPS)
+                r, its, _ = _nsgs_route(data, r_best, tol, NSGS_SWEEPS)
         except SolverError as exc:
             failures.append(f"{method}: {exc}")
             continue
@@ -286,43 +289,41 @@ def _lag(data: FrictionData, r: np.ndarray) -> np.ndarray:
 
 
 def _nsgs_route(data: FrictionData, r0: np.ndarray, tol: float,
-                sweeps: int) -> tuple[np.ndarray, int, float, float]:
+                sweeps: int) -> tuple[np.ndarray, int, float]:
     """The compiled projected Gauss–Seidel from r0 to the tolerance (or ``sweeps``), in two
-    halves. Returns r, the sweeps done, the sweeps its rate over the second half predicts
-    are still needed (0 when done, infinity when the error did not fall) and the seconds
-    per sweep of that half."""
+    halves. Returns r, the sweeps done and the sweeps its rate over the second half predicts
+    are still needed (0 when done, infinity when the error did not fall)."""
     r = np.array(r0, dtype=float)
     W = data.W
     first = sweeps // 2
     done, err = nsgs_rows(W.indptr, W.indices, W.data, data.q, data.mu, data.d, r, 0.5 * tol,
                           first, NSGS_LOCAL)
     if err <= 0.5 * tol or done == sweeps:
-        return r, int(done), 0.0 if err <= 0.5 * tol else math.inf, math.inf
-    start = time.perf_counter()
+        return r, int(done), 0.0 if err <= 0.5 * tol else math.inf
     more, err_more = nsgs_rows(W.indptr, W.indices, W.data, data.q, data.mu, data.d, r,
                                0.5 * tol, sweeps - first, NSGS_LOCAL)
-    per_sweep = (time.perf_counter() - start) / more
     if err_more <= 0.5 * tol:
         left = 0.0
     elif 0.0 < err_more < err:
         left = more * math.log(0.5 * tol / err_more) / math.log(err_more / err)
     else:
         left = math.inf
-    return r, int(done + more), left, per_sweep
+    return r, int(done + more), left
 
 
 def _short_nsgs_route(data: FrictionData, tol: float) -> tuple[np.ndarray, int, bool]:
-    """:data:`NSGS_SHORT` sweeps from r = 0, then Newton from there, given the time the
-    sweeps' rate predicts they need to reach the tolerance. When Newton has not succeeded by
-    then, the sweeps go on from their r, in rounds of the predicted number, for as long as
+    """:data:`NSGS_SHORT` sweeps from r = 0, then Newton from there: :data:`QUICK_POLISH`
+    steps when the sweeps' rate predicts they reach the tolerance within :data:`NSGS_MORE`
+    more, else up to ``POLISH_STEPS``. When Newton has not succeeded, the sweeps go on from
+    their r, in rounds of the predicted number, for as long as
     each round gains a factor ten in ‖F‖ (else their r is returned, to the next method) and
     up to :data:`NSGS_MORE` sweeps, after which Newton is tried again (docs/theory.md §15).
     Returns r, the sweeps and steps done, and whether Newton was run last."""
-    r, its, left, per_sweep = _nsgs_route(data, np.zeros_like(data.q), tol, NSGS_SHORT)
+    r, its, left = _nsgs_route(data, np.zeros_like(data.q), tol, NSGS_SHORT)
     if left == 0.0 and data.error(r) <= 0.5 * tol:
         return r, its, False
-    deadline = time.perf_counter() + left * per_sweep
-    r_pol, steps, ok = newton(data, r, tol, max_steps=POLISH_STEPS, deadline=deadline)
+    r_pol, steps, ok = newton(data, r, tol,
+                              max_steps=QUICK_POLISH if left <= NSGS_MORE else POLISH_STEPS)
     its += steps
     if ok or left > NSGS_MORE or data.error(r_pol) <= 0.5 * tol:
         return r_pol, its, True
@@ -330,7 +331,7 @@ def _short_nsgs_route(data: FrictionData, tol: float) -> tuple[np.ndarray, int, 
     err = data.error(r)
     while more < NSGS_MORE:
         rounds = int(min(max(left, NSGS_SHORT), NSGS_MORE - more))
-        r, done, left, _ = _nsgs_route(data, r, tol, rounds)
+        r, done, left = _nsgs_route(data, r, tol, rounds)
         more += done
         err_round = data.error(r)
         if err_round <= 0.5 * tol:

@@ -6,9 +6,6 @@ the last resort of ``auto`` before a long NSGS, for rank-deficient W where the f
 
 from __future__ import annotations
 
-import math
-import time
-
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
@@ -63,16 +60,14 @@ class FrictionData:
 
 
 def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
-            max_steps: int = NEWTON_STEPS,
-            deadline: float = math.inf) -> tuple[np.ndarray, int, bool]:
+            max_steps: int = NEWTON_STEPS) -> tuple[np.ndarray, int, bool]:
     """Semismooth Newton on Alart–Curnier's function Φ (docs/theory.md §15) from r: steps
     (J + λI)Δ = −Φ with J = A + B W (A, B block-diagonal, from
     :func:`impactqp.kernels.friction.alart_curnier`) and λ = κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²) (J is
     singular where W is; the shift vanishes with Φ), by sparse LU, then backtracking on ‖Φ‖.
 
     Stops when the projected r is within tol/2 in ‖F‖/‖q‖ (projecting moves r by up to ‖F‖,
-    hence u by up to ‖W‖‖F‖), after ``max_steps`` steps, when the line search fails, or at
-    the first step begun after ``deadline`` (a :func:`time.perf_counter` reading).
+    hence u by up to ‖W‖‖F‖), after ``max_steps`` steps, or when the line search fails.
     Returns r projected onto the cones, the steps done, and whether that r is within tol/2
     (the certificate's figure)."""
     W, q, mu, d, rho = data.W, data.q, data.mu, data.d, data.rho
@@ -90,7 +85,7 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
             rp = project_cones(r, mu, d)
             if data.error(rp) <= 0.5 * tol:
                 return rp, steps, True
-        if steps == max_steps or time.perf_counter() > deadline:
+        if steps == max_steps:
             break
         steps += 1
         shift = kappa * min(f / (scale or 1.0), 1e-2)
