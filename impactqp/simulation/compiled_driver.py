@@ -21,7 +21,7 @@ class CompiledDriver(ABC):
     A subclass sets ``kernel``, ``step`` (the Python loop's step: ``h``, ``theta``, ``t0`` and
     ``step(k, q, v) -> (q, v, Λ, events)``), ``q0``, ``v0``, ``keep``, ``buffers``, ``counts``
     and ``pieces`` (empty), and defines :meth:`kernel_data`, :meth:`_room`, :meth:`_used`
-    and :meth:`_events`.
+    and :meth:`_event`.
     """
 
     kernel: Callable[..., tuple[int, int, int]]
@@ -50,8 +50,8 @@ class CompiledDriver(ABC):
         """The entries of each buffer in use for the recorded ``counts``."""
 
     @abstractmethod
-    def _events(self) -> list:
-        """The run's events, in order, built from the pieces."""
+    def _event(self, e: int) -> Any:
+        """The event of the kernel's record ``e``."""
 
     def _grow(self) -> None:
         """More room in every event buffer (:meth:`_room`), keeping what is recorded."""
@@ -60,6 +60,14 @@ class CompiledDriver(ABC):
         for old, fresh, used in zip(self.buffers, new, self._used(*counts), strict=True):
             fresh[:used] = old[:used]
         self.buffers = new
+
+    def _events(self) -> list:
+        """The run's events, in order: the Python steps' as they are, the kernel's records
+        built by :meth:`_event`."""
+        out: list = []
+        for piece in self.pieces:
+            out.extend(piece if isinstance(piece, list) else map(self._event, range(*piece)))
+        return out
 
     def _close(self, first: int) -> None:
         """Mark the kernel's events since ``first`` as the next piece of the list."""

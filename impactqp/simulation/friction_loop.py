@@ -76,30 +76,23 @@ class CompiledFriction(CompiledDriver):
     def kernel_data(self) -> tuple:
         return (*self.geometry, *self.force, *self.products, *self.coefficients)
 
-    def _events(self) -> list[FrictionEvent]:
-        """The FrictionEvents of the run, in order, each with the certificate of
+    def _event(self, e: int) -> FrictionEvent:
+        """The FrictionEvent of record ``e``, with the certificate of
         :func:`impactqp.model.friction.certify_friction` recomputed from its (W, q, μ, r)."""
         head, contacts, qs, rs, ums, ups = self.buffers
         step, n, d = self.step, self.step.system.n_dof, self.step.d
-        out: list[FrictionEvent] = []
-        for piece in self.pieces:
-            if isinstance(piece, list):
-                out.extend(piece)
-                continue
-            for e in range(*piece):
-                k1, c0, a, r0, u0, sweeps = (int(x) for x in head[e])
-                closed = contacts[c0:c0 + a].copy()
-                cols = (closed[:, None] * d + np.arange(d)).ravel()
-                s = self.units[cols]  # the kernel's problem, in contact units
-                W = self.products[1][np.ix_(cols, cols)] / np.outer(s, s)
-                problem = FrictionContactProblem(W, qs[r0:r0 + a * d].copy(), step.mu[closed],
-                                                 contact_dim=d)
-                r = rs[r0:r0 + a * d].copy()
-                u = problem.velocity(r)
-                cert = certify_friction(problem, r, u, tol=step.tol)
-                result = FrictionResult(r, u, cert.error, cert, sweeps, 0.0, LOOP_BACKEND)
-                um, up = ums[u0:u0 + n].copy(), ups[u0:u0 + n].copy()
-                verdict = partial(step.membership, closed, um, up, r / s)
-                out.append(FrictionEvent(step.t0 + k1 * step.h, closed, problem, result, s,
-                                         um, up, verdict))
-        return out
+        k1, c0, a, r0, u0, sweeps = (int(x) for x in head[e])
+        closed = contacts[c0:c0 + a].copy()
+        cols = (closed[:, None] * d + np.arange(d)).ravel()
+        s = self.units[cols]  # the kernel's problem, in contact units
+        W = self.products[1][np.ix_(cols, cols)] / np.outer(s, s)
+        problem = FrictionContactProblem(W, qs[r0:r0 + a * d].copy(), step.mu[closed],
+                                         contact_dim=d)
+        r = rs[r0:r0 + a * d].copy()
+        u = problem.velocity(r)
+        cert = certify_friction(problem, r, u, tol=step.tol)
+        result = FrictionResult(r, u, cert.error, cert, sweeps, 0.0, LOOP_BACKEND)
+        um, up = ums[u0:u0 + n].copy(), ups[u0:u0 + n].copy()
+        verdict = partial(step.membership, closed, um, up, r / s)
+        return FrictionEvent(step.t0 + k1 * step.h, closed, problem, result, s, um, up,
+                             verdict)

@@ -292,33 +292,22 @@ class _CompiledLoop(CompiledDriver):
         return (*self.geometry, *self.force, *self.impacts, self.passive, *self.chain,
                 self.tol)
 
-    def _events(self) -> list[ImpactEvent]:
-        """The ImpactEvents of the run, in order: each recorded cluster with its problem,
-        the step law on it and the certificate of the residuals the kernel checked."""
+    def _event(self, e: int) -> ImpactEvent:
+        """The ImpactEvent of record ``e``: the recorded cluster with its problem, the step
+        law on it and the certificate of the residuals the kernel checked."""
         head, res, dofs, contacts, um, up, vp, lam = self.buffers
-        ends = np.append(head[1:int(self.counts[0]), 1], self.counts[1])
-        cache = self.step.solver.cache  # the structures of the Python loop's steps
+        step, d0, c0, mc = (int(x) for x in head[e])
+        end = head[e + 1, 1] if e + 1 < self.counts[0] else self.counts[1]
+        d = slice(d0, int(end))
+        c = contacts[c0:c0 + mc].copy()
         closed = np.zeros(self.system.n_contacts, dtype=bool)
-        names = RESIDUALS[:CHECKED]
-        out: list[ImpactEvent] = []
-        for piece in self.pieces:
-            if isinstance(piece, list):
-                out.extend(piece)
-                continue
-            for e in range(*piece):
-                step, d0, c0, mc = (int(x) for x in head[e])
-                d = slice(d0, int(ends[e]))
-                c = contacts[c0:c0 + mc].copy()
-                closed[:] = False
-                closed[c] = True
-                (cl,) = cache.clusters(closed)
-                problem = ImpactProblem.from_structure(cl.structure, um[d].copy())
-                law = MoreauJeanStep(self.law.step_restitution(c), vp[d].copy())
-                cert = Certificate(dict(zip(names, res[e].tolist())), self.tol)
-                result = ImpactResult(problem, law.name, law.coefficients_for(problem),
-                                      up[d].copy(), lam[c0:c0 + mc].copy(), LOOP_BACKEND,
-                                      cert, form="impulse", impact_law=law,
-                                      attempts=[f"{LOOP_BACKEND}: certified"])
-                out.append(ImpactEvent(self.step.t0 + step * self.step.h, "step",
-                                       dofs[d].copy(), c, result))
-        return out
+        closed[c] = True
+        (cl,) = self.step.solver.cache.clusters(closed)  # the Python loop's structures
+        problem = ImpactProblem.from_structure(cl.structure, um[d].copy())
+        law = MoreauJeanStep(self.law.step_restitution(c), vp[d].copy())
+        cert = Certificate(dict(zip(RESIDUALS[:CHECKED], res[e].tolist())), self.tol)
+        result = ImpactResult(problem, law.name, law.coefficients_for(problem), up[d].copy(),
+                              lam[c0:c0 + mc].copy(), LOOP_BACKEND, cert, form="impulse",
+                              impact_law=law, attempts=[f"{LOOP_BACKEND}: certified"])
+        return ImpactEvent(self.step.t0 + step * self.step.h, "step", dofs[d].copy(), c,
+                           result)
