@@ -9,9 +9,9 @@ from importlib.metadata import PackageNotFoundError, version
 
 from ..base.log import verbosity
 from ..errors import ImpactError
-from .commands import demo, fclib, plot, sector, simulate, solve, verify
+from .commands import compile, demo, fclib, plot, sector, simulate, solve, verify
 
-COMMANDS = [demo, solve, verify, fclib, plot, sector, simulate]
+COMMANDS = [demo, solve, verify, fclib, plot, sector, simulate, compile]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import os
+import sys
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import TypeVar
+from typing import TextIO, TypeVar
 
 import numba
+import numba.core.event
 
 F = TypeVar("F", bound=Callable)
 
@@ -56,3 +59,61 @@ def inline_kernel(function: F) -> F:
     with _cached_in_user_dir():
         return numba.njit(cache=True, nogil=True, error_model="numpy",
                           inline="always")(function)
+
+
+NOTICE_AFTER = 1.0
+"""Seconds impactqp's kernels may compile before :class:`CompileNotice` says so."""
+
+
+def _ours(event: numba.core.event.Event) -> bool:
+    """The event is the compilation of one of impactqp's kernels."""
+    dispatcher = (event.data or {}).get("dispatcher")
+    module = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
+    return module.startswith("impactqp.")
+
+
+class CompileNotice(numba.core.event.Listener):
+    """Says on stderr, once per process, that impactqp is compiling its kernels when a
+    compilation has gone on for more than :data:`NOTICE_AFTER` seconds: what happens, that
+    it happens once, and where the machine code is kept. A kernel loaded from the disk cache
+    raises no compile event, so a warm start stays silent."""
+
+    def __init__(self, stream: Callable[[], TextIO] = lambda: sys.stderr) -> None:
+        self.stream = stream
+        self.depth = 0
+        self.said = False
+        self.timer: threading.Timer | None = None
+
+    def message(self) -> str:
+        """The notice's one line."""
+        where = numba.config.CACHE_DIR or cache_dir()
+        return ("impactqp: compiling its numba kernels for this call, once: the machine code "
+                f"is cached in {where} (`impactqp compile` compiles every kernel ahead of "
+                "time)")
+
+    def say(self) -> None:
+        """Write the notice, unless it was written already."""
+        if not self.said:
+            self.said = True
+            print(self.message(), file=self.stream(), flush=True)
+
+    def on_start(self, event: numba.core.event.Event) -> None:
+        if not _ours(event):
+            return
+        self.depth += 1
+        if self.depth == 1 and not self.said:
+            self.timer = threading.Timer(NOTICE_AFTER, self.say)
+            self.timer.daemon = True
+            self.timer.start()
+
+    def on_end(self, event: numba.core.event.Event) -> None:
+        if not _ours(event):
+            return
+        self.depth = max(self.depth - 1, 0)
+        if self.depth == 0 and self.timer is not None:
+            self.timer.cancel()
+            self.timer = None
+
+
+NOTICE = CompileNotice()
+numba.core.event.register("numba:compile", NOTICE)

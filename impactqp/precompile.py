@@ -1,0 +1,160 @@
+"""Compile impactqp's kernels ahead of time, for images, containers and cluster workers.
+
+Every kernel is compiled by numba on its first call and its machine code kept in the cache
+folder (:func:`impactqp.kernels.jit.cache_dir`). :func:`compile_kernels` makes those first
+calls on small problems of every route — impacts of each law, batches, chains, S, friction,
+and both Moreau–Jean loops — so that later processes sharing the cache start warm.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from . import kernels
+from .kernels.jit import cache_dir
+from .laws.batch import solve_batch
+from .laws.complementarity import Fremond, Newton
+from .laws.coulomb import Coulomb
+from .laws.friction import solve_friction
+from .laws.functions import moreau, sector_law
+from .laws.lzb import LZB
+from .laws.moreau import Moreau
+from .laws.pipeline import solve
+from .model.builders import chain, newtons_cradle, random_impact
+from .model.classify import classify
+from .model.friction import FrictionContactProblem
+from .model.friction_builders import sphere_on_plane
+from .simulation.builders import block_on_incline, bouncing_ball, box_on_floor, cradle_system
+from .simulation.simulate import simulate
+
+
+def _impacts() -> None:
+    p = newtons_cradle(3, 1.0)
+    for eps in (0.0, 1.0):
+        moreau(p, eps)
+    solve(p, Newton([1.0, 0.5]))
+    solve(p, Fremond([[0.5, 0.2], [0.0, 0.5]]))
+    sector_law(p)
+    classify(p, [0.0, 0.0, 1.0])
+    p.admissible_set().contains([0.0, 0.0, 1.0])
+    r = random_impact(8, 5, seed=1)
+    moreau(r, 0.5)
+    moreau(r, 0.5, backend="nnls")
+
+
+def _batches() -> None:
+    p = newtons_cradle(3, 1.0)
+    U = np.random.default_rng(0).standard_normal((64, 3))
+    solve_batch(p, Moreau(0.5), U)
+    solve_batch(p, Newton([1.0, 0.5]), U)
+
+
+def _chains() -> None:
+    masses = np.linspace(1.0, 2.0, 2000)
+    u = np.zeros(2000)
+    u[0] = 1.0
+    moreau(chain(masses, u), 1.0)
+
+
+def _lzb() -> None:
+    solve(newtons_cradle(3, 1.0), LZB(1.0, 1.5, 0.9))
+
+
+def _friction() -> None:
+    p = sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
+    solve(p, Coulomb(0.3, 0.5))
+    rng = np.random.default_rng(2)
+    m = 40
+    A = rng.standard_normal((3 * m, 3 * m + 5))
+    W = A @ A.T / (3 * m)
+    q = rng.standard_normal(3 * m)
+    problem = FrictionContactProblem(W, q, 0.3)
+    for backend in ("auto", "nsgs", "newton"):
+        solve_friction(problem, backend=backend)
+
+
+def _simulations() -> None:
+    simulate(bouncing_ball(q0=0.1), Newton(0.5), 0.2, h=1e-2)
+    simulate(cradle_system(3), Moreau(1.0), 0.05, h=1e-3)
+    simulate(block_on_incline(0.3, dim=2, speed=1.0), Coulomb(0.5, 0.0), 0.05, h=1e-2)
+    simulate(box_on_floor(3, velocity=[1.0, 0.0]), Coulomb(0.3, 0.0), 0.05, h=1e-2)
+
+
+STAGES: tuple[tuple[str, Callable[[], None]], ...] = (
+    ("impacts", _impacts), ("batches", _batches), ("chains", _chains), ("LZB", _lzb),
+    ("friction", _friction), ("simulations", _simulations),
+)
+"""The routes :func:`compile_kernels` runs, by name."""
+
+
+@dataclass(frozen=True)
+class CompileReport:
+    """What :func:`compile_kernels` did.
+
+    Attributes
+    ----------
+    seconds : float
+        Wall-clock time of all stages.
+    compiled : tuple of str
+        Kernels that hold machine code afterwards (``module.function``).
+    not_reached : tuple of str
+        Kernels without machine code of their own: helpers compiled into the kernels that
+        call them (a test checks that after this call the routes compile nothing more).
+    cache : str
+        The cache folder the machine code was written to.
+    """
+
+    seconds: float
+    compiled: tuple[str, ...]
+    not_reached: tuple[str, ...]
+    cache: str
+
+    def summary(self) -> str:
+        """One line for the command line."""
+        return (f"{len(self.compiled)} kernels ready in {self.seconds:.1f} s "
+                f"(cache: {self.cache})")
+
+
+def _kernels() -> dict[str, object]:
+    """Every compiled kernel of :mod:`impactqp.kernels` by ``module.function``."""
+    found: dict[str, object] = {}
+    for info in pkgutil.iter_modules(kernels.__path__):
+        module = importlib.import_module(f"{kernels.__name__}.{info.name}")
+        for name, value in vars(module).items():
+            if getattr(value, "py_func", None) is not None and \
+                    value.py_func.__module__ == module.__name__:
+                found[f"{info.name}.{name}"] = value
+    return found
+
+
+def compile_kernels(progress: Callable[[str, int, int], None] | None = None) -> CompileReport:
+    """Compile every kernel impactqp's routes call, writing their machine code to the cache.
+
+    Parameters
+    ----------
+    progress : callable, optional
+        Called as ``progress(stage, done, total)`` before each stage and once at the end.
+
+    Returns
+    -------
+    CompileReport
+    """
+    start = time.perf_counter()
+    for i, (name, stage) in enumerate(STAGES):
+        if progress is not None:
+            progress(name, i, len(STAGES))
+        stage()
+    if progress is not None:
+        progress("done", len(STAGES), len(STAGES))
+    found = _kernels()
+    compiled = tuple(sorted(k for k, v in found.items() if v.signatures))
+    missing = tuple(sorted(k for k, v in found.items() if not v.signatures))
+    return CompileReport(time.perf_counter() - start, compiled, missing,
+                         numba.config.CACHE_DIR or cache_dir())

@@ -1,0 +1,87 @@
+"""Compilation is seen and done ahead of time: ``impactqp compile`` fills the cache so that a
+later process compiles nothing on the README's routes, and a cold first call says once on
+stderr that it compiles, while a warm one stays silent."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+NOTICE = "impactqp: compiling its numba kernels"
+
+# A later process's routes, with a listener counting every compilation of impactqp's kernels.
+ROUTES = """
+import numba.core.event as ev
+import numpy as np
+import impactqp as iq
+
+class Count(ev.Listener):
+    n = 0
+    def on_start(self, event):
+        d = (event.data or {}).get("dispatcher")
+        if getattr(getattr(d, "py_func", None), "__module__", "").startswith("impactqp."):
+            Count.n += 1
+    def on_end(self, event):
+        pass
+
+ev.register("numba:compile", Count())
+p = iq.newtons_cradle(3, 1.0)
+iq.moreau(p, 1.0); iq.moreau(p, 0.0); iq.sector_law(p)
+iq.solve_batch(p, iq.Moreau(0.5), np.random.default_rng(0).standard_normal((10, 3)))
+iq.solve(iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0]), iq.Coulomb(0.3, 0.5))
+iq.simulate(iq.bouncing_ball(q0=0.1), iq.Newton(0.5), 0.2, h=1e-2)
+iq.simulate(iq.block_on_incline(0.3, dim=2, speed=1.0), iq.Coulomb(0.5, 0.0), 0.05, h=1e-2)
+print("compilations", Count.n)
+"""
+
+
+def _env(cache) -> dict[str, str]:
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_DISABLE_JIT"}
+    env["NUMBA_CACHE_DIR"] = str(cache)
+    return env
+
+
+@pytest.mark.timeout(900)
+def test_compile_fills_the_cache_and_later_processes_compile_nothing(tmp_path):
+    cache = tmp_path / "numba"
+    done = subprocess.run([sys.executable, "-m", "impactqp", "compile", "--list"],
+                          env=_env(cache), capture_output=True, text=True, timeout=850)
+    assert done.returncode == 0, done.stderr
+    assert "kernels ready" in done.stdout
+    assert done.stderr.count(NOTICE) == 1, done.stderr  # said once, however many kernels
+    assert str(cache) in done.stderr
+    later = subprocess.run([sys.executable, "-c", ROUTES], env=_env(cache),
+                           capture_output=True, text=True, timeout=300)
+    assert later.returncode == 0, later.stderr
+    assert "compilations 0" in later.stdout, later.stdout
+    assert NOTICE not in later.stderr
+
+
+def test_notice_is_written_once_and_only_after_its_delay():
+    import io
+
+    from impactqp.kernels import jit
+
+    out = io.StringIO()
+    notice = jit.CompileNotice(lambda: out)
+
+    class Event:  # the part of numba's event the listener reads
+        def __init__(self, module):
+            self.data = {"dispatcher": type("D", (), {"py_func": type(
+                "F", (), {"__module__": module})})()}
+
+    ours, theirs = Event("impactqp.kernels.impact"), Event("somebody.else")
+    notice.on_start(theirs)
+    assert notice.timer is None  # other packages' kernels are not ours to announce
+    notice.on_start(ours)
+    notice.on_start(ours)  # nested: one timer
+    notice.on_end(ours)
+    assert notice.timer is not None
+    notice.on_end(ours)  # finished within the delay: nothing said
+    assert notice.timer is None and out.getvalue() == ""
+    notice.say()
+    notice.say()
+    assert out.getvalue().count(NOTICE) == 1
