@@ -20,8 +20,13 @@ equality multipliers) are refused, as are rolling-friction files.
 Reading is strict: a path that is not a regular file, a file that is not HDF5, missing or
 mis-typed datasets, sizes that do not fit together, indices out of range, non-finite numbers,
 negative μ and a singular M are refused with a :class:`~impactqp.errors.ProblemFileError`
-that names the file and the dataset. Dimensions above :data:`MAX_FCLIB_DIM` are refused before
-anything is allocated.
+that names the file and the dataset. A file is read alone: external links (which open other
+files, a FIFO among them, where reading would wait forever), soft links, external raw storage
+(a dataset whose bytes live in another file, /dev/zero reads as zeros) and virtual datasets
+are refused by name, before anything they point at is opened. Dimensions above
+:data:`MAX_FCLIB_DIM` and datasets declaring more than :data:`MAX_DATASET_BYTES` are refused
+before anything is allocated or decompressed, and only the entries the problem needs are
+read.
 """
 
 from __future__ import annotations
@@ -34,7 +39,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..base.outputs import output_file
+from ..base.outputs import atomic_output
 from ..errors import InputError, OptionalDependencyError, ProblemFileError
 from ..model.friction import FrictionContactProblem
 
@@ -49,6 +54,11 @@ REDUCTION_RTOL = 1e-8
 """Largest componentwise backward error |M Y − H| ≤ rtol·(|M||Y| + |H|) accepted for
 Y = M⁻¹H; above it M is taken as singular (the reduced W would not be Hᵀ M⁻¹ H)."""
 
+MAX_DATASET_BYTES = 2**30
+"""Largest dataset (declared shape × item size, and largest chunk) read from an FCLib file:
+1 GiB, some 10⁸ numbers, far above the largest problems of the FCLib collections. A
+compressed dataset may declare far more than its file's size; it is refused before reading."""
+
 MIXED_PARTS = {"fclib_local": ("V", "R", "vectors/s"), "fclib_global": ("G", "vectors/b")}
 
 
@@ -61,7 +71,11 @@ def _h5py() -> Any:
 
 
 class _Reader:
-    """Datasets of one open FCLib file, each checked and named in every error."""
+    """Datasets of one open FCLib file, each checked and named in every error.
+
+    Objects are reached through hard links only, and a dataset is read only once its storage
+    (in this file: not external, not virtual), type, shape and declared size have been checked,
+    and then only the entries the problem needs."""
 
     def __init__(self, path: Path, handle: Any) -> None:
         self.path = path
@@ -70,45 +84,102 @@ class _Reader:
     def error(self, name: str, what: str) -> ProblemFileError:
         return ProblemFileError(f"{self.path}: /{name}: {what}")
 
-    def dataset(self, name: str) -> np.ndarray:
-        obj = self.handle.get(name)
+    def node(self, name: str) -> Any | None:
+        """The object at ``name``, found link by link without following any link that is not
+        a hard one (an external link opens another file, a soft one may lead to one); None
+        when a link on the way is absent."""
+        h5l = _h5py().h5l
+        node = self.handle
+        parts = name.split("/")
+        for k, part in enumerate(parts):
+            where = "/".join(parts[:k + 1])
+            if not hasattr(node, "keys"):
+                raise self.error("/".join(parts[:k]), "is a dataset, expected a group")
+            key = part.encode()
+            if not node.id.links.exists(key):
+                return None
+            kind = node.id.links.get_info(key).type
+            if kind == h5l.TYPE_EXTERNAL:
+                target, inside = (x.decode(errors="replace") for x in node.id.links.get_val(key))
+                raise self.error(where, f"is an external link (to {inside} in {target}); "
+                                        "links to other files are refused")
+            if kind != h5l.TYPE_HARD:
+                what = "a soft link" if kind == h5l.TYPE_SOFT else "a user-defined link"
+                raise self.error(where, f"is {what}; only groups and datasets stored under "
+                                        "their own name are read")
+            node = node[part]
+        return node
+
+    def contains(self, name: str) -> bool:
+        return self.node(name) is not None
+
+    def stored(self, name: str) -> Any:
+        """The dataset at ``name``, its data stored in this file (not in external raw files,
+        not a virtual view of other datasets), checked before any of it is read."""
+        h5d = _h5py().h5d
+        obj = self.node(name)
         if obj is None:
             raise self.error(name, "missing (an FCLib file needs it)")
-        if not hasattr(obj, "dtype"):
+        if not hasattr(obj, "dtype") or not hasattr(obj, "chunks"):
             raise self.error(name, "is a group, expected a dataset")
+        plist = obj.id.get_create_plist()
+        if plist.get_layout() == h5d.VIRTUAL:
+            sources = {plist.get_virtual_filename(i) for i in range(plist.get_virtual_count())}
+            raise self.error(name, f"is a virtual dataset (a view of datasets in "
+                                   f"{', '.join(sorted(sources))}); refused, an FCLib file is "
+                                   "read alone")
+        if plist.get_external_count():
+            target = plist.get_external(0)[0].decode(errors="replace")
+            raise self.error(name, f"is stored in external raw file(s) ({target}, ...); "
+                                   "refused, an FCLib file is read alone")
+        return obj
+
+    def _read(self, name: str, obj: Any, length: int | None) -> np.ndarray:
+        """The first ``length`` entries of the 1-D dataset ``obj`` (all of a scalar one for
+        None), once its declared size and chunk size are within :data:`MAX_DATASET_BYTES`."""
+        itemsize = obj.dtype.itemsize
+        declared = int(np.prod(obj.shape, dtype=np.float64)) * itemsize
+        chunk = int(np.prod(obj.chunks, dtype=np.float64)) * itemsize if obj.chunks else 0
+        if max(declared, chunk) > MAX_DATASET_BYTES:
+            what = (f"declares {declared} bytes (shape {obj.shape})" if declared > chunk else
+                    f"is stored in chunks of {chunk} bytes (chunks {obj.chunks})")
+            raise self.error(name, f"{what}; datasets and chunks above {MAX_DATASET_BYTES} "
+                                   "bytes are refused before reading")
         try:
-            return np.asarray(obj[()])
+            return np.asarray(obj[()] if length is None else obj[:length])
         except (OSError, TypeError, ValueError) as exc:
             raise self.error(name, f"cannot be read ({exc})") from None
 
     def integer(self, name: str) -> int:
-        data = self.dataset(name)
-        if data.dtype.kind not in "iu" or data.size != 1 or data.ndim > 1:
-            raise self.error(name, f"must hold one integer, got dtype {data.dtype} and shape "
-                                   f"{data.shape}")
-        return int(data.reshape(-1)[0])
+        obj = self.stored(name)
+        if obj.dtype.kind not in "iu" or obj.size != 1 or len(obj.shape) > 1:
+            raise self.error(name, f"must hold one integer, got dtype {obj.dtype} and shape "
+                                   f"{obj.shape}")
+        return int(self._read(name, obj, None).reshape(-1)[0])
+
+    def vector(self, name: str, kinds: str, length: int, exact: bool) -> np.ndarray:
+        """The first ``length`` entries of a 1-D dataset whose type is of ``kinds`` and whose
+        declared size fits ``length`` (equals it when ``exact``, else at least)."""
+        obj = self.stored(name)
+        described = "integers" if kinds == "iu" else "numbers"
+        if obj.dtype.kind not in kinds or len(obj.shape) != 1:
+            raise self.error(name, f"must be a vector of {described}, got dtype {obj.dtype} "
+                                   f"and shape {obj.shape}")
+        size = obj.shape[0]
+        if size < length or (exact and size != length):
+            raise self.error(name, f"has {size} entries, "
+                                   f"{'expected' if exact else 'needs at least'} {length}")
+        return self._read(name, obj, length)
 
     def indices(self, name: str, length: int, bound: int) -> np.ndarray:
-        data = self.dataset(name)
-        if data.dtype.kind not in "iu" or data.ndim != 1:
-            raise self.error(name, f"must be a vector of integers, got dtype {data.dtype} and "
-                                   f"shape {data.shape}")
-        if data.size < length:
-            raise self.error(name, f"has {data.size} entries, needs at least {length}")
-        data = data[:length].astype(np.int64)
+        data = self.vector(name, "iu", length, exact=False).astype(np.int64)
         if length and (data.min() < 0 or data.max() >= bound):
             raise self.error(name, f"indices must lie in [0, {bound}), found "
                                    f"{data.min()}..{data.max()}")
         return data
 
     def floats(self, name: str, length: int, *, exact: bool = True) -> np.ndarray:
-        data = self.dataset(name)
-        if data.dtype.kind not in "fiu" or data.ndim != 1:
-            raise self.error(name, f"must be a vector of numbers, got dtype {data.dtype} and "
-                                   f"shape {data.shape}")
-        if data.size < length or (exact and data.size != length):
-            raise self.error(name, f"has {data.size} entries, expected {length}")
-        data = data[:length].astype(float)
+        data = self.vector(name, "fiu", length, exact).astype(float)
         if not np.all(np.isfinite(data)):
             raise self.error(name, f"holds {int(np.sum(~np.isfinite(data)))} non-finite "
                                    "number(s) (NaN or infinity)")
@@ -218,12 +289,11 @@ def _global(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int
 
 
 def _read(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]:
-    handle = reader.handle
-    root = next((r for r in ("fclib_local", "fclib_global") if r in handle), None)
+    root = next((r for r in ("fclib_local", "fclib_global") if reader.contains(r)), None)
     if root is None:
         raise ProblemFileError(f"{reader.path}: neither /fclib_local nor /fclib_global; not an "
                                "FCLib problem file")
-    mixed = [part for part in MIXED_PARTS[root] if f"{root}/{part}" in handle]
+    mixed = [part for part in MIXED_PARTS[root] if reader.contains(f"{root}/{part}")]
     if mixed:
         raise reader.error(f"{root}/{mixed[0]}", "mixed problems (extra equality multipliers) "
                                                  "are not supported")
@@ -254,7 +324,10 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
     ProblemFileError
         Not a regular file, not HDF5, neither problem group, a mixed problem (``V``/``R`` or
         ``G``/``b``), a missing or malformed dataset, non-finite numbers, negative μ or a
-        singular M; the message names the file and the dataset.
+        singular M; a link that is not a hard one (an external link reaches into another
+        file), a dataset stored outside the file (external raw storage, a virtual dataset),
+        one declaring more than :data:`MAX_DATASET_BYTES`, or a problem that does not fit in
+        memory. The message names the file and the dataset.
     """
     if not isinstance(path, (str, Path)):
         raise ProblemFileError(f"path must be a str or Path, got {type(path).__name__}")
@@ -268,15 +341,20 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
         handle = h5py.File(path, "r")
     except OSError as exc:
         raise ProblemFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    with handle:
-        try:
-            W, q, mu, d = _read(_Reader(path, handle))
-        except ProblemFileError:
-            raise
-        except (OSError, RuntimeError, KeyError, ValueError) as exc:  # h5py on a damaged file
-            raise ProblemFileError(f"{path}: damaged HDF5 file ({exc})") from None
     try:
+        with handle:
+            try:
+                W, q, mu, d = _read(_Reader(path, handle))
+            except ProblemFileError:
+                raise
+            except (OSError, RuntimeError, KeyError, ValueError) as exc:  # h5py, damaged file
+                raise ProblemFileError(f"{path}: damaged HDF5 file ({exc})") from None
         return FrictionContactProblem(W, q, mu, contact_dim=d)
+    except MemoryError:
+        raise ProblemFileError(f"{path}: the problem does not fit in this machine's memory")\
+            from None
+    except ProblemFileError:
+        raise
     except InputError as exc:
         raise ProblemFileError(f"{path}: {exc}") from exc
 
@@ -288,8 +366,10 @@ def _write_int(group: Any, name: str, value: int) -> None:
 def save_fclib(problem: FrictionContactProblem, path: str | Path) -> Path:
     """Write a local frictional contact problem as an FCLib HDF5 file (``/fclib_local``).
 
-    W is stored in compressed columns (``nz = -1``), as FCLib and Siconos read it; the file
-    is replaced if it exists. :func:`load_fclib` reads back W, q and μ bit for bit.
+    W is stored in compressed columns (``nz = -1``), as FCLib and Siconos read it. The file
+    is written beside ``path`` and renamed onto it when complete, so an existing file is
+    replaced whole or, when writing fails, left as it was. :func:`load_fclib` reads back W,
+    q and μ bit for bit.
 
     Parameters
     ----------
@@ -320,10 +400,10 @@ def save_fclib(problem: FrictionContactProblem, path: str | Path) -> Path:
         if not np.all(np.isfinite(values)):
             raise InputError(f"problem.{name} holds non-finite numbers; FCLib files hold "
                              "finite ones")
-    path = output_file(path)
+    path = Path(path)
     h5py = _h5py()
     try:
-        with h5py.File(path, "w") as handle:
+        with atomic_output(path) as temp, h5py.File(temp, "w") as handle:
             root = handle.create_group("fclib_local")
             _write_int(root, "spacedim", problem.contact_dim)
             group = root.create_group("W")
