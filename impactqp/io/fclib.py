@@ -23,10 +23,10 @@ negative μ and a singular M are refused with a :class:`~impactqp.errors.Problem
 that names the file and the dataset. A file is read alone: external links (which open other
 files, a FIFO among them, where reading would wait forever), soft links, external raw storage
 (a dataset whose bytes live in another file, /dev/zero reads as zeros) and virtual datasets
-are refused by name, before anything they point at is opened. Dimensions above
-:data:`MAX_FCLIB_DIM` and datasets declaring more than :data:`MAX_DATASET_BYTES` are refused
-before anything is allocated or decompressed, and only the entries the problem needs are
-read.
+are refused by name, before anything they point at is opened (:mod:`.hdf5_reader`).
+Dimensions above :data:`MAX_FCLIB_DIM` and datasets declaring more than
+:data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES` are refused before anything is allocated
+or decompressed, and only the entries the problem needs are read.
 """
 
 from __future__ import annotations
@@ -40,8 +40,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..base.outputs import atomic_output
-from ..errors import InputError, OptionalDependencyError, ProblemFileError
+from ..errors import InputError, ProblemFileError
 from ..model.friction import FrictionContactProblem
+from .hdf5_reader import CheckedReader, h5py_module
 
 MAX_FCLIB_DIM = 1_000_000
 """Largest row or column count of a matrix in an FCLib file (degrees of freedom, d·contacts)."""
@@ -54,136 +55,11 @@ REDUCTION_RTOL = 1e-8
 """Largest componentwise backward error |M Y − H| ≤ rtol·(|M||Y| + |H|) accepted for
 Y = M⁻¹H; above it M is taken as singular (the reduced W would not be Hᵀ M⁻¹ H)."""
 
-MAX_DATASET_BYTES = 2**30
-"""Largest dataset (declared shape × item size, and largest chunk) read from an FCLib file:
-1 GiB, some 10⁸ numbers, far above the largest problems of the FCLib collections. A
-compressed dataset may declare far more than its file's size; it is refused before reading."""
-
 MIXED_PARTS = {"fclib_local": ("V", "R", "vectors/s"), "fclib_global": ("G", "vectors/b")}
 
 
-def _h5py() -> Any:
-    try:
-        import h5py
-    except ImportError:
-        raise OptionalDependencyError("FCLib files need h5py: pip install h5py") from None
-    return h5py
-
-
-class _Reader:
-    """Datasets of one open FCLib file, each checked and named in every error.
-
-    Objects are reached through hard links only, and a dataset is read only once its storage
-    (in this file: not external, not virtual), type, shape and declared size have been checked,
-    and then only the entries the problem needs."""
-
-    def __init__(self, path: Path, handle: Any) -> None:
-        self.path = path
-        self.handle = handle
-
-    def error(self, name: str, what: str) -> ProblemFileError:
-        return ProblemFileError(f"{self.path}: /{name}: {what}")
-
-    def node(self, name: str) -> Any | None:
-        """The object at ``name``, found link by link without following any link that is not
-        a hard one (an external link opens another file, a soft one may lead to one); None
-        when a link on the way is absent."""
-        h5l = _h5py().h5l
-        node = self.handle
-        parts = name.split("/")
-        for k, part in enumerate(parts):
-            where = "/".join(parts[:k + 1])
-            if not hasattr(node, "keys"):
-                raise self.error("/".join(parts[:k]), "is a dataset, expected a group")
-            key = part.encode()
-            if not node.id.links.exists(key):
-                return None
-            kind = node.id.links.get_info(key).type
-            if kind == h5l.TYPE_EXTERNAL:
-                target, inside = (x.decode(errors="replace") for x in node.id.links.get_val(key))
-                raise self.error(where, f"is an external link (to {inside} in {target}); "
-                                        "links to other files are refused")
-            if kind != h5l.TYPE_HARD:
-                what = "a soft link" if kind == h5l.TYPE_SOFT else "a user-defined link"
-                raise self.error(where, f"is {what}; only groups and datasets stored under "
-                                        "their own name are read")
-            node = node[part]
-        return node
-
-    def contains(self, name: str) -> bool:
-        return self.node(name) is not None
-
-    def stored(self, name: str) -> Any:
-        """The dataset at ``name``, its data stored in this file (not in external raw files,
-        not a virtual view of other datasets), checked before any of it is read."""
-        h5d = _h5py().h5d
-        obj = self.node(name)
-        if obj is None:
-            raise self.error(name, "missing (an FCLib file needs it)")
-        if not hasattr(obj, "dtype") or not hasattr(obj, "chunks"):
-            raise self.error(name, "is a group, expected a dataset")
-        plist = obj.id.get_create_plist()
-        if plist.get_layout() == h5d.VIRTUAL:
-            sources = {plist.get_virtual_filename(i) for i in range(plist.get_virtual_count())}
-            raise self.error(name, f"is a virtual dataset (a view of datasets in "
-                                   f"{', '.join(sorted(sources))}); refused, an FCLib file is "
-                                   "read alone")
-        if plist.get_external_count():
-            target = plist.get_external(0)[0].decode(errors="replace")
-            raise self.error(name, f"is stored in external raw file(s) ({target}, ...); "
-                                   "refused, an FCLib file is read alone")
-        return obj
-
-    def _read(self, name: str, obj: Any, length: int | None) -> np.ndarray:
-        """The first ``length`` entries of the 1-D dataset ``obj`` (all of a scalar one for
-        None), once its declared size and chunk size are within :data:`MAX_DATASET_BYTES`."""
-        itemsize = obj.dtype.itemsize
-        declared = int(np.prod(obj.shape, dtype=np.float64)) * itemsize
-        chunk = int(np.prod(obj.chunks, dtype=np.float64)) * itemsize if obj.chunks else 0
-        if max(declared, chunk) > MAX_DATASET_BYTES:
-            what = (f"declares {declared} bytes (shape {obj.shape})" if declared > chunk else
-                    f"is stored in chunks of {chunk} bytes (chunks {obj.chunks})")
-            raise self.error(name, f"{what}; datasets and chunks above {MAX_DATASET_BYTES} "
-                                   "bytes are refused before reading")
-        try:
-            return np.asarray(obj[()] if length is None else obj[:length])
-        except (OSError, TypeError, ValueError) as exc:
-            raise self.error(name, f"cannot be read ({exc})") from None
-
-    def integer(self, name: str) -> int:
-        obj = self.stored(name)
-        if obj.dtype.kind not in "iu" or obj.size != 1 or len(obj.shape) > 1:
-            raise self.error(name, f"must hold one integer, got dtype {obj.dtype} and shape "
-                                   f"{obj.shape}")
-        return int(self._read(name, obj, None).reshape(-1)[0])
-
-    def vector(self, name: str, kinds: str, length: int, exact: bool) -> np.ndarray:
-        """The first ``length`` entries of a 1-D dataset whose type is of ``kinds`` and whose
-        declared size fits ``length`` (equals it when ``exact``, else at least)."""
-        obj = self.stored(name)
-        described = "integers" if kinds == "iu" else "numbers"
-        if obj.dtype.kind not in kinds or len(obj.shape) != 1:
-            raise self.error(name, f"must be a vector of {described}, got dtype {obj.dtype} "
-                                   f"and shape {obj.shape}")
-        size = obj.shape[0]
-        if size < length or (exact and size != length):
-            raise self.error(name, f"has {size} entries, "
-                                   f"{'expected' if exact else 'needs at least'} {length}")
-        return self._read(name, obj, length)
-
-    def indices(self, name: str, length: int, bound: int) -> np.ndarray:
-        data = self.vector(name, "iu", length, exact=False).astype(np.int64)
-        if length and (data.min() < 0 or data.max() >= bound):
-            raise self.error(name, f"indices must lie in [0, {bound}), found "
-                                   f"{data.min()}..{data.max()}")
-        return data
-
-    def floats(self, name: str, length: int, *, exact: bool = True) -> np.ndarray:
-        data = self.vector(name, "fiu", length, exact).astype(float)
-        if not np.all(np.isfinite(data)):
-            raise self.error(name, f"holds {int(np.sum(~np.isfinite(data)))} non-finite "
-                                   "number(s) (NaN or infinity)")
-        return data
+class _Reader(CheckedReader):
+    """The CSparse matrices, ``spacedim`` and μ of an FCLib file, each checked."""
 
     def matrix(self, name: str) -> sp.csc_matrix:
         """The sparse matrix stored in group ``name`` (CSparse layout, see the module doc)."""
@@ -326,13 +202,13 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
         ``G``/``b``), a missing or malformed dataset, non-finite numbers, negative μ or a
         singular M; a link that is not a hard one (an external link reaches into another
         file), a dataset stored outside the file (external raw storage, a virtual dataset),
-        one declaring more than :data:`MAX_DATASET_BYTES`, or a problem that does not fit in
-        memory. The message names the file and the dataset.
+        one declaring more than :data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES`, or a
+        problem that does not fit in memory. The message names the file and the dataset.
     """
     if not isinstance(path, (str, Path)):
         raise ProblemFileError(f"path must be a str or Path, got {type(path).__name__}")
     path = Path(path)
-    h5py = _h5py()
+    h5py = h5py_module()
     try:
         if not stat.S_ISREG(path.stat().st_mode):
             raise ProblemFileError(f"{path}: not a regular file")
@@ -401,7 +277,7 @@ def save_fclib(problem: FrictionContactProblem, path: str | Path) -> Path:
             raise InputError(f"problem.{name} holds non-finite numbers; FCLib files hold "
                              "finite ones")
     path = Path(path)
-    h5py = _h5py()
+    h5py = h5py_module()
     try:
         with atomic_output(path) as temp, h5py.File(temp, "w") as handle:
             root = handle.create_group("fclib_local")
