@@ -270,3 +270,21 @@ def test_fclib_memory_error_is_named(tmp_path: Path, monkeypatch: pytest.MonkeyP
     monkeypatch.setattr(fclib, "_local", no_memory)
     with pytest.raises(ProblemFileError, match="memory"):
         fclib.load_fclib(fclib_file(tmp_path / "p.hdf5"))
+
+
+@pytest.mark.parametrize("dataset, word", [
+    ("fclib_local/vectors/q", "must be a vector of numbers"),
+    ("fclib_local/W/m", "must hold one integer")])
+def test_fclib_dataset_without_a_shape_is_named(tmp_path: Path, dataset: str, word: str) -> None:
+    import h5py
+
+    from impactqp.errors import ProblemFileError
+    from impactqp.io.fclib import load_fclib
+
+    path = fclib_file(tmp_path / "empty.hdf5")
+    with h5py.File(path, "a") as handle:  # a null dataspace: no shape, no data
+        dtype = handle[dataset].dtype
+        del handle[dataset]
+        handle.create_dataset(dataset, data=h5py.Empty(dtype))
+    with pytest.raises(ProblemFileError, match=f"/{dataset}: {word}.*shape None"):
+        load_fclib(path)

@@ -117,7 +117,8 @@ class CheckedReader:
 
     def integer(self, name: str) -> int:
         obj = self.stored(name)
-        if obj.dtype.kind not in "iu" or obj.size != 1 or len(obj.shape) > 1:
+        if obj.dtype.kind not in "iu" or obj.shape is None or obj.size != 1 \
+                or len(obj.shape) > 1:
             raise self.error(name, f"must hold one integer, got dtype {obj.dtype} and shape "
                                    f"{obj.shape}")
         return int(self._read(name, obj, None).reshape(-1)[0])
@@ -127,7 +128,7 @@ class CheckedReader:
         declared size fits ``length`` (equals it when ``exact``, else at least)."""
         obj = self.stored(name)
         described = "integers" if kinds == "iu" else "numbers"
-        if obj.dtype.kind not in kinds or len(obj.shape) != 1:
+        if obj.dtype.kind not in kinds or obj.shape is None or len(obj.shape) != 1:
             raise self.error(name, f"must be a vector of {described}, got dtype {obj.dtype} "
                                    f"and shape {obj.shape}")
         size = obj.shape[0]
