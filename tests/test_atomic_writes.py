@@ -188,3 +188,35 @@ def test_animation(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     cradle.animate(path, frames=3, fps=3)
     assert path.read_bytes()[:6] == b"GIF89a"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["c.gif"]
+
+
+KILLED_MID_WRITE = """
+import os, signal, sys
+from pathlib import Path
+import impactqp as iq
+
+def die_half_way(self, text, *args, **kwargs):
+    with open(self, "w") as handle:
+        handle.write(text[: len(text) // 2])
+    os.kill(os.getpid(), signal.SIGKILL)
+
+Path.write_text = die_half_way
+iq.save_problem(iq.newtons_cradle(3), sys.argv[1])
+"""
+
+
+@pytest.mark.skipif(not hasattr(os, "kill") or os.name != "posix", reason="needs SIGKILL")
+def test_a_writer_killed_half_way_leaves_the_old_file(tmp_path: Path) -> None:
+    import signal
+    import subprocess
+    import sys
+
+    path = previous(tmp_path / "p.toml")
+    out = subprocess.run([sys.executable, "-c", KILLED_MID_WRITE, str(path)], timeout=120,
+                         capture_output=True, text=True)
+    assert out.returncode == -signal.SIGKILL, out.stderr
+    assert path.read_bytes() == OLD
+    # the killed process could not clean up: its half-written temporary is all that is left
+    strays = [p for p in tmp_path.iterdir() if p != path]
+    assert len(strays) == 1 and strays[0].name.startswith(".p.")
+    assert strays[0].name.endswith(".part.toml")
