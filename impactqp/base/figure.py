@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError, OptionalDependencyError
-from .outputs import output_file
+from .outputs import atomic_output
 
 FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 DPI = 100
@@ -62,5 +62,6 @@ def figure_format(path: str | Path) -> str:
 def save_figure(fig: Any, path: str | Path) -> Path:
     """Write ``fig`` in the format of the suffix of ``path``, without time stamps."""
     fmt = figure_format(path)
-    fig.savefig(output_file(path), format=fmt, metadata=_NO_DATES[fmt])
+    with atomic_output(path) as temp:
+        fig.savefig(temp, format=fmt, metadata=_NO_DATES[fmt])
     return Path(path)

@@ -8,7 +8,7 @@ import sys
 from importlib.metadata import PackageNotFoundError, version
 
 from ..base.log import verbosity
-from ..errors import ImpactError
+from ..errors import ImpactError, OutOfRangeError
 from .commands import compile, demo, fclib, plot, sector, simulate, solve, verify
 
 COMMANDS = [demo, solve, verify, fclib, plot, sector, simulate, compile]
@@ -57,6 +57,15 @@ def _fail(message: str) -> int:
     return 2
 
 
+def out_of_range(command: str, exc: OverflowError) -> OutOfRangeError:
+    """The named error of a number that left the float range while ``command`` ran."""
+    cause = exc.args[-1] if exc.args else type(exc).__name__
+    return OutOfRangeError(f"{command}: a number left the range of floats (magnitudes up to "
+                           f"{sys.float_info.max:.3g}; {cause}); impacts do not depend on "
+                           "the units (docs/theory.md §8): give the input in units that "
+                           "keep its numbers and their squares finite")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the ``impactqp`` command; return its exit status.
 
@@ -82,7 +91,11 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:  # unwritable --out, vanished files
         where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
         return _fail(f"cannot access{where}: {exc.strerror or exc}")
-    except (MemoryError, RecursionError, OverflowError, ValueError) as exc:
+    except OverflowError as exc:
+        if os.environ.get("IMPACTQP_DEBUG"):
+            raise
+        return _fail(str(out_of_range(args.command, exc)))
+    except (MemoryError, RecursionError, ValueError) as exc:
         if os.environ.get("IMPACTQP_DEBUG"):
             raise
         return _fail(f"{type(exc).__name__}: {exc}")

@@ -13,13 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from ..base.figure import DPI, figure_format
-from ..errors import InputError, OptionalDependencyError
+from ..base.figure import figure_format, new_figure, save_figure
+from ..errors import InputError
 from ..verification.compare import LawComparison
-
-NO_DATES = {"png": {"Software": None}, "svg": {"Date": None},
-            "pdf": {"CreationDate": None, "ModDate": None}}
-"""Metadata that would make the output differ from run to run."""
 
 STYLES = {"Moreau ε = 0": ("tab:blue", "s", "--"), "Moreau ε = 1": ("tab:orange", "D", "--"),
           "sector law": ("tab:green", "^", ":"), "LZB": ("crimson", "o", "-")}
@@ -72,7 +68,7 @@ def plot_comparison(comparisons: Sequence[LawComparison], path: str | Path,
     OptionalDependencyError
         matplotlib is not installed.
     """
-    fmt = figure_format(path)
+    figure_format(path)
     comparisons = list(comparisons)
     if not comparisons or not all(isinstance(c, LawComparison) for c in comparisons):
         raise InputError("comparisons must be a non-empty sequence of LawComparison")
@@ -80,14 +76,8 @@ def plot_comparison(comparisons: Sequence[LawComparison], path: str | Path,
     if len(titles) != len(comparisons):
         raise InputError(f"titles must have one entry per comparison ({len(comparisons)}), "
                          f"got {len(titles)}")
-    try:
-        from matplotlib.figure import Figure
-    except ImportError:
-        raise OptionalDependencyError("figures need matplotlib: pip install 'impactqp[plot]'") \
-            from None
-    fig = Figure(figsize=(6.4 * len(comparisons), 5.2), dpi=DPI, layout="constrained")
+    fig = new_figure(6.4 * len(comparisons), 5.2)
     axes = fig.subplots(1, len(comparisons), squeeze=False)[0]
     for comparison, ax, title in zip(comparisons, axes, titles):
         draw_comparison(comparison, ax, title)
-    fig.savefig(path, format=fmt, metadata=NO_DATES[fmt])
-    return Path(path)
+    return save_figure(fig, path)

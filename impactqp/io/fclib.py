@@ -20,8 +20,13 @@ equality multipliers) are refused, as are rolling-friction files.
 Reading is strict: a path that is not a regular file, a file that is not HDF5, missing or
 mis-typed datasets, sizes that do not fit together, indices out of range, non-finite numbers,
 negative μ and a singular M are refused with a :class:`~impactqp.errors.ProblemFileError`
-that names the file and the dataset. Dimensions above :data:`MAX_FCLIB_DIM` are refused before
-anything is allocated.
+that names the file and the dataset. A file is read alone: external links (which open other
+files, a FIFO among them, where reading would wait forever), soft links, external raw storage
+(a dataset whose bytes live in another file, /dev/zero reads as zeros) and virtual datasets
+are refused by name, before anything they point at is opened (:mod:`.hdf5_reader`).
+Dimensions above :data:`MAX_FCLIB_DIM` and datasets declaring more than
+:data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES` are refused before anything is allocated
+or decompressed, and only the entries the problem needs are read.
 """
 
 from __future__ import annotations
@@ -34,9 +39,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..base.outputs import output_file
-from ..errors import InputError, OptionalDependencyError, ProblemFileError
+from ..base.outputs import atomic_output
+from ..errors import InputError, ProblemFileError
 from ..model.friction import FrictionContactProblem
+from .hdf5_reader import CheckedReader, h5py_module
 
 MAX_FCLIB_DIM = 1_000_000
 """Largest row or column count of a matrix in an FCLib file (degrees of freedom, d·contacts)."""
@@ -52,67 +58,8 @@ Y = M⁻¹H; above it M is taken as singular (the reduced W would not be Hᵀ M�
 MIXED_PARTS = {"fclib_local": ("V", "R", "vectors/s"), "fclib_global": ("G", "vectors/b")}
 
 
-def _h5py() -> Any:
-    try:
-        import h5py
-    except ImportError:
-        raise OptionalDependencyError("FCLib files need h5py: pip install h5py") from None
-    return h5py
-
-
-class _Reader:
-    """Datasets of one open FCLib file, each checked and named in every error."""
-
-    def __init__(self, path: Path, handle: Any) -> None:
-        self.path = path
-        self.handle = handle
-
-    def error(self, name: str, what: str) -> ProblemFileError:
-        return ProblemFileError(f"{self.path}: /{name}: {what}")
-
-    def dataset(self, name: str) -> np.ndarray:
-        obj = self.handle.get(name)
-        if obj is None:
-            raise self.error(name, "missing (an FCLib file needs it)")
-        if not hasattr(obj, "dtype"):
-            raise self.error(name, "is a group, expected a dataset")
-        try:
-            return np.asarray(obj[()])
-        except (OSError, TypeError, ValueError) as exc:
-            raise self.error(name, f"cannot be read ({exc})") from None
-
-    def integer(self, name: str) -> int:
-        data = self.dataset(name)
-        if data.dtype.kind not in "iu" or data.size != 1 or data.ndim > 1:
-            raise self.error(name, f"must hold one integer, got dtype {data.dtype} and shape "
-                                   f"{data.shape}")
-        return int(data.reshape(-1)[0])
-
-    def indices(self, name: str, length: int, bound: int) -> np.ndarray:
-        data = self.dataset(name)
-        if data.dtype.kind not in "iu" or data.ndim != 1:
-            raise self.error(name, f"must be a vector of integers, got dtype {data.dtype} and "
-                                   f"shape {data.shape}")
-        if data.size < length:
-            raise self.error(name, f"has {data.size} entries, needs at least {length}")
-        data = data[:length].astype(np.int64)
-        if length and (data.min() < 0 or data.max() >= bound):
-            raise self.error(name, f"indices must lie in [0, {bound}), found "
-                                   f"{data.min()}..{data.max()}")
-        return data
-
-    def floats(self, name: str, length: int, *, exact: bool = True) -> np.ndarray:
-        data = self.dataset(name)
-        if data.dtype.kind not in "fiu" or data.ndim != 1:
-            raise self.error(name, f"must be a vector of numbers, got dtype {data.dtype} and "
-                                   f"shape {data.shape}")
-        if data.size < length or (exact and data.size != length):
-            raise self.error(name, f"has {data.size} entries, expected {length}")
-        data = data[:length].astype(float)
-        if not np.all(np.isfinite(data)):
-            raise self.error(name, f"holds {int(np.sum(~np.isfinite(data)))} non-finite "
-                                   "number(s) (NaN or infinity)")
-        return data
+class _Reader(CheckedReader):
+    """The CSparse matrices, ``spacedim`` and μ of an FCLib file, each checked."""
 
     def matrix(self, name: str) -> sp.csc_matrix:
         """The sparse matrix stored in group ``name`` (CSparse layout, see the module doc)."""
@@ -218,12 +165,11 @@ def _global(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int
 
 
 def _read(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]:
-    handle = reader.handle
-    root = next((r for r in ("fclib_local", "fclib_global") if r in handle), None)
+    root = next((r for r in ("fclib_local", "fclib_global") if reader.contains(r)), None)
     if root is None:
         raise ProblemFileError(f"{reader.path}: neither /fclib_local nor /fclib_global; not an "
                                "FCLib problem file")
-    mixed = [part for part in MIXED_PARTS[root] if f"{root}/{part}" in handle]
+    mixed = [part for part in MIXED_PARTS[root] if reader.contains(f"{root}/{part}")]
     if mixed:
         raise reader.error(f"{root}/{mixed[0]}", "mixed problems (extra equality multipliers) "
                                                  "are not supported")
@@ -254,12 +200,15 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
     ProblemFileError
         Not a regular file, not HDF5, neither problem group, a mixed problem (``V``/``R`` or
         ``G``/``b``), a missing or malformed dataset, non-finite numbers, negative μ or a
-        singular M; the message names the file and the dataset.
+        singular M; a link that is not a hard one (an external link reaches into another
+        file), a dataset stored outside the file (external raw storage, a virtual dataset),
+        one declaring more than :data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES`, or a
+        problem that does not fit in memory. The message names the file and the dataset.
     """
     if not isinstance(path, (str, Path)):
         raise ProblemFileError(f"path must be a str or Path, got {type(path).__name__}")
     path = Path(path)
-    h5py = _h5py()
+    h5py = h5py_module()
     try:
         if not stat.S_ISREG(path.stat().st_mode):
             raise ProblemFileError(f"{path}: not a regular file")
@@ -268,15 +217,20 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
         handle = h5py.File(path, "r")
     except OSError as exc:
         raise ProblemFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    with handle:
-        try:
-            W, q, mu, d = _read(_Reader(path, handle))
-        except ProblemFileError:
-            raise
-        except (OSError, RuntimeError, KeyError, ValueError) as exc:  # h5py on a damaged file
-            raise ProblemFileError(f"{path}: damaged HDF5 file ({exc})") from None
     try:
+        with handle:
+            try:
+                W, q, mu, d = _read(_Reader(path, handle))
+            except ProblemFileError:
+                raise
+            except (OSError, RuntimeError, KeyError, ValueError) as exc:  # h5py, damaged file
+                raise ProblemFileError(f"{path}: damaged HDF5 file ({exc})") from None
         return FrictionContactProblem(W, q, mu, contact_dim=d)
+    except MemoryError:
+        raise ProblemFileError(f"{path}: the problem does not fit in this machine's memory")\
+            from None
+    except ProblemFileError:
+        raise
     except InputError as exc:
         raise ProblemFileError(f"{path}: {exc}") from exc
 
@@ -288,8 +242,10 @@ def _write_int(group: Any, name: str, value: int) -> None:
 def save_fclib(problem: FrictionContactProblem, path: str | Path) -> Path:
     """Write a local frictional contact problem as an FCLib HDF5 file (``/fclib_local``).
 
-    W is stored in compressed columns (``nz = -1``), as FCLib and Siconos read it; the file
-    is replaced if it exists. :func:`load_fclib` reads back W, q and μ bit for bit.
+    W is stored in compressed columns (``nz = -1``), as FCLib and Siconos read it. The file
+    is written beside ``path`` and renamed onto it when complete, so an existing file is
+    replaced whole or, when writing fails, left as it was. :func:`load_fclib` reads back W,
+    q and μ bit for bit.
 
     Parameters
     ----------
@@ -320,10 +276,10 @@ def save_fclib(problem: FrictionContactProblem, path: str | Path) -> Path:
         if not np.all(np.isfinite(values)):
             raise InputError(f"problem.{name} holds non-finite numbers; FCLib files hold "
                              "finite ones")
-    path = output_file(path)
-    h5py = _h5py()
+    path = Path(path)
+    h5py = h5py_module()
     try:
-        with h5py.File(path, "w") as handle:
+        with atomic_output(path) as temp, h5py.File(temp, "w") as handle:
             root = handle.create_group("fclib_local")
             _write_int(root, "spacedim", problem.contact_dim)
             group = root.create_group("W")

@@ -15,7 +15,7 @@ import numpy as np
 import tomli_w
 
 from ..base.arrays import as_dense
-from ..base.outputs import output_file
+from ..base.outputs import atomic_output, output_file
 from ..errors import InputError
 from ..model.problem import ImpactProblem
 from .file_laws import COEFFICIENT_KEYS
@@ -115,5 +115,6 @@ def save_problem(problem: ImpactProblem, path: str | Path, *, law: str | None = 
     fmt = file_format(path)
     data = problem_to_dict(problem, law=law, coefficients=coefficients, u_plus=u_plus)
     text = to_json(data) if fmt == "json" else to_toml(data)
-    path.write_text(text, encoding="utf-8")
+    with atomic_output(path) as temp:
+        temp.write_text(text, encoding="utf-8")
     return path

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..base.arrays import as_count, as_real
 from ..base.figure import DPI, figure_format, new_figure, save_figure
-from ..base.outputs import output_file
+from ..base.outputs import atomic_output
 from ..errors import InputError, OptionalDependencyError
 
 KINDS = ("positions", "energy")
@@ -173,5 +173,6 @@ def animate(trajectory: Any, path: str | Path | None = None, *, length: float = 
     movie = FuncAnimation(fig, draw, frames=frames, interval=1000.0 / fps, blit=False)
     if path is not None:
         writer = PillowWriter(fps=fps) if suffix == ".gif" else FFMpegWriter(fps=fps)
-        movie.save(str(output_file(path)), writer=writer, dpi=DPI)
+        with atomic_output(path) as temp:
+            movie.save(str(temp), writer=writer, dpi=DPI)
     return movie

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ..base.outputs import output_file
+from ..base.outputs import atomic_output, output_file
 from ..errors import InputError
 from ..laws.base import ImpactLaw
 from .friction_step import FrictionEvent
@@ -203,10 +203,11 @@ class Trajectory:
         if suffix == ".npz":
             meta = json.dumps({"scheme": self.scheme, "law": repr(self.law),
                                "settings": self.settings})
-            np.savez_compressed(path, t=self.t, q=self.q, v=self.v, impulses=self.impulses,
-                                kinetic_energy=self.kinetic_energy,
-                                potential_energy=self.potential_energy,
-                                meta=np.array(meta), **self.event_arrays())
+            with atomic_output(path) as temp:
+                np.savez_compressed(temp, t=self.t, q=self.q, v=self.v, impulses=self.impulses,
+                                    kinetic_energy=self.kinetic_energy,
+                                    potential_energy=self.potential_energy,
+                                    meta=np.array(meta), **self.event_arrays())
             return path
         n, m, d = self.system.n_dof, self.system.n_contacts, self.system.contact_dim
         impulses = [f"lambda{j}" for j in range(m)] if d == 1 else \
@@ -215,8 +216,9 @@ class Trajectory:
                   + impulses + ["kinetic_energy", "potential_energy"])
         table = np.column_stack([self.t, self.q, self.v, self.impulses, self.kinetic_energy,
                                  self.potential_energy])
-        np.savetxt(path, table, fmt="%.17g", delimiter=",", header=",".join(header),
-                   comments="", encoding="utf-8")
+        with atomic_output(path) as temp:
+            np.savetxt(temp, table, fmt="%.17g", delimiter=",", header=",".join(header),
+                       comments="", encoding="utf-8")
         self._save_events_csv(path.with_name(path.stem + ".events.csv"))
         return path
 
@@ -225,7 +227,7 @@ class Trajectory:
             return " ".join(repr(float(x)) if values.dtype.kind == "f" else str(x)
                             for x in values)
 
-        with path.open("w", newline="", encoding="utf-8") as handle:
+        with atomic_output(path) as temp, temp.open("w", newline="", encoding="utf-8") as handle:
             writer = csv.writer(handle)
             writer.writerow(["time", "kind", "law", "certified", "worst_residual",
                              "admissible", "dofs", "contacts", "u_minus", "u_plus",
