@@ -164,7 +164,7 @@ def check_friction(problem: ImpactProblem, law: ImpactLaw) -> None:
                          "columns")
 
 
-def route(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str = "auto") -> str:
+def _path(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str = "auto") -> str:
     """Where the answer of ``law`` on ``problem`` starts (one of :data:`ROUTES`)."""
     if small.applies(problem, law, backend, form):
         return "compiled"
@@ -198,15 +198,15 @@ def plan(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", form: st
     if mode == "single":
         scale = problem.peak_minus
         if law.homogeneous and scale > 0 and not UNIT_RANGE[0] <= scale <= UNIT_RANGE[1]:
-            return Route(mode, route(problem, law, backend, form), scale=scale)
+            return Route(mode, _path(problem, law, backend, form), scale=scale)
         groups = parallel.collapsible(problem, law)
         if groups is not None:
-            return Route(mode, route(problem, law, backend, form), groups=groups)
-        return _SINGLE[route(problem, law, backend, form)]
+            return Route(mode, _path(problem, law, backend, form), groups=groups)
+        return _SINGLE[_path(problem, law, backend, form)]
     if mode == "batch":
         if backend in ("auto", "isotonic") and chain_rows.suits(problem, law):
             return Route(mode, "chain")
-        return Route(mode, route(problem, law, backend, form))
+        return Route(mode, _path(problem, law, backend, form))
     if mode != "run" or stepping is None:
         raise InputError(f"mode must be one of {MODES} (with stepping for a run), got {mode!r}")
     return Route(mode, _loop(problem, law, backend, stepping))
