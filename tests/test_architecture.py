@@ -193,3 +193,73 @@ def test_readme_table_is_the_registry() -> None:
     assert rows == ["auto"] + BACKENDS
     assert [law.name for law in LAWS] == ["moreau", "newton", "fremond", "sector", "reflection",
                                           "lzb"]
+
+
+def built_in_law_names() -> set[str]:
+    """Names of the package's impact law classes (every subclass of ImpactLaw it defines)."""
+    found, todo = set(), [iq.ImpactLaw]
+    while todo:
+        cls = todo.pop()
+        for sub in cls.__subclasses__():
+            if sub.__module__.startswith("impactqp."):
+                found.add(sub.__name__)
+            todo.append(sub)
+    return found
+
+
+def law_class_checks(source: str, names: set[str]) -> list[int]:
+    """Lines of ``source`` that recognise a law by its class: isinstance/issubclass against
+    a law class, ``type(x)`` compared with one (``is``, ``==``) or looked up in anything
+    (``in``), or a tuple of law classes."""
+
+    def mentions(node: ast.AST) -> bool:
+        return any(isinstance(n, ast.Name) and n.id in names
+                   or isinstance(n, ast.Attribute) and n.attr in names for n in ast.walk(node))
+
+    def is_type_of(node: ast.AST) -> bool:
+        return (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                and node.func.id == "type") or (isinstance(node, ast.Attribute)
+                                                 and node.attr == "__class__")
+
+    lines = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
+                and node.func.id in ("isinstance", "issubclass") and len(node.args) == 2 \
+                and mentions(node.args[1]):
+            lines.append(node.lineno)
+        elif isinstance(node, ast.Compare) and is_type_of(node.left) and (
+                any(isinstance(op, (ast.In, ast.NotIn)) for op in node.ops)
+                or any(mentions(c) for c in node.comparators)):
+            lines.append(node.lineno)
+        elif isinstance(node, ast.Tuple) and sum(isinstance(e, ast.Name) and e.id in names
+                                                 for e in node.elts) >= 2:
+            lines.append(node.lineno)
+    return lines
+
+
+def test_the_scan_for_law_classes_sees_them() -> None:
+    names = built_in_law_names()
+    assert {"Moreau", "Newton", "Fremond", "SectorLaw", "ReflectionLaw", "LZB",
+            "Coulomb", "MoreauJeanStep"} <= names
+    bad = ("if isinstance(law, Coulomb): pass\nok = type(law) is Moreau\n"
+           "fast = type(law) in FAST\nFAST = (Moreau, Newton)\nx = isinstance(law, ImpactLaw)\n"
+           "y = type(value) is not float\nz = law.family is not None\n")
+    assert law_class_checks(bad, names) == [1, 2, 3, 4]
+
+
+def test_no_law_is_recognised_by_its_class() -> None:
+    # what a law can do is declared on it (family, frictional, restitution_per_contact,
+    # compliant) and read by every fast path: outside the laws, no module asks for a class,
+    # and neither do the laws' own fast paths and planner
+    names = built_in_law_names()
+    fast_paths = {"laws/small.py", "laws/batch.py", "laws/chain_rows.py", "laws/parallel.py",
+                  "laws/planner.py", "laws/pipeline.py"}
+    found = {}
+    for path in PACKAGE.rglob("*.py"):
+        rel = path.relative_to(PACKAGE).as_posix()
+        if rel.startswith("laws/") and rel not in fast_paths:
+            continue
+        lines = law_class_checks(path.read_text(encoding="utf-8"), names)
+        if lines:
+            found[rel] = lines
+    assert found == {}

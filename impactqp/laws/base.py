@@ -25,6 +25,25 @@ from ..model.structure import ImpactStructure
 from ..qp.program import QPSolution, QuadraticProgram
 from .certificate import Certificate
 
+MOREAU_FAMILY = "moreau"
+"""Moreau's family (docs/theory.md §3): ``0 ≤ Λ ⟂ GΛ + (1 + ε)γ⁻ ≥ 0``, u⁺ = (1 + ε)z − εu⁻
+with z = prox_{T_C}(u⁻) in the metric M."""
+
+COMPLEMENTARITY_FAMILY = "complementarity"
+"""The complementarity family (docs/theory.md §3): ``0 ≤ Λ ⟂ GΛ + (I + E)γ⁻ ≥ 0``."""
+
+FAMILIES = (MOREAU_FAMILY, COMPLEMENTARITY_FAMILY)
+"""The compiled families a law may declare as its :attr:`ImpactLaw.family`."""
+
+FAMILY_METHODS = {MOREAU_FAMILY: ("restitution", "projection"),
+                  COMPLEMENTARITY_FAMILY: ("restitution",)}
+"""The methods a law of each family defines besides :class:`ImpactLaw`'s (a law of Moreau's
+family also has the attribute ``eps``, its ε ∈ [0, 1])."""
+
+_DECLARED_PER_CLASS = ("family", "restitution_per_contact", "compliant")
+"""Capabilities a subclass does not inherit: a subclass may change the law (its program,
+its residuals), so it is of a fast family only when it says so itself."""
+
 
 class Answer(NamedTuple):
     """A law's answer: post-impact velocity, impulses and (Moreau's family) the projection z.
@@ -87,7 +106,36 @@ class ImpactLaw(ABC):
     frictional : bool
         The law acts on frictional contacts (``problem.contact_dim`` 2 or 3, docs/theory.md
         §16), like :class:`~impactqp.Coulomb`; every other law is refused such a problem
-        by the entry points (its ``normal_problem()`` is the frictionless one).
+        by the entry points (its ``normal_problem()`` is the frictionless one). Simulations
+        of a frictional law run the frictional Moreau–Jean step (docs/theory.md §17), which
+        reads the law's ``mu``, ``restitution`` (per contact or one number) and ``method``.
+    family : str or None
+        The compiled family of complementarity laws the law belongs to, whose fast paths
+        take it (docs/theory.md §9): the compiled single impact, its rows in batches, the
+        compiled Moreau–Jean loop and the collapse of parallel contacts.
+        ``"complementarity"`` (:data:`COMPLEMENTARITY_FAMILY`): the law is
+        ``0 ≤ Λ ⟂ GΛ + (I + E)γ⁻ ≥ 0`` with E = ``restitution(m)`` (an (m,) diagonal or an
+        (m, m) matrix), has the step form E = :meth:`step_restitution` and, with
+        per-contact coefficients, :meth:`restrict`. ``"moreau"`` (:data:`MOREAU_FAMILY`):
+        the same with E = εI from the law's ``eps``, and the projection
+        z = ``projection(problem, u⁺)``; short chains also take the column-wise isotonic
+        path. The fast paths compute and certify the family's answer with the family's
+        residuals (docs/theory.md §8), not the law's :meth:`program` and :meth:`residuals`:
+        a law declares a family only when it *is* that law, and it keeps its programs for
+        the impacts the fast paths decline. None (the default): the law's own programs or
+        closed form answer. Declared per class: a subclass of a built-in law that does not
+        declare it takes the general path; a class that declares a family without its
+        methods (:data:`FAMILY_METHODS`) is refused when it is defined.
+    restitution_per_contact : bool
+        E is diagonal (one coefficient per contact, or one ε for all): contacts whose columns
+        of W are parallel, with equal coefficients, act as one and an impact with more
+        contacts than degrees of freedom is solved collapsed (docs/theory.md §1). Read with
+        :attr:`family`, whose ``restitution(m)`` gives the coefficients. Declared per class.
+    compliant : bool
+        The outcome depends on the contacts' compliance (stiffnesses, exponents), as for the
+        LZB model (docs/theory.md §13), and not on the rigid geometry alone:
+        :func:`~impactqp.verification.compare.compare_laws` sets such a law against the
+        rigid ones. Declared per class.
     """
 
     name: ClassVar[str]
@@ -102,6 +150,17 @@ class ImpactLaw(ABC):
             cls.title = cls.__name__
         if "coefficient_key" in cls.__dict__ and "coefficient_keys" not in cls.__dict__:
             cls.coefficient_keys = (cls.coefficient_key,) if cls.coefficient_key else ()
+        for capability in _DECLARED_PER_CLASS:
+            if capability not in cls.__dict__:
+                setattr(cls, capability, getattr(ImpactLaw, capability))
+        if cls.family is not None:
+            if cls.family not in FAMILIES:
+                raise InputError(f"{cls.__name__}.family must be None or one of {FAMILIES}, "
+                                 f"got {cls.family!r}")
+            missing = [name for name in FAMILY_METHODS[cls.family] if not hasattr(cls, name)]
+            if missing:
+                raise InputError(f"{cls.__name__} declares family {cls.family!r} but has no "
+                                 f"{', '.join(missing)}")
     forms: ClassVar[tuple[str, ...]] = ()
     closed_form_backend: ClassVar[str] = "closed form"
     always_solvable: ClassVar[bool] = False
@@ -112,6 +171,9 @@ class ImpactLaw(ABC):
     needs_coefficients: ClassVar[bool] = False
     homogeneous: ClassVar[bool] = False
     frictional: ClassVar[bool] = False
+    family: ClassVar[str | None] = None
+    restitution_per_contact: ClassVar[bool] = False
+    compliant: ClassVar[bool] = False
 
     @classmethod
     def from_coefficients(cls, coefficients: Any = None) -> ImpactLaw:

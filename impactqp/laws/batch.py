@@ -1,9 +1,10 @@
 """Many impacts of one problem structure at once (k pre-impact velocities, rows of a matrix),
 through the same law objects as single impacts.
 
-The route is the one :func:`impactqp.solve` takes (:mod:`impactqp.laws.planner`): dense
-impacts of the complementarity laws run the compiled impact row by row, certificate
-included; Moreau's law on a short chain runs column by column; closed-form laws run on all
+The route comes from the planner that :func:`impactqp.solve` asks too
+(:func:`impactqp.laws.planner.plan`, mode ``"batch"``): dense impacts of the laws of a
+compiled family run the compiled impact row by row, certificate included; Moreau's family
+on a short chain runs column by column; closed-form laws run on all
 rows at once; other program laws run on a fast-path backend that solves many linear terms
 at once (isotonic regression for chains, the active-set search); rows they cannot settle,
 and every row of other structures, go through :func:`impactqp.solve`. Every row's
@@ -28,11 +29,11 @@ from ..model.problem import ImpactProblem
 from ..qp import backends
 from ..qp.certified import FAST_PATHS
 from . import small
-from .base import ImpactLaw
-from .chain_rows import ChainRows, suits
+from .base import MOREAU_FAMILY, ImpactLaw
+from .chain_rows import ChainRows
 from .moreau import Moreau
 from .pipeline import solve
-from .planner import check_problem, route, validate
+from .planner import check_problem, plan, validate
 from .sector import SectorLaw
 
 
@@ -170,7 +171,7 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
     if fast == "chain":
         rows = ChainRows(st, law.eps)
     elif fast == "compiled":
-        moreau = type(law) is Moreau
+        moreau = law.family == MOREAU_FAMILY
         compiled = (st.kernel_pack, small.restitution_for(law, st.m),
                     law.eps if moreau else 0.0, moreau)
     elif fast is not None:
@@ -255,8 +256,8 @@ def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: s
     n_jobs = as_count("n_jobs", n_jobs, minimum=1)
     st = problem.structure
     k = U.shape[0]
-    way = route(problem, law, backend)
-    if backend in ("auto", "isotonic") and suits(problem, law):
+    way = plan(problem, law, backend, mode="batch").path
+    if way == "chain":
         fast, used = "chain", "isotonic"
     elif way == "compiled":
         fast, used = "compiled", "kernel"

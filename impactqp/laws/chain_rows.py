@@ -22,17 +22,17 @@ import numpy as np
 from ..kernels.residuals import chain_residual_rows
 from ..model.problem import ImpactProblem
 from ..model.structure import ImpactStructure
-from .base import ImpactLaw
-from .moreau import Moreau
+from .base import MOREAU_FAMILY, ImpactLaw
 
 MAX_BALLS = 6
 """Longest chain served: the min–max formula takes about N³/6 comparisons per row."""
 
 
 def suits(problem: ImpactProblem, law: ImpactLaw) -> bool:
-    """Whether :class:`ChainRows` serves ``law`` on ``problem``: Moreau's law on a chain of
-    at most :data:`MAX_BALLS` balls with at least one contact."""
-    return (type(law) is Moreau and problem.chain is not None
+    """Whether :class:`ChainRows` serves ``law`` on ``problem``: a law of Moreau's family
+    (``law.family``, its ``eps``) on a chain of at most :data:`MAX_BALLS` balls with at least
+    one contact."""
+    return (law.family == MOREAU_FAMILY and problem.chain is not None
             and 0 < problem.n_contacts and problem.n_dof <= MAX_BALLS)
 
 

@@ -18,7 +18,7 @@ from ..model.problem import ImpactProblem
 from ..model.programs import impulse_program
 from ..model.structure import ImpactStructure
 from ..qp.program import QPSolution, QuadraticProgram
-from .base import Answer, ImpactLaw
+from .base import COMPLEMENTARITY_FAMILY, Answer, ImpactLaw
 from .certificate import law_residuals
 
 
@@ -94,6 +94,8 @@ class Newton(_ComplementarityLaw):
     coefficient_key = "e"
     coefficient_symbol = "e"
     needs_coefficients = True
+    family = COMPLEMENTARITY_FAMILY
+    restitution_per_contact = True
 
     def __init__(self, e: Any = 1.0) -> None:
         arr = as_array("e", e, allow_nonfinite=True)
@@ -145,6 +147,7 @@ class Fremond(_ComplementarityLaw):
     coefficient_key = "E"
     coefficient_symbol = "E"
     needs_coefficients = True
+    family = COMPLEMENTARITY_FAMILY
 
     def __init__(self, E: Any) -> None:
         arr = as_array("E", E)

@@ -17,7 +17,7 @@ from ..model.problem import ImpactProblem
 from ..model.programs import impulse_program, velocity_program
 from ..model.structure import ImpactStructure
 from ..qp.program import QPSolution, QuadraticProgram
-from .base import Answer, ImpactLaw
+from .base import MOREAU_FAMILY, Answer, ImpactLaw
 from .certificate import law_residuals
 
 
@@ -62,6 +62,8 @@ class Moreau(ImpactLaw):
     by_name = True
     coefficient_key = "eps"
     coefficient_symbol = "ε"
+    family = MOREAU_FAMILY
+    restitution_per_contact = True
 
     def __init__(self, eps: float = 0.0) -> None:
         self.eps = check_eps(eps)
@@ -78,8 +80,8 @@ class Moreau(ImpactLaw):
         return self.eps
 
     def restitution(self, m: int) -> np.ndarray:
-        """The law's E = εI for m contacts (docs/theory.md §3)."""
-        return np.eye(m) * self.eps
+        """The diagonal of the law's E = εI for m contacts, an (m,) array (docs/theory.md §3)."""
+        return np.full(m, self.eps)
 
     def program(self, problem: ImpactProblem, form: str) -> QuadraticProgram:
         if form == "velocity":

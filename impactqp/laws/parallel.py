@@ -1,8 +1,9 @@
 """Duplicate and parallel contacts collapsed before an impact is solved (docs/theory.md §1).
 
 Contacts whose columns of W point the same way, wⱼ = cⱼ w_g with cⱼ > 0, constrain the
-same contact velocity γ_g = w_gᵀu and push along the same direction: for Moreau's law, and
-for local Newton when their coefficients agree, the impact equals the one with each group
+same contact velocity γ_g = w_gᵀu and push along the same direction: for a law of a
+compiled family with one coefficient per contact (``law.restitution_per_contact``: Moreau's
+law, local Newton) when their coefficients agree, the impact equals the one with each group
 replaced by its representative w_g. Its impulse Λ_g is split back as λⱼ = Λ_g / (k_g cⱼ)
 over the k_g members, so Σⱼ wⱼλⱼ = w_gΛ_g, every λⱼ ≥ 0, and each member's complementarity
 holds with γⱼ = cⱼγ_g. The answer is certified on the original problem.
@@ -23,9 +24,7 @@ import scipy.sparse as sp
 from ..base.arrays import as_dense
 from ..model.problem import ImpactProblem
 from ..model.structure import ImpactStructure
-from .base import Answer, ImpactLaw
-from .complementarity import Newton
-from .moreau import Moreau
+from .base import FAMILIES, MOREAU_FAMILY, Answer, ImpactLaw
 
 MAX_ENTRIES = 50_000_000
 """Largest n·m that is searched for parallel columns (the search forms the dense W)."""
@@ -84,17 +83,20 @@ def _find(structure: ImpactStructure) -> Groups | None:
 
 def collapsible(problem: ImpactProblem, law: ImpactLaw) -> Groups | None:
     """The groups to collapse ``problem`` by, when ``law`` acts alike on every member of each
-    group (Moreau's law; local Newton with one coefficient per group) and there are more
-    contacts than degrees of freedom (fewer are answered as they are); else None."""
-    if problem.n_impulses <= problem.n_dof or type(law) not in (Moreau, Newton):
+    group (a law of a compiled family with ``restitution_per_contact``, one coefficient per
+    group: Moreau's law, local Newton) and there are more contacts than degrees of freedom
+    (fewer are answered as they are); else None."""
+    if (problem.n_impulses <= problem.n_dof or law.family not in FAMILIES
+            or not law.restitution_per_contact):
         return None
     groups = parallel_groups(problem.structure)
     if groups is None:
         return None
-    if type(law) is Newton:
-        e = law.restitution(problem.n_contacts)
-        if np.any(e != e[groups.representative][groups.label]):
-            return None
+    if law.family == MOREAU_FAMILY:  # one ε for every contact
+        return groups
+    e = np.asarray(law.restitution(problem.n_contacts))
+    if e.ndim != 1 or np.any(e != e[groups.representative][groups.label]):
+        return None
     return groups
 
 

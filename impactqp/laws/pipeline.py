@@ -14,7 +14,7 @@ from functools import partial
 
 import numpy as np
 
-from ..base.checks import DEFAULT_TOL, UNIT_RANGE
+from ..base.checks import DEFAULT_TOL
 from ..base.log import verbosity
 from ..errors import (
     BackendUnsuitableError,
@@ -28,7 +28,7 @@ from ..qp.certified import solve_in_forms
 from ..qp.program import QPSolution
 from . import parallel, small
 from .base import Answer, ImpactLaw
-from .planner import route, validate
+from .planner import plan, validate
 from .result import ImpactResult
 
 LOG = logging.getLogger(__name__)
@@ -107,13 +107,12 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
     tol = validate(problem, law, backend, form, tol)
     if options is not None:
         options = backends.check_options(backend, options)
-    scale = problem.peak_minus
-    if law.homogeneous and scale > 0 and not UNIT_RANGE[0] <= scale <= UNIT_RANGE[1]:
-        return _rescaled(problem, law, scale, backend, form, tol, options, start)
-    groups = parallel.collapsible(problem, law)
-    if groups is not None:
-        return _collapsed(problem, law, groups, backend, form, tol, start, options)
-    way = route(problem, law, backend, form)
+    planned = plan(problem, law, backend, form)  # units, collapse and path, in one Route
+    if planned.scale != 1.0:
+        return _rescaled(problem, law, planned.scale, backend, form, tol, options, start)
+    if planned.groups is not None:
+        return _collapsed(problem, law, planned.groups, backend, form, tol, start, options)
+    way = planned.path
     if way == "compiled":
         result = small.solve_small(problem, law, tol, start)
         if result is not None:

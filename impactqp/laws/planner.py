@@ -1,12 +1,17 @@
-"""Which route answers an impact: the one decision :func:`impactqp.solve` and
-:func:`impactqp.solve_batch` share (docs/theory.md §9).
+"""Which route answers: the one decision :func:`impactqp.solve`, :func:`impactqp.solve_batch`
+and :func:`impactqp.simulate` share (docs/theory.md §9).
 
-Both entry points validate their input with :func:`validate` and ask :func:`route` how the
-law is evaluated on the problem:
+The entry points validate their input with :func:`validate` and ask :func:`plan` for a
+:class:`Route`: the units an impact is solved in, the collapse of its parallel contacts,
+the path that answers, and how the rows of a batch or the steps of a Moreau–Jean run are
+taken. Every choice reads what the law declares (``law.family``, ``law.frictional``,
+``law.restitution_per_contact``, ``law.homogeneous``, ``law.forms``; docs/theory.md §9),
+never its class. The paths of one impact:
 
 ``"compiled"``
-    a dense impact of Moreau's, local Newton's or Frémond's law, solved and certified in one
-    compiled call (:mod:`impactqp.laws.small`; a batch runs it row by row);
+    a dense impact of a law of a compiled family (Moreau's, local Newton's, Frémond's law),
+    solved and certified in one compiled call (:mod:`impactqp.laws.small`; a batch runs it
+    row by row);
 ``"closed_form"``
     a law evaluated in closed form (the sector and reflection laws, LZB);
 ``"programs"``
@@ -18,18 +23,79 @@ only says where to start.
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 from ..base.arrays import check_tol
+from ..base.checks import UNIT_RANGE
 from ..errors import InputError
 from ..model.problem import ImpactProblem
 from ..qp import backends
 from ..qp.backends import FORMS
-from . import small
-from .base import ImpactLaw
+from . import chain_rows, parallel, small
+from .base import FAMILIES, ImpactLaw
 
 FORM_CHOICES = ("auto",) + FORMS
 ROUTES = ("compiled", "closed_form", "programs")
+"""The paths of one impact."""
+BATCH_PATHS = ("chain", "compiled", "closed_form", "programs")
+"""The paths of the rows of a batch: the chain's columns (:mod:`.chain_rows`), the compiled
+impact row by row, the closed form on all rows, the programs (a vectorised fast-path
+backend where one takes them, else row by row through :func:`impactqp.solve`)."""
+LOOPS = ("compiled", "python", "friction-compiled", "friction")
+"""The loops of a Moreau–Jean run (docs/theory.md §14, §17)."""
+MODES = ("single", "batch", "run")
+
+MAX_COMPILED_LOOP = 400
+"""Most degrees of freedom and most contact columns a compiled Moreau–Jean loop takes (it
+holds Ŵ⁻¹, Ŵ⁻¹H and HᵀŴ⁻¹H dense)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Route:
+    """How an answer is computed, decided once by :func:`plan` (docs/theory.md §9).
+
+    Attributes
+    ----------
+    mode : {"single", "batch", "run"}
+        One impact, the rows of a batch, or a Moreau–Jean run.
+    path : str
+        Where the answer starts: one of :data:`ROUTES` (one impact), :data:`BATCH_PATHS`
+        (a batch) or :data:`LOOPS` (a run).
+    scale : float
+        Units: the impact is solved with u⁻ divided by ``scale`` and the answer scaled back
+        (a homogeneous law whose velocities lie outside the range worked in as given,
+        docs/theory.md §8); 1.0 solves it as given.
+    groups : parallel.Groups or None
+        The groups of parallel contacts the impact is solved collapsed by
+        (:mod:`.parallel`, docs/theory.md §1); None solves it as it is.
+    """
+
+    mode: str
+    path: str
+    scale: float = 1.0
+    groups: parallel.Groups | None = None
+
+
+_SINGLE = {path: Route("single", path) for path in ROUTES}
+"""The routes of impacts solved in their units and uncollapsed, formed once (no allocation
+on the way of a small impact)."""
+
+
+class Stepping(NamedTuple):
+    """What a Moreau–Jean run adds to the planning of its impacts.
+
+    Attributes
+    ----------
+    force_compilable : bool
+        The force is constant or linear (a compiled loop evaluates it).
+    compiled : bool or None
+        The caller's choice of a compiled loop (True), the Python loop (False), or None for
+        the rule's.
+    """
+
+    force_compilable: bool
+    compiled: bool | None = None
 
 
 def check_problem(problem: Any) -> ImpactProblem:
@@ -98,8 +164,74 @@ def check_friction(problem: ImpactProblem, law: ImpactLaw) -> None:
                          "columns")
 
 
-def route(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str = "auto") -> str:
+def _path(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str = "auto") -> str:
     """Where the answer of ``law`` on ``problem`` starts (one of :data:`ROUTES`)."""
     if small.applies(problem, law, backend, form):
         return "compiled"
     return "programs" if law.forms else "closed_form"
+
+
+def plan(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", form: str = "auto",
+         *, mode: str = "single", stepping: Stepping | None = None) -> Route:
+    """The :class:`Route` of ``law`` on ``problem`` (validated by :func:`validate`).
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+        The impact (``"single"``), the structure of a batch's rows, or the system's
+        structure for a run (u⁻ unused then).
+    law : ImpactLaw
+    backend, form : str
+        As given to the entry point (for a frictional run: the method of its local problem).
+    mode : {"single", "batch", "run"}
+        One impact (units, collapse, path), the rows of a batch (their path; a row the path
+        leaves goes through :func:`impactqp.solve`, which plans its own route), or the loop
+        of a Moreau–Jean run.
+    stepping : Stepping, optional
+        Required with ``mode="run"``.
+
+    Raises
+    ------
+    InputError
+        ``stepping.compiled`` True for a run no compiled loop takes.
+    """
+    if mode == "single":
+        scale = problem.peak_minus
+        if law.homogeneous and scale > 0 and not UNIT_RANGE[0] <= scale <= UNIT_RANGE[1]:
+            return Route(mode, _path(problem, law, backend, form), scale=scale)
+        groups = parallel.collapsible(problem, law)
+        if groups is not None:
+            return Route(mode, _path(problem, law, backend, form), groups=groups)
+        return _SINGLE[_path(problem, law, backend, form)]
+    if mode == "batch":
+        if backend in ("auto", "isotonic") and chain_rows.suits(problem, law):
+            return Route(mode, "chain")
+        return Route(mode, _path(problem, law, backend, form))
+    if mode != "run" or stepping is None:
+        raise InputError(f"mode must be one of {MODES} (with stepping for a run), got {mode!r}")
+    return Route(mode, _loop(problem, law, backend, stepping))
+
+
+def loop_fits(problem: ImpactProblem, backend: str, stepping: Stepping) -> bool:
+    """Whether a compiled Moreau–Jean loop takes a run on ``problem``'s structure, whatever
+    the law: ``backend="auto"``, a constant or linear force and a dense system with at least
+    one contact column and at most :data:`MAX_COMPILED_LOOP` degrees of freedom and contact
+    columns."""
+    st = problem.structure
+    return (backend == "auto" and stepping.force_compilable and not st.sparse
+            and 0 < problem.n_impulses <= MAX_COMPILED_LOOP and st.n <= MAX_COMPILED_LOOP)
+
+
+def _loop(problem: ImpactProblem, law: ImpactLaw, backend: str, stepping: Stepping) -> str:
+    """The loop of a Moreau–Jean run: a compiled loop for a frictional law or a law of a
+    compiled family where :func:`loop_fits`, else the Python loop."""
+    fits = (law.frictional or law.family in FAMILIES) and loop_fits(problem, backend, stepping)
+    use = fits if stepping.compiled is None else stepping.compiled
+    if use and not fits:
+        what = "frictional loop" if law.frictional else "loop"
+        raise InputError(f"compiled=True: the compiled {what} does not take this run (a "
+                         "law, a callable force, a backend other than 'auto', a sparse or a "
+                         "larger system)")
+    if law.frictional:
+        return "friction-compiled" if use else "friction"
+    return "compiled" if use else "python"

@@ -1,6 +1,7 @@
 """Single dense impacts in compiled code: the pipeline's first fast path (docs/theory.md §8, §9).
 
-For a dense impact of Moreau's law, local Newton or Frémond's law, the whole solve — γ⁻, the
+For a dense impact of a law of a compiled family (``law.family``: Moreau's law, local Newton,
+Frémond's law, or a user's law that declares the family), the whole solve — γ⁻, the
 impulse-form LCP by the compiled active-set search, u⁺ and every residual of the law's
 certificate — runs in one call of :func:`impactqp.kernels.impact.solve_impact`, which says
 whether every residual is within the tolerance. An answer that misses it is not returned:
@@ -19,10 +20,8 @@ from ..kernels.impact import solve_impact
 from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
 from ..model.residuals import restitution_matrix
-from .base import ImpactLaw
+from .base import FAMILIES, MOREAU_FAMILY, ImpactLaw
 from .certificate import Certificate
-from .complementarity import Fremond, Newton
-from .moreau import Moreau
 from .result import ImpactResult
 
 MAX_CONTACTS = 400
@@ -35,10 +34,6 @@ SHORT_CHAIN = 10
 """Most contacts of a chain the compiled path takes; longer chains go to isotonic regression,
 exact in O(N) where the Delassus matrix of a chain grows ill-conditioned (docs/theory.md §5)."""
 
-_LAWS = (Moreau, Newton, Fremond)
-"""The laws the compiled path takes, by exact type (a subclass may change the law)."""
-
-
 _RESTITUTION: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 """The (m, m) restitution matrix of each law object, by m (laws are immutable)."""
 
@@ -48,7 +43,7 @@ _MOREAU_E = np.zeros((0, 0))
 
 def restitution_for(law: ImpactLaw, m: int) -> np.ndarray:
     """The law's E as the kernel takes it, formed once per law object and contact count."""
-    if type(law) is Moreau:
+    if law.family == MOREAU_FAMILY:
         return _MOREAU_E
     per_law = _RESTITUTION.setdefault(law, {})
     E = per_law.get(m)
@@ -63,7 +58,7 @@ def applies(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str) -> 
     return (backend in ("auto", "kernel") and form in ("auto", "impulse") and not st.sparse
             and 0 < st.m <= (MAX_CONTACTS if st.chain is None else SHORT_CHAIN)
             and st.n <= MAX_DOF
-            and type(law) in _LAWS)
+            and law.family in FAMILIES)
 
 
 def _certificate(names: tuple[str, ...], values: np.ndarray, tol: float) -> Certificate:
@@ -75,7 +70,7 @@ def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float,
                 start: float) -> ImpactResult | None:
     """The certified result by the compiled path, or None to go on to the general path."""
     st = problem.structure
-    moreau = type(law) is Moreau
+    moreau = law.family == MOREAU_FAMILY
     eps = law.eps if moreau else 0.0
     n, m = st.n, st.m
     out = np.empty(n + m + 6)

@@ -11,7 +11,6 @@ from ..base.arrays import as_count, as_flag, as_real, check_tol
 from ..base.checks import DEFAULT_TOL
 from ..errors import InputError, NonFiniteStateError
 from ..laws.base import ImpactLaw
-from ..laws.coulomb import Coulomb
 from ..laws.planner import check_backend, check_law
 from ..model.problem import ImpactProblem
 from .event_driven import event_driven
@@ -116,7 +115,7 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
     check_law(law)
     if scheme not in SCHEMES:
         raise InputError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
-    frictional = isinstance(law, Coulomb)
+    frictional = law.frictional
     if frictional or system.contact_dim > 1:
         if scheme != "moreau-jean":
             check_frictionless(system, law, scheme)

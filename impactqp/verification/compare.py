@@ -125,7 +125,8 @@ def compare_laws(problem: ImpactProblem, lzb: LZB, *, tol: float = DEFAULT_TOL
     problem : ImpactProblem
         Any impact; the sector law only answers on free chains of equal masses.
     lzb : LZB
-        The LZB law with the contacts' stiffnesses, exponents and restitutions.
+        The LZB law with the contacts' stiffnesses, exponents and restitutions, or another
+        compliant law (``law.compliant``, docs/theory.md §13).
     tol : float
         Certificate tolerance of every solve.
 
@@ -137,13 +138,13 @@ def compare_laws(problem: ImpactProblem, lzb: LZB, *, tol: float = DEFAULT_TOL
     Raises
     ------
     InputError
-        Not a problem, not an LZB law, or coefficients that do not fit the contacts.
+        Not a problem, not a compliant law, or coefficients that do not fit the contacts.
     CertificateError
         A law's answer fails its certificate.
     """
     check_problem(problem)
-    if not isinstance(check_law(lzb), LZB):
-        raise InputError(f"lzb must be an LZB law, got {lzb!r}")
+    if not check_law(lzb).compliant:
+        raise InputError(f"lzb must be a compliant law such as iq.LZB(stiffness), got {lzb!r}")
     laws = [("Moreau ε = 0", Moreau(0.0)), ("Moreau ε = 1", Moreau(1.0)),
             ("sector law", SectorLaw()), ("LZB", lzb)]
     return LawComparison(problem, tuple(_outcome(problem, label, law, tol)

@@ -17,7 +17,6 @@ from ...errors import InputError
 from ...io.file_laws import COEFFICIENT_KEYS, KNOWN_COEFFICIENTS, LAWS
 from ...io.files import ProblemFile, load_problem
 from ...laws.catalogue import NAMED_LAWS, law_named
-from ...laws.coulomb import Coulomb
 from ...laws.friction import FRICTION_BACKENDS
 from ...laws.pipeline import solve
 from ...laws.result import ImpactResult
@@ -74,11 +73,11 @@ def solve_law(problem: ImpactProblem, law: str, coefficients: Any,
               backend: str = "auto") -> ImpactResult:
     """Apply the law called ``law`` (docs/theory.md §3, §6, §10, §16) through
     :func:`impactqp.solve`, with exactly its checks (a closed-form law refuses a named
-    backend, as in Python); for Coulomb's law ``backend`` is the method of its local problem
-    (:data:`~impactqp.laws.friction.FRICTION_BACKENDS`)."""
+    backend, as in Python); for a frictional law (Coulomb's) ``backend`` is the method of its
+    local problem (:data:`~impactqp.laws.friction.FRICTION_BACKENDS`)."""
     impact_law = law_named(law, coefficients)
-    if isinstance(impact_law, Coulomb):
-        impact_law = Coulomb(impact_law.mu, impact_law.restitution, method=backend)
+    if impact_law.frictional:
+        impact_law = type(impact_law)(impact_law.mu, impact_law.restitution, method=backend)
         backend = "auto"
     return solve(problem, impact_law, backend)
 

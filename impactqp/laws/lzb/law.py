@@ -129,6 +129,7 @@ class LZB(ImpactLaw):
     title = "the LZB model"
     closed_form_backend = "lzb"
     always_solvable = True
+    compliant = True
 
     def __init__(self, stiffness: Any, exponent: Any = 1.5, restitution: Any = 1.0,
                  step: float | None = None, *, rtol: float = DEFAULT_RTOL,
