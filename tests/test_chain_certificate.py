@@ -55,6 +55,28 @@ def test_cold_chain_solve_forms_no_matrix(n, walls):
                                     sparse=True)).nnz == 0
 
 
+@pytest.mark.timeout(120)
+def test_a_failing_chain_certificate_fails_fast(monkeypatch):
+    # a defect in the O(N) chain pass (simulated: its momentum off by one) makes the exact
+    # isotonic answer fail its certificate; on 10⁵ balls the solve stops at once with a
+    # CertificateError naming the fast path, instead of minutes in general solvers
+    import impactqp.model.residuals as residuals
+    true_pass = residuals.chain_residuals
+
+    def broken(*args):
+        true_pass(*args)
+        args[-1][0] += 1.0
+
+    monkeypatch.setattr(residuals, "chain_residuals", broken)
+    n = 10**5
+    u = np.zeros(n)
+    u[0] = 1.0
+    p = iq.chain(np.ones(n), u)
+    with pytest.raises(iq.CertificateError, match="isotonic answer on 100000 unknowns") as err:
+        iq.moreau(p, 0.5)
+    assert "momentum" in str(err.value)
+
+
 @pytest.mark.parametrize("sparse", [False, True])
 def test_lazy_structure_serves_every_consumer(sparse):
     m, u = np.array([1.0, 2.0, 0.5, 3.0]), np.array([2.0, -1.0, 0.5, -2.0])

@@ -24,7 +24,7 @@ from ..errors import (
 )
 from ..model.problem import ImpactProblem
 from ..qp import backends
-from ..qp.certified import solve_in_forms
+from ..qp.certified import FAST_PATHS, solve_in_forms
 from ..qp.program import QPSolution
 from . import parallel, small
 from .base import Answer, ImpactLaw
@@ -32,6 +32,32 @@ from .planner import plan, validate
 from .result import ImpactResult
 
 LOG = logging.getLogger(__name__)
+
+FALLBACK_LIMIT = 10_000
+"""Most unknowns (n_dof) on which ``"auto"`` still tries general solvers after an exact fast
+path's answer failed its certificate. That answer is exact, so its failure means a defect (in
+the path or in the certificate), not a hard impact; above this size the general solvers take
+minutes on what they would then be asked, so the solve stops at once with the fast path's
+residuals."""
+
+
+class _ExactPathFailed(Exception):
+    """Leaves the fallback loop from a stage's finish; re-raised as CertificateError."""
+
+
+def _fail_fast(problem: ImpactProblem, law: ImpactLaw, solution: QPSolution, cert,
+               backend: str) -> None:
+    """Raise :class:`_ExactPathFailed` when an exact fast path's answer on more than
+    :data:`FALLBACK_LIMIT` unknowns fails its certificate under ``"auto"``."""
+    if cert.ok or backend != "auto" or problem.n_dof <= FALLBACK_LIMIT:
+        return
+    if solution.backend.split("+")[0] not in FAST_PATHS:
+        return
+    name, value = cert.worst
+    raise _ExactPathFailed(
+        f"{law.title}: the exact {solution.backend} answer on {problem.n_dof} unknowns failed "
+        f"its certificate ({name} = {value:.1e}, tol {cert.tol:.0e}); general solvers are "
+        f"not tried above {FALLBACK_LIMIT} unknowns after an exact path failed")
 
 
 def _result(problem: ImpactProblem, law: ImpactLaw, answer: Answer, backend: str, cert,
@@ -136,11 +162,15 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
     def stage(f: str):
         def finish(solution: QPSolution):
             answer = law.recover(problem, f, solution)
-            return answer, law.certificate(problem, answer, tol)
+            cert = law.certificate(problem, answer, tol)
+            _fail_fast(problem, law, solution, cert, backend)
+            return answer, cert
         return f, partial(law.program, problem, f), finish
 
     try:
         out = solve_in_forms([stage(f) for f in forms], backend, options)
+    except _ExactPathFailed as exc:
+        raise CertificateError(str(exc)) from None
     except NoSolutionError as exc:
         if law.always_solvable:  # a solution exists: failing to find it is the solvers'
             raise CertificateError(f"{law.title} has a solution for every u⁻, but no "

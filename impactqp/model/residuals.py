@@ -9,6 +9,8 @@ scale; u⁻ = 0 is measured against the answer's own size (any non-zero u⁺ the
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from ..base.rowwise import row_max, row_min, row_sum
@@ -73,6 +75,24 @@ more go through numpy products that apply a scalar or per-contact E without form
 _EMPTY = np.zeros((0, 0))
 
 
+_OPERANDS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def certificate_operand(structure: ImpactStructure) -> np.ndarray:
+    """M⁻¹W of a dense structure for the certificate's impact equation, solved here from the
+    given M and W by LU (LAPACK's gesv), once per structure.
+
+    The solvers recover u⁺ = u⁻ + M⁻¹WΛ from an impulse-form answer with the structure's own
+    M⁻¹W (from the Cholesky factor of M); measuring the impact equation with that same
+    operand would certify any error in it that Wᵀ does not see (docs/theory.md §8,
+    "Independence")."""
+    op = _OPERANDS.get(structure)
+    if op is None:
+        op = np.ascontiguousarray(np.linalg.solve(structure.dense_mass, structure.dense_Wt.T))
+        _OPERANDS[structure] = op
+    return op
+
+
 def _restitute(E: np.ndarray, gamma: np.ndarray) -> np.ndarray:
     """Eγ for every row of γ: εγ, eᵢγᵢ or the matrix product, without forming εI or diag(e)."""
     return E * gamma if E.ndim < 2 else gamma @ E.T
@@ -83,9 +103,10 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
     """Residuals of the certificate for one impact (1-D arrays) or k impacts (rows).
 
     The formulas are those of :mod:`impactqp.kernels.residuals` (docs/theory.md §8), fed by
-    the structure's operators: compiled dense products for dense M and W, numpy products
-    otherwise. Returns a dict with the keys of :attr:`Certificate.residuals`: floats for one
-    impact, (k,) arrays for k; ``energy_balance`` and ``duality_gap`` only with Moreau's
+    the structure's operators: compiled dense products for dense M and W (with M⁻¹W of
+    :func:`certificate_operand`, not the solvers' own), numpy products otherwise. Returns a
+    dict with the keys of :attr:`Certificate.residuals`: floats for one impact, (k,) arrays
+    for k; ``energy_balance`` and ``duality_gap`` only with Moreau's
     ``eps``, where u⁺ = z − εz⊥ and the energy balance is −2ε⟨z, z⊥⟩ (docs/theory.md §3).
     """
     st = structure
@@ -99,7 +120,7 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
     if not st.sparse and st.chain is None and st.m <= DENSE_CONTACTS:
         # the kernel forms εI itself for Moreau's law (an empty E), any other E as a matrix
         Em = _EMPTY if moreau else restitution_matrix(E, st.m)
-        table = dense_residual_rows(st.dense_mass, st.dense_Wt, st.dense_Minv_W,
+        table = dense_residual_rows(st.dense_mass, st.dense_Wt, certificate_operand(st),
                                     st.contact_scale, Um, Up, L, Em, e, moreau)
     else:
         with np.errstate(over="ignore", invalid="ignore"):
