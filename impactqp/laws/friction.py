@@ -23,7 +23,7 @@ from ..errors import CertificateError, InputError, OutOfRangeError, SolverError
 from ..kernels.friction import modified_velocity, nsgs_rows, project_cones
 from ..kernels.friction_newton import scales, solve_small
 from ..model.friction import (
-    QUANTITY_RANGE,
+    ContactUnits,
     FrictionCertificate,
     FrictionContactProblem,
     certify_friction,
@@ -145,9 +145,9 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     if backend not in FRICTION_BACKENDS:
         raise InputError(f"backend must be one of {', '.join(FRICTION_BACKENDS)}, got "
                          f"{backend!r}")
-    c = float(np.abs(problem.q).max())
-    if c > 0.0 and not QUANTITY_RANGE[0] < c < QUANTITY_RANGE[1]:
-        return _rescaled(problem, c, backend, tol)
+    units = problem.in_contact_units()
+    if units.problem is not problem:
+        return _rescaled(problem, units, backend, tol)
     start = time.perf_counter()
     if backend == "auto" and problem.n_contacts <= SMALL_CONTACTS:
         small = _solve_small(problem, tol, start)
@@ -197,24 +197,30 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
                            f"{tol:.0e}: " + "; ".join(failures))
 
 
-def _rescaled(problem: FrictionContactProblem, c: float, backend: str,
+def _rescaled(problem: FrictionContactProblem, units: ContactUnits, backend: str,
               tol: float) -> FrictionResult:
-    """The problem solved with q/c, c = max|qᵢ| far from 1, and scaled back: r is positively
-    homogeneous in q (docs/theory.md §15), so r(q) = c·r(q/c); certified on the problem as
-    given (:data:`~impactqp.model.friction.QUANTITY_RANGE`)."""
+    """The problem solved in its contacts' units (W̃ = DWD, q̂ = 2⁻ᵏDq: the normal diagonal
+    one and max|q̂ᵢ| within :data:`~impactqp.model.friction.QUANTITY_RANGE`), the answer
+    scaled back (r = 2ᵏ r̂/s, u = 2ᵏ s∘û) and certified on the problem as given
+    (docs/theory.md §15).
+
+    Raises
+    ------
+    OutOfRangeError
+        r or u is beyond the floats, or lands where floats hold it too coarsely for the
+        certificate (the answer in contact units was certified).
+    """
     start = time.perf_counter()
-    unit = FrictionContactProblem.of_checked(problem.W, problem.q / c, problem.mu,
-                                             problem.contact_dim)
-    found = solve_friction(unit, backend=backend, tol=tol)
-    with np.errstate(over="ignore", invalid="ignore"):
-        r = found.r * c
-        u = problem.velocity(r)
+    found = solve_friction(units.problem, backend=backend, tol=tol)
+    r, u = units.reaction(found.r), units.velocity(found.u)
     if not (np.isfinite(r).all() and np.isfinite(u).all()):
-        raise OutOfRangeError(f"the reaction or velocity of this problem (‖q‖∞ = {c:.3g}) is "
-                              "beyond the floats")
+        raise OutOfRangeError("the reaction or velocity of this problem is beyond the floats "
+                              f"(2^{units.k} times its answer in contact units)")
     cert = certify_friction(problem, r, u, tol=tol)
-    if not cert.ok:
-        raise CertificateError(f"the answer scaled back from ‖q‖∞ = 1 fails: {cert.summary()}")
+    if not cert.ok:  # certified in contact units: only the floats' range can lose it here
+        raise OutOfRangeError("floats hold the reaction or velocity of this problem too "
+                              f"coarsely for its certificate (2^{units.k} times its answer "
+                              f"in contact units): {cert.summary()}")
     return FrictionResult(r, u, cert.error, cert, found.iterations,
                           time.perf_counter() - start, found.backend)
 
