@@ -250,10 +250,14 @@ def _socp(P: sp.csc_matrix, c: np.ndarray, mu: np.ndarray, d: int) -> np.ndarray
     Contacts with μ > 0 are second-order cones (μ r_n, r_T); frictionless ones a
     non-negative r_n and r_T = 0 (a zero cone), listed first."""
     C, cones = friction_cone_rows(mu, d)
+    # r is positively homogeneous in c: solved for c of order one (a power of two, exact),
+    # where the interior-point tolerances are meant (at max|cᵢ| = 1e50 Clarabel reported
+    # the program dual infeasible)
+    k = int(np.frexp(np.abs(c).max())[1])
     # an iterate of the fixed point (its end is judged by certify_friction): certified at
     # 1e-6, what Clarabel's answers reach on rank-deficient W (3e-7 measured on PerioBox)
-    program = ConeProgram(P, c, -C, np.zeros(C.shape[0]), cones)
-    return solve_cone(program, "clarabel", tol=1e-10, accept=1e-6).x
+    program = ConeProgram(P, np.ldexp(c, -k), -C, np.zeros(C.shape[0]), cones)
+    return np.ldexp(solve_cone(program, "clarabel", tol=1e-10, accept=1e-6).x, k)
 
 
 def _socp_route(data: FrictionData, r0: np.ndarray, tol: float) -> tuple[np.ndarray, int, bool]:
