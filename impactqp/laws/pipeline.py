@@ -163,21 +163,13 @@ def _rescaled(problem: ImpactProblem, law: ImpactLaw, scale: float, backend: str
     if not (np.isfinite(u_plus).all() and np.isfinite(impulses).all()):
         raise OutOfRangeError(f"{law.title}: u⁺ or Λ ({max(np.abs(unit.u_plus).max(), 1.0):.3g}"
                               f" × {scale:.3g} in the problem's units) overflows floats")
-    if _too_coarse(u_plus, tol) or _too_coarse(impulses, tol):
-        raise OutOfRangeError(f"{law.title}: u⁺ or Λ (× {scale:.3g} in the problem's units) "
-                              "lands among the subnormal floats, whose spacing is beyond the "
-                              f"tolerance {tol:.0e} of the answer")
+    if tol * scale < np.finfo(float).smallest_subnormal:  # u⁺ is measured against scale
+        raise OutOfRangeError(f"{law.title}: u⁺ (× {scale:.3g} in the problem's units) lands "
+                              "among the subnormal floats, whose spacing is beyond the "
+                              f"tolerance {tol:.0e} of the answer (docs/theory.md §8)")
     return _result(problem, law, Answer(u_plus, impulses, None), unit.backend,
                    unit.certificate, start, form=unit.form,
                    attempts=[f"solved in units of u⁻/{scale:.3g}", *unit.attempts])
-
-
-def _too_coarse(x: np.ndarray, tol: float) -> bool:
-    """The floats' absolute spacing near zero (the smallest subnormal) exceeds ``tol`` times
-    the largest |xᵢ|: a vector scaled back that far cannot hold its answer to the
-    certificate's tolerance (docs/theory.md §8)."""
-    top = float(np.abs(x).max(initial=0.0))
-    return 0.0 < top and tol * top < np.finfo(float).smallest_subnormal
 
 
 def _collapsed(problem: ImpactProblem, law: ImpactLaw, groups: parallel.Groups, backend: str,
