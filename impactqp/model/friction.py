@@ -21,11 +21,12 @@ import scipy.sparse as sp
 from ..base.arrays import as_array, as_count, as_matrix, check_tol
 from ..base.checks import NamedChecks
 from ..errors import InputError, OutOfRangeError, ShapeError
+from ..kernels.coulomb_conditions import coulomb_violation_sums
 from ..kernels.friction import natural_map
 from ..kernels.units import contact_units
 
 __all__ = ["ContactUnits", "FrictionCertificate", "FrictionContactProblem", "certify_friction",
-           "coulomb_violations", "friction_coefficients"]
+           "friction_coefficients"]
 
 QUANTITY_RANGE = (1e-100, 1e100)
 """max|q̃ᵢ| (q in contact units) within which a problem is solved and judged as posed; beyond
@@ -241,8 +242,8 @@ class FrictionCertificate(NamedChecks):
       figure, :func:`impactqp.kernels.friction.natural_map`);
     - velocity: ‖û − (W̃ r̂ + q̂)‖ / ‖q̂‖ of the u given with r;
 
-    and the defining conditions, by formulas of :func:`coulomb_violations` that no solver
-    calls:
+    and the defining conditions, by the formulas of
+    :func:`impactqp.kernels.coulomb_conditions.coulomb_violation_sums`, which no solver calls:
 
     - cone: r̂_c ∈ K_μc (‖r_T‖ ≤ μ r_n), over max(‖q̂‖, ‖r̂‖);
     - dual_cone: ũ_c = û_c + μ_c‖û_T,c‖e_n ∈ K_{1/μc} (μ‖ũ_T‖ ≤ ũ_n), over ‖q̂‖;
@@ -300,51 +301,6 @@ def _candidate(name: str, value, n: int) -> np.ndarray:
     return value
 
 
-def coulomb_violations(r: np.ndarray, u: np.ndarray, mu: np.ndarray,
-                       d: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """How far (r, u) is from De Saxcé's conditions, contact by contact, by the defining
-    inequalities (docs/theory.md §15) — no projection, no formula a solver calls.
-
-    With ũ = u + μ‖u_T‖e_n and ω = √(1 + μ²):
-
-    - cone: max((‖r_T‖ − μ r_n)/ω, −r_n, 0), zero exactly when r ∈ K_μ;
-    - dual: max((μ‖ũ_T‖ − ũ_n)/ω, −ũ_n, 0), zero exactly when ũ ∈ K*_μ = K_{1/μ};
-    - complementarity: |r·ũ| / (‖r‖ + ‖ũ‖) (0 where both vanish).
-
-    The first two are lower bounds of the distances to the cones (equal to them beside the
-    boundary), the last at most ‖F‖ + ‖F‖²/(‖r‖ + ‖ũ‖) for the natural map F, so that an
-    answer ABH's figure accepts is not refused by these for a factor of the order of one.
-
-    Parameters
-    ----------
-    r, u : (d·m,) ndarray
-    mu : (m,) ndarray
-    d : int
-
-    Returns
-    -------
-    cone, dual, complementarity : (m,) ndarray
-    """
-    m = mu.size
-    R = r.reshape(m, d)
-    U = u.reshape(m, d)
-    with np.errstate(over="ignore", invalid="ignore"):
-        omega = np.sqrt(1.0 + mu * mu)
-        r_t = np.sqrt(np.sum(R[:, 1:] * R[:, 1:], axis=1))
-        u_t = np.sqrt(np.sum(U[:, 1:] * U[:, 1:], axis=1))
-        tilde = U.copy()
-        tilde[:, 0] = U[:, 0] + mu * u_t
-        tilde_t = np.sqrt(np.sum(tilde[:, 1:] * tilde[:, 1:], axis=1))
-        cone = np.maximum(np.maximum((r_t - mu * R[:, 0]) / omega, -R[:, 0]), 0.0)
-        dual = np.maximum(np.maximum((mu * tilde_t - tilde[:, 0]) / omega, -tilde[:, 0]), 0.0)
-        size = np.sqrt(np.sum(R * R, axis=1)) + np.sqrt(np.sum(tilde * tilde, axis=1))
-        dot = np.abs(np.sum(R * tilde, axis=1))
-        comp = np.where(dot == 0.0, 0.0, dot / np.where(size > 0.0, size, 1.0))
-    for a in (cone, dual, comp):
-        a[np.isnan(a)] = np.inf
-    return cone, dual, comp
-
-
 def certify_friction(problem: FrictionContactProblem, r, u=None, *,
                      tol: float = 1e-8) -> FrictionCertificate:
     """Recompute the certificate of a candidate reaction ``r`` (and velocity ``u``) in the
@@ -386,11 +342,11 @@ def certify_friction(problem: FrictionContactProblem, r, u=None, *,
         fn = _norm(F)
         rn = _norm(r)
         un = _norm(u_w)
-    cone, dual, comp = coulomb_violations(r, u_w, unit.mu, unit.contact_dim)
+    cone, dual, comp = coulomb_violation_sums(r, u_w, unit.mu, unit.contact_dim)
     values = {"natural_map": _ratio(fn, q_scale), "velocity": consistency,
-              "cone": _ratio(_norm(cone), max(q_scale, rn)),
-              "dual_cone": _ratio(_norm(dual), q_scale),
-              "complementarity": _ratio(_norm(comp), q_scale)}
+              "cone": _ratio(math.sqrt(cone), max(q_scale, rn)),
+              "dual_cone": _ratio(math.sqrt(dual), q_scale),
+              "complementarity": _ratio(math.sqrt(comp), q_scale)}
     with np.errstate(invalid="ignore"):
         penetration = _norm(np.maximum(-u_w[::unit.contact_dim], 0.0))
     reported = {"siconos_error": _ratio(fn, max(qn, rn, un)),
