@@ -115,7 +115,9 @@ class FrictionResult:
 def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
                    tol: float = 1e-8) -> FrictionResult:
     """Solve u = W r + q, r_c ∈ K_μc ⟂ u_c + μ_c‖u_T,c‖e_n ∈ K*_μc with a certificate
-    (docs/theory.md §15).
+    (docs/theory.md §15), in the problem's contacts' units
+    (:meth:`~impactqp.FrictionContactProblem.in_contact_units`): r and u are scaled back and
+    certified on the problem as given.
 
     Parameters
     ----------
@@ -137,6 +139,8 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     ------
     CertificateError
         No method reached the tolerance; the message gives the best residuals.
+    OutOfRangeError
+        The answer is beyond what floats hold in the problem's units.
     """
     if not isinstance(problem, FrictionContactProblem):
         raise InputError(f"problem must be a FrictionContactProblem, got "
