@@ -47,3 +47,24 @@ def test_tiny_masses_and_huge_velocities_classify_finitely():
 def test_an_answer_beyond_the_floats_is_named():
     with pytest.raises(iq.OutOfRangeError, match="overflows floats"):
         iq.moreau(iq.newtons_cradle(3, v=1.7e308), 1.0)  # u⁺ fits, Λ = 1.7e308·4/3 does not
+
+
+def test_an_answer_among_the_subnormals_is_accurate_or_named():
+    """Hit at 1e-320 the cradle's answer (−1/3, 2/3, 2/3)·v lands where floats are spaced
+    4.9e-324 apart, 5e-4 of it: refused by name, not returned as a success; at 1e-312 the
+    spacing is 7e-12 of it and the answer is returned to that."""
+    with pytest.raises(iq.OutOfRangeError, match="subnormal"):
+        iq.moreau(iq.newtons_cradle(3, 1e-320), 1.0)
+    r = iq.moreau(iq.newtons_cradle(3, 1e-312), 1.0)
+    np.testing.assert_allclose(r.u_plus / 1e-312, [-1 / 3, 2 / 3, 2 / 3], rtol=1e-10)
+
+
+@pytest.mark.parametrize("make", [
+    lambda: iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0]).admissible_set(mu=0.3).contains(
+        [1e200, 0.0, 0.0]),
+    lambda: iq.newtons_cradle(3, 1e-200).admissible_set().contains([0.0, 0.0, 1e16]),
+    lambda: iq.newtons_cradle(3, 1.0).admissible_set().contains([0.0, 0.0, 1e300]),
+])
+def test_a_point_far_outside_s_is_simply_not_in_it(make):
+    membership = make()  # was a bare OverflowError (‖u‖²/‖u⁻‖² beyond the floats)
+    assert not membership.member and membership.energetic == np.inf

@@ -290,7 +290,7 @@ def test_fclib_text_figures_parse_back(capsys):
     code, out, _ = run(capsys, "fclib", FCLIB, "--tol", "1e-10")
     assert code == 0 and "9 contacts, d = 3" in out and "certificate: ok (tol 1e-10)" in out
     rows = {line.split()[0]: float(line.split()[-1]) for line in out.splitlines()[3:]}
-    assert set(rows) == {"natural", "Siconos", "cone", "velocity", "penetration",
+    assert set(rows) == {"natural", "Siconos", "cone", "dual", "velocity", "penetration",
                          "complementarity"}
     assert rows["natural"] <= 1e-10 and rows["Siconos"] <= rows["natural"] * (1 + 1e-3)
 

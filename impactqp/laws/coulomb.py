@@ -41,7 +41,8 @@ def local_problem(structure: ImpactStructure, u_minus: np.ndarray, mu: np.ndarra
     (docs/theory.md §8, §16).
 
     Returns (problem, s): with G = WᵀM⁻¹W, q = Wᵀu⁻ + e∘γ⁻_n on the normal rows and
-    sᵢ = √G_nn of the contact of entry i, the problem Ũ = G̃ r + q̃ with G̃ = D G D,
+    sᵢ = √G_nn of the contact of entry i (:func:`impactqp.kernels.units.contact_units`,
+    through ``structure.contact_delassus``), the problem Ũ = G̃ r + q̃ with G̃ = D G D,
     q̃ = D q and D = diag(1/s): the contacts' columns scaled by 1/s_c, which changes no
     cone, so its reaction r = sΛ solves the impact's problem U = GΛ + q, Ũ = DU. Velocities
     are measured in contact units and r is a velocity, so the natural-map error does not
@@ -63,7 +64,7 @@ def local_problem(structure: ImpactStructure, u_minus: np.ndarray, mu: np.ndarra
     if not np.isfinite(q).all():
         raise NonFiniteError("the local problem's free velocity q is not finite: u⁻ is "
                              "beyond the floats in the contacts' units")
-    return FrictionContactProblem.of_checked(G, q, mu, d), s
+    return FrictionContactProblem.of_contact_units(G, q, mu, d), s
 
 
 def _coefficient(name: str, value: Any) -> np.ndarray:
@@ -220,8 +221,10 @@ class Coulomb(ImpactLaw):
     def residuals(self, structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
                   impulses: np.ndarray) -> dict[str, Any]:
         """The momentum residual every law shares and the friction checks of the local
-        problem recomputed from Λ (docs/theory.md §16): ``natural_map`` ‖F(sΛ)‖/‖q̃‖ and
-        ``cone`` (Λ in the friction cones) of the reduced problem in contact units, and
+        problem recomputed from Λ (docs/theory.md §16): ``natural_map`` ‖F(sΛ)‖/‖q̃‖,
+        ``cone`` (Λ in the friction cones) and ``complementarity`` (r_c·ũ_c = 0 contact by
+        contact) of the reduced problem in contact units
+        (:func:`~impactqp.model.friction.certify_friction`), and
         ``non_penetration`` ‖(−U_n/s)₊‖/‖q̃‖ of the Newton-shifted normal velocity of u⁺
         itself."""
         U_minus, U_plus, impulses = normalized_rows(U_minus, U_plus, impulses)
@@ -248,6 +251,7 @@ class Coulomb(ImpactLaw):
             q_norm = float(np.linalg.norm(local.q))
             penetration = float(np.linalg.norm(np.minimum(shifted_normal, 0.0)))
         return {"natural_map": checks["natural_map"], "cone": checks["cone"],
+                "complementarity": checks["complementarity"],
                 "non_penetration": penetration / (q_norm if q_norm > 0 else 1.0)}
 
     def __repr__(self) -> str:
@@ -256,5 +260,5 @@ class Coulomb(ImpactLaw):
         return f"Coulomb(mu={show(self.mu)}, restitution={show(self.restitution)})"
 
 
-FRICTION_RESIDUALS = ("natural_map", "cone", "non_penetration")
+FRICTION_RESIDUALS = ("natural_map", "cone", "complementarity", "non_penetration")
 """The friction checks of :meth:`Coulomb.residuals`, beside the shared momentum."""

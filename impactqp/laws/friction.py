@@ -23,7 +23,7 @@ from ..errors import CertificateError, InputError, OutOfRangeError, SolverError
 from ..kernels.friction import modified_velocity, nsgs_rows, project_cones
 from ..kernels.friction_newton import scales, solve_small
 from ..model.friction import (
-    QUANTITY_RANGE,
+    ContactUnits,
     FrictionCertificate,
     FrictionContactProblem,
     certify_friction,
@@ -115,7 +115,9 @@ class FrictionResult:
 def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
                    tol: float = 1e-8) -> FrictionResult:
     """Solve u = W r + q, r_c ∈ K_μc ⟂ u_c + μ_c‖u_T,c‖e_n ∈ K*_μc with a certificate
-    (docs/theory.md §15).
+    (docs/theory.md §15), in the problem's contacts' units
+    (:meth:`~impactqp.FrictionContactProblem.in_contact_units`): r and u are scaled back and
+    certified on the problem as given.
 
     Parameters
     ----------
@@ -137,6 +139,8 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     ------
     CertificateError
         No method reached the tolerance; the message gives the best residuals.
+    OutOfRangeError
+        The answer is beyond what floats hold in the problem's units.
     """
     if not isinstance(problem, FrictionContactProblem):
         raise InputError(f"problem must be a FrictionContactProblem, got "
@@ -145,9 +149,9 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     if backend not in FRICTION_BACKENDS:
         raise InputError(f"backend must be one of {', '.join(FRICTION_BACKENDS)}, got "
                          f"{backend!r}")
-    c = float(np.abs(problem.q).max())
-    if c > 0.0 and not QUANTITY_RANGE[0] < c < QUANTITY_RANGE[1]:
-        return _rescaled(problem, c, backend, tol)
+    units = problem.in_contact_units()
+    if units.problem is not problem:
+        return _rescaled(problem, units, backend, tol)
     start = time.perf_counter()
     if backend == "auto" and problem.n_contacts <= SMALL_CONTACTS:
         small = _solve_small(problem, tol, start)
@@ -197,24 +201,30 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
                            f"{tol:.0e}: " + "; ".join(failures))
 
 
-def _rescaled(problem: FrictionContactProblem, c: float, backend: str,
+def _rescaled(problem: FrictionContactProblem, units: ContactUnits, backend: str,
               tol: float) -> FrictionResult:
-    """The problem solved with q/c, c = max|qᵢ| far from 1, and scaled back: r is positively
-    homogeneous in q (docs/theory.md §15), so r(q) = c·r(q/c); certified on the problem as
-    given (:data:`~impactqp.model.friction.QUANTITY_RANGE`)."""
+    """The problem solved in its contacts' units (W̃ = DWD, q̂ = 2⁻ᵏDq: the normal diagonal
+    one and max|q̂ᵢ| within :data:`~impactqp.model.friction.QUANTITY_RANGE`), the answer
+    scaled back (r = 2ᵏ r̂/s, u = 2ᵏ s∘û) and certified on the problem as given
+    (docs/theory.md §15).
+
+    Raises
+    ------
+    OutOfRangeError
+        r or u is beyond the floats, or lands where floats hold it too coarsely for the
+        certificate (the answer in contact units was certified).
+    """
     start = time.perf_counter()
-    unit = FrictionContactProblem.of_checked(problem.W, problem.q / c, problem.mu,
-                                             problem.contact_dim)
-    found = solve_friction(unit, backend=backend, tol=tol)
-    with np.errstate(over="ignore", invalid="ignore"):
-        r = found.r * c
-        u = problem.velocity(r)
+    found = solve_friction(units.problem, backend=backend, tol=tol)
+    r, u = units.reaction(found.r), units.velocity(found.u)
     if not (np.isfinite(r).all() and np.isfinite(u).all()):
-        raise OutOfRangeError(f"the reaction or velocity of this problem (‖q‖∞ = {c:.3g}) is "
-                              "beyond the floats")
+        raise OutOfRangeError("the reaction or velocity of this problem is beyond the floats "
+                              f"(2^{units.k} times its answer in contact units)")
     cert = certify_friction(problem, r, u, tol=tol)
-    if not cert.ok:
-        raise CertificateError(f"the answer scaled back from ‖q‖∞ = 1 fails: {cert.summary()}")
+    if not cert.ok:  # certified in contact units: only the floats' range can lose it here
+        raise OutOfRangeError("floats hold the reaction or velocity of this problem too "
+                              f"coarsely for its certificate (2^{units.k} times its answer "
+                              f"in contact units): {cert.summary()}")
     return FrictionResult(r, u, cert.error, cert, found.iterations,
                           time.perf_counter() - start, found.backend)
 
@@ -244,10 +254,14 @@ def _socp(P: sp.csc_matrix, c: np.ndarray, mu: np.ndarray, d: int) -> np.ndarray
     Contacts with μ > 0 are second-order cones (μ r_n, r_T); frictionless ones a
     non-negative r_n and r_T = 0 (a zero cone), listed first."""
     C, cones = friction_cone_rows(mu, d)
+    # r is positively homogeneous in c: solved for c of order one (a power of two, exact),
+    # where the interior-point tolerances are meant (at max|cᵢ| = 1e50 Clarabel reported
+    # the program dual infeasible)
+    k = int(np.frexp(np.abs(c).max())[1])
     # an iterate of the fixed point (its end is judged by certify_friction): certified at
     # 1e-6, what Clarabel's answers reach on rank-deficient W (3e-7 measured on PerioBox)
-    program = ConeProgram(P, c, -C, np.zeros(C.shape[0]), cones)
-    return solve_cone(program, "clarabel", tol=1e-10, accept=1e-6).x
+    program = ConeProgram(P, np.ldexp(c, -k), -C, np.zeros(C.shape[0]), cones)
+    return np.ldexp(solve_cone(program, "clarabel", tol=1e-10, accept=1e-6).x, k)
 
 
 def _socp_route(data: FrictionData, r0: np.ndarray, tol: float) -> tuple[np.ndarray, int, bool]:

@@ -192,6 +192,10 @@ def _rescaled(problem: ImpactProblem, law: ImpactLaw, scale: float, backend: str
     if not (np.isfinite(u_plus).all() and np.isfinite(impulses).all()):
         raise OutOfRangeError(f"{law.title}: u⁺ or Λ ({max(np.abs(unit.u_plus).max(), 1.0):.3g}"
                               f" × {scale:.3g} in the problem's units) overflows floats")
+    if tol * scale < np.finfo(float).smallest_subnormal:  # u⁺ is measured against scale
+        raise OutOfRangeError(f"{law.title}: u⁺ (× {scale:.3g} in the problem's units) lands "
+                              "among the subnormal floats, whose spacing is beyond the "
+                              f"tolerance {tol:.0e} of the answer (docs/theory.md §8)")
     return _result(problem, law, Answer(u_plus, impulses, None), unit.backend,
                    unit.certificate, start, form=unit.form,
                    attempts=[f"solved in units of u⁻/{scale:.3g}", *unit.attempts])

@@ -29,7 +29,7 @@ from ..qp.cones import Cone, ConeProgram
 from ..qp.lcp import solve_psd_lcp
 from ..qp.program import QPSolution
 from .friction_admissible import friction_coefficients_of, frictional_membership
-from .membership import METHODS, OPTIMIZER_TOL, Membership
+from .membership import METHODS, OPTIMIZER_TOL, Membership, energy_excess
 from .programs import impulse_program, preferred_forms, velocity_program
 from .residuals import law_residuals
 
@@ -187,8 +187,9 @@ class AdmissibleSet:
         lam, res = best_impulses(p, un - umn)
         gamma = st.Wt_times(un)
         s = st.contact_scale
-        kinematic = float(max(0.0, -np.min(gamma / (s * V), initial=0.0)))
-        energetic = max(0.0, float(st.kinetic_norms(un) / V) ** 2 - 1.0)
+        with np.errstate(over="ignore"):
+            kinematic = float(max(0.0, -np.min(gamma / (s * V), initial=0.0)))
+        energetic = energy_excess(float(st.kinetic_norms(un) / V))
         kinetic = res / V
         with np.errstate(over="ignore"):  # the verdict is scale-free; impulses beyond the
             lam = lam * c                 # floats are reported as inf

@@ -3,25 +3,36 @@
 
 Find r and u = W r + q such that, for every contact c, r_c ∈ K_μc ⟂ ũ_c ∈ K*_μc with
 ũ_c = u_c + μ_c‖u_T,c‖e_n (De Saxcé's form of Coulomb's law). W is used as given (never its
-symmetric part); the formulas are those of :mod:`impactqp.kernels.friction`.
+symmetric part). Every problem is solved and judged in its contacts' units
+(:meth:`FrictionContactProblem.in_contact_units`, docs/theory.md §15); the certificate checks
+the defining conditions with formulas written here, which no solver calls, beside ABH's
+natural map of :mod:`impactqp.kernels.friction` (docs/theory.md §15).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import as_array, as_count, as_matrix, check_tol
 from ..base.checks import NamedChecks
-from ..errors import InputError, ShapeError
-from ..kernels.friction import certificate_sums
+from ..errors import InputError, OutOfRangeError, ShapeError
+from ..kernels.coulomb_conditions import coulomb_violation_sums
+from ..kernels.friction import natural_map
+from ..kernels.units import contact_units
 
-__all__ = ["FrictionCertificate", "FrictionContactProblem", "certify_friction",
+__all__ = ["ContactUnits", "FrictionCertificate", "FrictionContactProblem", "certify_friction",
            "friction_coefficients"]
+
+QUANTITY_RANGE = (1e-100, 1e100)
+"""max|q̃ᵢ| (q in contact units) within which a problem is solved and judged as posed; beyond
+it, in units of a power of two near max|q̃ᵢ| (docs/theory.md §15)."""
+
+_LOG2_RANGE = (math.log2(QUANTITY_RANGE[0]), math.log2(QUANTITY_RANGE[1]))
 
 
 def friction_coefficients(value: Any, n_contacts: int, name: str = "mu") -> np.ndarray:
@@ -85,6 +96,7 @@ class FrictionContactProblem:
         self.mu = mu
         self.contact_dim = d
         self.n_contacts = m
+        self._units: ContactUnits | None = None
 
     @classmethod
     def of_checked(cls, W, q: np.ndarray, mu: np.ndarray,
@@ -94,10 +106,41 @@ class FrictionContactProblem:
         problem = cls.__new__(cls)
         problem.W, problem.q, problem.mu = W, q, mu
         problem.contact_dim, problem.n_contacts = contact_dim, mu.size
+        problem._units = None
         return problem
 
+    @classmethod
+    def of_contact_units(cls, W, q: np.ndarray, mu: np.ndarray,
+                         contact_dim: int) -> FrictionContactProblem:
+        """:meth:`of_checked` for a problem impactqp has already posed in its contacts' units
+        (normal diagonal one, as :meth:`in_contact_units` makes it): its units are taken as
+        s = 1, only the scale-first rule on q is applied."""
+        problem = cls.of_checked(W, q, mu, contact_dim)
+        problem._units = _units_of(problem, np.ones(q.size))
+        return problem
+
+    def in_contact_units(self) -> ContactUnits:
+        """The problem posed in its contacts' units (docs/theory.md §15): W̃ = DWD,
+        q̂ = 2⁻ᵏDq, D = diag(1/s), s = √W_nn of each contact
+        (:func:`impactqp.kernels.units.contact_units`) and 2ᵏ = 1 unless max|Dq| lies
+        outside :data:`QUANTITY_RANGE`, where it is the power of two nearest it. Its
+        reaction r̂ = 2⁻ᵏ s∘r and velocity û = 2⁻ᵏ u/s; the cones do not change (a positive
+        factor per contact), so r solves this problem exactly when r̂ solves that one. The
+        same object every time (it is computed once); a problem already in its units is
+        its own unit problem.
+
+        Raises
+        ------
+        OutOfRangeError
+            W̃ is not finite (|W_ij| far beyond √(W_ii W_jj)): floats cannot pose it.
+        """
+        if self._units is None:
+            s = contact_units(np.ascontiguousarray(_diagonal(self.W)), self.contact_dim)
+            self._units = _units_of(self, s)
+        return self._units
+
     def velocity(self, r: np.ndarray) -> np.ndarray:
-        """u = W r + q."""
+        """u = W r + q (as given, in the problem's units)."""
         return np.asarray(self.W @ r).ravel() + self.q
 
     def dense_W(self) -> np.ndarray:
@@ -109,21 +152,105 @@ class FrictionContactProblem:
                 f"contact_dim={self.contact_dim})")
 
 
+class ContactUnits(NamedTuple):
+    """A :class:`FrictionContactProblem` posed in its contacts' units
+    (:meth:`FrictionContactProblem.in_contact_units`, docs/theory.md §15).
+
+    Attributes
+    ----------
+    problem : FrictionContactProblem
+        W̃ = DWD and q̂ = 2⁻ᵏDq, D = diag(1/s).
+    s : (d·m,) ndarray
+        The unit s_c of the contact of each entry.
+    k : int
+        The scale-first exponent (0 unless max|Dq| lies outside :data:`QUANTITY_RANGE`).
+    """
+
+    problem: FrictionContactProblem
+    s: np.ndarray
+    k: int
+
+    def reaction(self, r_unit: np.ndarray) -> np.ndarray:
+        """r = 2ᵏ r̂/s of the problem as given (inf or 0 where floats do not hold it)."""
+        with np.errstate(over="ignore", under="ignore"):
+            return np.ldexp(r_unit / self.s, self.k)
+
+    def velocity(self, u_unit: np.ndarray) -> np.ndarray:
+        """u = 2ᵏ s∘û of the problem as given."""
+        with np.errstate(over="ignore", under="ignore"):
+            return np.ldexp(u_unit * self.s, self.k)
+
+    def unit_reaction(self, r: np.ndarray) -> np.ndarray:
+        """r̂ = 2⁻ᵏ s∘r."""
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            return np.ldexp(r, -self.k) * self.s
+
+    def unit_velocity(self, u: np.ndarray) -> np.ndarray:
+        """û = 2⁻ᵏ u/s."""
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            return np.ldexp(u, -self.k) / self.s
+
+
+def _diagonal(W) -> np.ndarray:
+    """W's diagonal as a float array."""
+    return np.asarray(W.diagonal(), dtype=float).ravel()
+
+
+def _units_of(problem: FrictionContactProblem, s: np.ndarray) -> ContactUnits:
+    """:class:`ContactUnits` of ``problem`` with the units s (the problem itself when s = 1
+    and q needs no scaling)."""
+    q = problem.q
+    mq, eq = np.frexp(q)
+    ms, es = np.frexp(s)
+    exponents = (eq - es)[q != 0.0]
+    top = int(exponents.max()) if exponents.size else 0  # max|qᵢ/sᵢ| in [2^(top−2), 2^top)
+    k = 0 if _LOG2_RANGE[0] < top < _LOG2_RANGE[1] else top
+    ones = bool(np.all(s == 1.0))
+    if ones and k == 0:
+        return ContactUnits(problem, s, 0)
+    with np.errstate(under="ignore"):  # entries below 2⁻¹⁰⁷⁴ of the largest are not kept
+        q_unit = np.ldexp(mq / ms, eq - es - k)
+    if ones:
+        W = problem.W
+    else:
+        D = 1.0 / s
+        with np.errstate(over="ignore", invalid="ignore"):
+            if sp.issparse(problem.W):
+                W = sp.csc_matrix(sp.diags(D) @ problem.W @ sp.diags(D))
+                finite = np.isfinite(W.data).all()
+            else:
+                W = problem.W * D[:, None] * D[None, :]
+                finite = np.isfinite(W).all()
+        if not finite:
+            raise OutOfRangeError("W in its contacts' units (W_ij/√(W_ii W_jj)) is beyond "
+                                  "the floats")
+    unit = FrictionContactProblem.of_checked(W, q_unit, problem.mu, problem.contact_dim)
+    unit._units = ContactUnits(unit, np.ones(q.size), 0)
+    return ContactUnits(unit, s, k)
+
+
 @dataclass(frozen=True)
 class FrictionCertificate(NamedChecks):
     """The recomputed checks of one candidate answer (r, u) of a
-    :class:`FrictionContactProblem` (docs/theory.md §15).
+    :class:`FrictionContactProblem`, in its contacts' units: r̂, û and q̂ of
+    :meth:`FrictionContactProblem.in_contact_units`, û = W̃ r̂ + q̂ recomputed (docs/theory.md
+    §15).
 
     Accepted when each of its ``residuals`` is within ``tol``:
 
-    - natural_map: ‖r − P_K(r − ũ)‖ / ‖q‖ with u = W r + q recomputed (Acary–Brémond–Huber's
-      error, the acceptance figure);
-    - velocity: ‖u − (W r + q)‖ / ‖q‖ of the u given with r;
-    - cone: ‖r − P_K(r)‖ / ‖r‖, r in the friction cones.
+    - natural_map: ‖r̂ − P_K(r̂ − ũ)‖ / ‖q̂‖ (Acary–Brémond–Huber's error, the acceptance
+      figure, :func:`impactqp.kernels.friction.natural_map`);
+    - velocity: ‖û − (W̃ r̂ + q̂)‖ / ‖q̂‖ of the u given with r;
+
+    and the defining conditions, by the formulas of
+    :func:`impactqp.kernels.coulomb_conditions.coulomb_violation_sums`, which no solver calls:
+
+    - cone: r̂_c ∈ K_μc (‖r_T‖ ≤ μ r_n), over max(‖q̂‖, ‖r̂‖);
+    - dual_cone: ũ_c = û_c + μ_c‖û_T,c‖e_n ∈ K_{1/μc} (μ‖ũ_T‖ ≤ ũ_n), over ‖q̂‖;
+    - complementarity: |r̂_c·ũ_c| / (‖r̂_c‖ + ‖ũ_c‖) contact by contact, over ‖q̂‖.
 
     Reported beside them (``reported``), not part of the verdict: ``siconos_error``
-    ‖F‖/max(‖q‖, ‖r‖, ‖u‖), ``penetration`` ‖(−u_n)₊‖/‖q‖ (ũ ∈ K*_μ reduces to u_n ≥ 0)
-    and ``complementarity`` ``Σ_c |r_c·ũ_c| / (‖r‖‖q‖)``.
+    ‖F‖/max(‖q̂‖, ‖r̂‖, ‖û‖) and ``penetration`` ‖(−û_n)₊‖/‖q̂‖.
 
     Parameters
     ----------
@@ -142,7 +269,7 @@ class FrictionCertificate(NamedChecks):
 
     @property
     def error(self) -> float:
-        """The acceptance figure ‖F‖/‖q‖ (ABH)."""
+        """The acceptance figure ‖F‖/‖q‖ (ABH), in contact units."""
         return self.values["natural_map"]
 
     def summary(self) -> str:
@@ -157,10 +284,6 @@ def _ratio(num: float, den: float) -> float:
         return 0.0
     v = num / den if den > 0.0 else math.inf
     return v if v == v else math.inf
-
-
-QUANTITY_RANGE = (1e-100, 1e100)
-"""max|qᵢ| within which the certificate's sums of squares are formed as given."""
 
 
 def _norm(x: np.ndarray) -> float:
@@ -180,45 +303,52 @@ def _candidate(name: str, value, n: int) -> np.ndarray:
 
 def certify_friction(problem: FrictionContactProblem, r, u=None, *,
                      tol: float = 1e-8) -> FrictionCertificate:
-    """Recompute the certificate of a candidate reaction ``r`` (and velocity ``u``).
+    """Recompute the certificate of a candidate reaction ``r`` (and velocity ``u``) in the
+    problem's contacts' units (:class:`FrictionCertificate`, docs/theory.md §15).
 
     Parameters
     ----------
     problem : FrictionContactProblem
     r : (d·m,) array
-        The candidate reaction.
+        The candidate reaction, in the problem's units.
     u : (d·m,) array, optional
         The candidate velocity; its distance to W r + q is the ``velocity`` residual (0 when
         not given). Every other figure uses u = W r + q recomputed.
     tol : float
         Tolerance of the residuals.
+
+    Raises
+    ------
+    OutOfRangeError
+        The problem cannot be posed in its contacts' units in floats.
     """
     tol = check_tol(tol)
     n = problem.q.size
     r = _candidate("r", r, n)
-    q = problem.q
     if u is not None:
         u = _candidate("u", u, n)
-    # every figure is a ratio, invariant under (r, u, q) → (r, u, q)/c: far from order one
-    # (‖q‖² would underflow or overflow) they are computed in units of c = max|qᵢ|
-    c = float(np.abs(q).max())
-    if c > 0.0 and not QUANTITY_RANGE[0] < c < QUANTITY_RANGE[1]:
-        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-            q, r = q / c, r / c
-            u = None if u is None else u / c
-    u_w = np.asarray(problem.W @ r).ravel() + q
-    qn = _norm(q)
-    q_scale = qn if qn > 0.0 else 1.0
-    consistency = 0.0
-    if u is not None:
-        consistency = _ratio(_norm(u - u_w), q_scale)
-    f2, comp, pen, cone = certificate_sums(r, u_w, problem.mu, problem.contact_dim)
-    fn = math.sqrt(f2)
-    rn = _norm(r)
-    un = _norm(u_w)
+    units = problem.in_contact_units()
+    unit = units.problem
+    r = units.unit_reaction(r)
+    q = unit.q
+    with np.errstate(over="ignore", invalid="ignore"):
+        u_w = np.asarray(unit.W @ r).ravel() + q
+        qn = _norm(q)
+        q_scale = qn if qn > 0.0 else 1.0
+        consistency = 0.0
+        if u is not None:
+            consistency = _ratio(_norm(units.unit_velocity(u) - u_w), q_scale)
+        F = natural_map(r, u_w, unit.mu, unit.contact_dim)
+        fn = _norm(F)
+        rn = _norm(r)
+        un = _norm(u_w)
+    cone, dual, comp = coulomb_violation_sums(r, u_w, unit.mu, unit.contact_dim)
     values = {"natural_map": _ratio(fn, q_scale), "velocity": consistency,
-              "cone": _ratio(math.sqrt(cone), rn)}
+              "cone": _ratio(math.sqrt(cone), max(q_scale, rn)),
+              "dual_cone": _ratio(math.sqrt(dual), q_scale),
+              "complementarity": _ratio(math.sqrt(comp), q_scale)}
+    with np.errstate(invalid="ignore"):
+        penetration = _norm(np.maximum(-u_w[::unit.contact_dim], 0.0))
     reported = {"siconos_error": _ratio(fn, max(qn, rn, un)),
-                "penetration": _ratio(math.sqrt(pen), q_scale),
-                "complementarity": _ratio(comp, rn * q_scale)}
+                "penetration": _ratio(penetration, q_scale)}
     return FrictionCertificate(values, tol, reported)

@@ -27,16 +27,22 @@ from ..base.arrays import as_dense
 from ..base.checks import DEFAULT_TOL
 from ..errors import InputError
 from ..kernels.friction import project_cones
+from ..kernels.units import contact_units
 from ..qp.cone_solve import solve_cone
 from ..qp.cones import Cone, ConeProgram, friction_cone_rows
 from .friction import friction_coefficients
-from .membership import OPTIMIZER_TOL, Membership
+from .membership import OPTIMIZER_TOL, Membership, energy_excess
 
 __all__ = ["cone_least_squares", "friction_coefficients", "friction_coefficients_of",
            "frictional_membership"]
 
 SOCP_TOL = 1e-12
 """Clarabel's tolerance for the distance program (its objective is the distance itself)."""
+
+
+def _finite_or_inf(x: float) -> float:
+    """x, or +inf where it is NaN (a residual that cannot be evaluated fails)."""
+    return x if x == x else float("inf")
 
 
 def friction_coefficients_of(problem: Any, mu: Any) -> np.ndarray | None:
@@ -99,18 +105,19 @@ def frictional_membership(problem: Any, mu: np.ndarray, u: np.ndarray, method: s
     B, Lt = _metric_factor(st)
     b = Lt @ (un - umn)
     exact = method == "exact" and st.full_column_rank
+    units = contact_units(np.ascontiguousarray(st.delassus_diagonal, dtype=float), d)
     if exact:
         lam = project_cones(np.linalg.lstsq(B, b, rcond=None)[0], mu, d)
-    else:  # in contact units (Λ̃_c = s_cΛ_c/V, one factor a contact: the cones stay), so
-        # the interior-point solver sees an order-one program whatever the unit of mass
-        units = np.repeat(st.contact_scale[::d], d)
-        units = np.where(units > 0.0, units, 1.0)
+    else:  # in contact units (Λ̃_c = s_cΛ_c/V, one factor a contact: the cones stay, s_c
+        # of kernels.units), so the interior-point solver sees an order-one program
+        # whatever the unit of mass
         lam = cone_least_squares(B / units, b / V, mu, d) * (V / units)
-    kinetic = float(np.linalg.norm(B @ lam - b)) / V
-    gamma_n = st.Wt_times(un)[::d]
-    s_n = st.contact_scale[::d]
-    kinematic = float(max(0.0, -np.min(gamma_n / (s_n * V), initial=0.0)))
-    energetic = max(0.0, float(st.kinetic_norms(un) / V) ** 2 - 1.0)
+    with np.errstate(over="ignore", invalid="ignore"):  # far outside S: inf, not an error
+        kinetic = _finite_or_inf(float(np.linalg.norm(B @ lam - b)) / V)
+        gamma_n = st.Wt_times(un)[::d]
+        kinematic = _finite_or_inf(float(max(0.0, -np.min(gamma_n / (units[::d] * V),
+                                                          initial=0.0))))
+    energetic = energy_excess(float(st.kinetic_norms(un) / V))
     with np.errstate(over="ignore"):  # impulses beyond the floats are reported as inf
         lam = lam * c
     if tol is None:

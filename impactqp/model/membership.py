@@ -13,6 +13,14 @@ METHODS = ("exact", "optimizer")
 """The methods of :meth:`~impactqp.AdmissibleSet.contains`."""
 
 
+def energy_excess(ratio: float) -> float:
+    """The energetic residual max(0, ρ² − 1) of ρ = ‖u‖/‖u⁻‖ (docs/theory.md §2): +inf where
+    ρ² is beyond the floats (a point that far outside the energy ball is simply not in S)."""
+    if not ratio < 1e150:
+        return float("inf")
+    return max(0.0, ratio * ratio - 1.0)
+
+
 @dataclass(frozen=True)
 class Membership:
     """Verdict on u ∈ S with the residual of each condition (dimensionless, docs/theory.md §2).

@@ -21,6 +21,7 @@ from ..base.arrays import Matrix, as_count, as_dense, as_matrix
 from ..base.rowwise import row_max, row_sum
 from ..errors import InputError, MassMatrixError, ShapeError
 from ..kernels.impact import pack
+from ..kernels.units import contact_units
 
 
 @dataclass(frozen=True)
@@ -294,9 +295,10 @@ class ImpactStructure:
     @cached_property
     def contact_delassus(self) -> tuple[Matrix, np.ndarray]:
         """(G̃, s), kept: G in each frictional contact's own unit, G̃ = D G D with
-        D = diag(1/s) and sᵢ = √G_nn of the contact of entry i (docs/theory.md §16)."""
-        d = self.contact_dim
-        s = np.repeat(np.sqrt(self.delassus_diagonal[::d]), d)
+        D = diag(1/s) and sᵢ = √G_nn of the contact of entry i
+        (:func:`impactqp.kernels.units.contact_units`, docs/theory.md §16)."""
+        s = contact_units(np.ascontiguousarray(self.delassus_diagonal, dtype=float),
+                          self.contact_dim)
         G = self.delassus
         if sp.issparse(G):
             D = sp.diags(1.0 / s)

@@ -20,8 +20,9 @@ from ..report import to_json
 def friction_report(problem: FrictionContactProblem, result: FrictionResult,
                     source: str) -> dict[str, Any]:
     """The figures of a certified answer: the problem's size, the method, the time and every
-    residual of the certificate, accepted (``natural_map`` is ABH's error, ``velocity``,
-    ``cone``) and reported (``siconos_error``, ``penetration``, ``complementarity``)."""
+    residual of the certificate, in contact units, accepted (``natural_map`` is ABH's error,
+    ``velocity``, ``cone``, ``dual_cone``, ``complementarity``) and reported
+    (``siconos_error``, ``penetration``)."""
     cert = result.certificate
     return {"source": source, "contacts": problem.n_contacts,
             "contact_dim": problem.contact_dim, "method": result.backend,
@@ -40,10 +41,11 @@ def format_friction(report: dict[str, Any]) -> str:
         f"certificate: {'ok' if cert['ok'] else 'FAILED'} (tol {cert['tolerance']:.0e})",
         f"  natural map ‖F‖/‖q‖ (ABH)      {cert['natural_map']:.3e}",
         f"  Siconos ‖F‖/max(‖q‖,‖r‖,‖u‖)    {cert['siconos_error']:.3e}",
-        f"  cone ‖r − P_K(r)‖/‖r‖          {cert['cone']:.3e}",
+        f"  cone r ∈ K_μ                   {cert['cone']:.3e}",
+        f"  dual ũ ∈ K_1/μ                 {cert['dual_cone']:.3e}",
+        f"  complementarity r_c·ũ_c = 0    {cert['complementarity']:.3e}",
         f"  velocity ‖u − (Wr + q)‖/‖q‖    {cert['velocity']:.3e}",
         f"  penetration ‖(−u_n)₊‖/‖q‖      {cert['penetration']:.3e}",
-        f"  complementarity                {cert['complementarity']:.3e}",
     ])
 
 
