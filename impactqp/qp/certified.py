@@ -1,12 +1,15 @@
-"""Run programs on backends until one answer passes the caller's own certificate.
+"""Run programs on backends until one answer passes the caller's own certificate: the one
+certified loop of impactqp, for quadratic programs, cone programs and frictional contact
+problems (docs/theory.md §9).
 
 The caller hands a list of :class:`Candidate` (backend, form, program, and ``finish``: the
-caller's recovery of its answer from a :class:`~impactqp.qp.program.QPSolution` together
-with its certificate). ``"auto"`` builds that list from the registry; a named backend is
-one candidate. Iterative answers are polished (docs/theory.md §9) and retried once with a
-tighter tolerance; a failed certificate never becomes a success. Every backend sees the
-program normalized to order one (:mod:`.scaling`), so answers do not depend on units. This
-layer knows nothing of impacts: the certificate is whatever ``finish`` returns.
+caller's recovery of its answer from the backend's solution together with its certificate).
+``"auto"`` builds that list from the registry; a named backend is one candidate. Iterative
+answers are polished (docs/theory.md §9, §15) and quadratic and cone programs retried once
+with a tighter tolerance; a failed certificate never becomes a success. Every QP backend sees
+the program normalized to order one (:mod:`.scaling`), so answers do not depend on units. This
+layer knows nothing of impacts: the certificate is whatever ``finish`` returns, and the
+backend an answer reports is always a name the caller can pass back.
 """
 
 from __future__ import annotations
@@ -19,7 +22,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.optimize import linprog
 
 from ..base.checks import ResidualChecks
 from ..errors import (
@@ -32,11 +34,11 @@ from ..errors import (
 )
 from . import backends
 from .backends.exact import MAX_CONSTRAINTS
-from .polish import polish
-from .program import QPSolution, QuadraticProgram
-from .scaling import Scaling, normalize
+from .kinds import QPKind, kind_of
+from .program import QuadraticProgram
 
-Finish = Callable[[QPSolution], tuple[Any, ResidualChecks]]
+Finish = Callable[[Any], tuple[Any, ResidualChecks]]
+"""The caller's recovery of its answer from a backend's solution, with its certificate."""
 
 LOG = logging.getLogger(__name__)
 
@@ -58,32 +60,39 @@ FAST_PATHS = ("kernel", "isotonic")
 
 @dataclass(frozen=True)
 class Candidate:
-    """One way to try: a backend on a program of a given form."""
+    """One way to try: a backend on a program of a given form; ``checked`` when the
+    backend is known to take the program (else the loop asks when it gets there)."""
 
     backend: str
     form: str
-    program: QuadraticProgram
+    program: Any
     finish: Finish
+    checked: bool = True
 
 
 @dataclass(frozen=True)
 class Outcome:
-    """A certified answer and how it was reached."""
+    """A certified answer and how it was reached: the backend's ``solution`` it was recovered
+    from and the registry name of the ``backend`` (one the caller may pass back)."""
 
     answer: Any
     checks: ResidualChecks
+    solution: Any
     backend: str
     form: str
     attempts: list[str]
 
 
-def auto_order(qp: QuadraticProgram, form: str) -> list[str]:
-    """The backends ``"auto"`` tries on ``qp``, least overhead and exact first (measured in
-    benchmarks/: the kernel and isotonic regression beat every QP solver where they apply;
-    NNLS is exact and fastest on dense impulse forms; PIQP is 3–5× faster than Clarabel on
-    sparse impacts of 10⁴ contacts and as accurate after polishing).
-
-    The order depends on the program's shape only, so it is kept per owner and tag."""
+def auto_order(qp: Any, form: str) -> list[str]:
+    """The backends ``"auto"`` tries on ``qp``, least overhead and exact first. Cone and
+    friction programs: :data:`~impactqp.qp.backends.AUTO_ORDER` (whether each takes ``qp`` is
+    asked when the loop reaches it: most answers come from the first). Quadratic programs
+    (measured in benchmarks/): the kernel and isotonic regression beat every QP solver where
+    they apply; NNLS is exact and fastest on dense impulse forms; PIQP is 3–5× faster than
+    Clarabel on sparse impacts of 10⁴ contacts and as accurate after polishing; that order
+    depends on the program's shape only, so it is kept per owner and tag."""
+    if form not in backends.FORMS:
+        return list(backends.AUTO_ORDER[form])
     if qp.cache_owner is None:
         return _auto_order(qp, form)
     per_owner = _ORDERS.setdefault(qp.cache_owner, {})
@@ -114,7 +123,7 @@ def _auto_order(qp: QuadraticProgram, form: str) -> list[str]:
     return names
 
 
-def plan(form: str, qp: QuadraticProgram, finish: Finish, backend: str) -> list[Candidate]:
+def plan(form: str, qp: Any, finish: Finish, backend: str) -> list[Candidate]:
     """The candidates for one program: the auto order, or the named backend alone.
 
     Raises
@@ -125,7 +134,8 @@ def plan(form: str, qp: QuadraticProgram, finish: Finish, backend: str) -> list[
         A named backend that cannot take the program (the message says why).
     """
     if backend == "auto":
-        return [Candidate(name, form, qp, finish) for name in auto_order(qp, form)]
+        checked = form in backends.FORMS
+        return [Candidate(name, form, qp, finish, checked) for name in auto_order(qp, form)]
     entry, _ = backends.parse_backend(backend)
     reason = backends.unsuitable(entry, qp, form)
     if reason is not None:
@@ -133,7 +143,7 @@ def plan(form: str, qp: QuadraticProgram, finish: Finish, backend: str) -> list[
     return [Candidate(backend, form, qp, finish)]
 
 
-Stage = tuple[str, Callable[[], QuadraticProgram], Finish]
+Stage = tuple[str, Callable[[], Any], Finish]
 
 
 def solve_in_forms(stages: Sequence[Stage], backend: str,
@@ -168,16 +178,11 @@ def solve_in_forms(stages: Sequence[Stage], backend: str,
             failures.append(str(exc))
             _note(log, f"{form} form: {exc}", logging.INFO)
             continue
-        return Outcome(out.answer, out.checks, out.backend, out.form, log + out.attempts)
+        return Outcome(out.answer, out.checks, out.solution, out.backend, out.form,
+                       log + out.attempts)
     if failures:
         raise CertificateError("; ".join(failures))
     raise BackendUnsuitableError("; ".join(dict.fromkeys(unsuitable)))
-
-
-def lcp_feasible(qp: QuadraticProgram) -> bool:
-    """For the impulse form: is there x ≥ 0 with Px + c ≥ 0? (For PSD P: solvable iff so.)"""
-    res = linprog(np.zeros(qp.n_vars), A_ub=-qp.P, b_ub=qp.c, bounds=(0, None), method="highs")
-    return bool(res.status == 0)
 
 
 def _better(new: ResidualChecks, old: ResidualChecks) -> bool:
@@ -187,7 +192,10 @@ def _better(new: ResidualChecks, old: ResidualChecks) -> bool:
 
 def solve_certified(candidates: Sequence[Candidate], *, named: bool,
                     tol: float = 1e-10, options: dict | None = None) -> Outcome:
-    """Try each candidate until one answer passes its certificate.
+    """The one certified loop: try each candidate (all of one form) until an answer passes
+    its certificate, for quadratic programs, cone programs and frictional contact problems
+    alike (how each kind is run and polished: :mod:`.kinds`). Iterative answers are polished
+    and kept when their certificate is at least as good; every attempt is recorded.
 
     Raises
     ------
@@ -199,7 +207,8 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
         No candidate produced an answer within the certificate's tolerance.
     """
     log: list[str] = []
-    settings = {"options": options} if options else {}
+    kind = kind_of(candidates[0].form) if candidates else QPKind()
+    warm, warm_value = None, math.inf  # the best uncertified answer, where a method starts
     for cand in candidates:
         entry, sub = backends.parse_backend(cand.backend)
         try:
@@ -209,11 +218,15 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
                 raise
             _note(log, f"{cand.backend}: not installed", logging.INFO)
             continue
-        unit, scaling = (cand.program, Scaling(1.0, 1.0)) if entry.scale_free \
-            else normalize(cand.program)
-        for attempt_tol in ((tol,) if entry.exact else (tol, tol * 1e-2)):
+        if not cand.checked:
+            reason = backends.unsuitable(entry, cand.program, cand.form)
+            if reason is not None:
+                _note(log, f"{cand.backend}: unsuitable ({reason})", logging.DEBUG)
+                continue
+        prepared = kind.prepare(entry, cand.program)
+        for attempt_tol in kind.tolerances(entry, tol):
             try:
-                sol_unit = module.solve(unit, tol=attempt_tol, solver=sub, **settings)
+                raw = kind.run(module, entry, sub, prepared, attempt_tol, options, warm)
             except InputError:  # the user's options: theirs to mend, not a solver failure
                 raise
             except (BackendUnsuitableError, UnknownBackendError) as exc:
@@ -227,30 +240,24 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
                 if entry.exact:
                     break
                 continue
-            sol = scaling.solution(sol_unit)
+            sol = kind.solution(prepared, raw)
             answer, cert = cand.finish(sol)
             if not entry.exact:
-                # iterative answers stop at a tolerance: solve their active set exactly and
-                # keep that when its certificate is at least as good. Small residuals do not
-                # mean accurate velocities on ill-conditioned impacts (a 10⁵-ball chain
-                # passes at 1e-9 with velocities off by 1e-6), so this is always tried.
-                polished = polish(unit, sol_unit)
+                polished = kind.polish(prepared, raw, attempt_tol)
                 if polished is not None:
-                    answer_p, cert_p = cand.finish(scaling.solution(polished))
+                    sol_p = kind.solution(prepared, polished)
+                    answer_p, cert_p = cand.finish(sol_p)
                     if _better(cert_p, cert):
-                        _note(log, f"{sol.backend}+polish ({cand.form}): certified")
+                        _note(log, f"{sol.backend} ({cand.form}): polished, certified")
                         _verdict(cert_p)
-                        return Outcome(answer_p, cert_p, f"{sol.backend}+polish", cand.form,
-                                       log)
+                        return Outcome(answer_p, cert_p, sol_p, sol.backend, cand.form, log)
             if cert.ok:
                 _note(log, f"{sol.backend} ({cand.form}): certified")
                 _verdict(cert)
-                return Outcome(answer, cert, sol.backend, cand.form, log)
+                return Outcome(answer, cert, sol, sol.backend, cand.form, log)
             name, value = cert.worst
+            if value < warm_value:
+                warm, warm_value = sol, value
             _note(log, f"{cand.backend} ({cand.form}, tol {attempt_tol:.0e}): certificate "
                        f"failed, {name} = {value:.1e}")
-    impulse = [c.program for c in candidates if c.program.nonnegative]
-    if impulse and not lcp_feasible(normalize(impulse[0])[0]):
-        raise NoSolutionError("the LCP 0 ≤ Λ ⟂ GΛ + q ≥ 0 has no feasible point, so the law "
-                              "has no solution for this pre-impact velocity")
-    raise CertificateError("no backend met the certificate: " + "; ".join(log))
+    raise kind.failure([c.program for c in candidates], log)

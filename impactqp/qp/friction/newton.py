@@ -1,17 +1,19 @@
-"""Newton's methods for local frictional contact problems on the general route of
-:func:`impactqp.solve_friction` (docs/theory.md §15): the semismooth Newton on Alart–Curnier's
-function with shifted sparse LU steps, and the least-squares Newton on the natural map (dense;
-the last resort of ``auto`` before a long NSGS, for rank-deficient W where the first stalls).
+"""Newton's methods for local frictional contact problems (docs/theory.md §15): the
+semismooth Newton on Alart–Curnier's function with shifted sparse LU steps, and the
+least-squares Newton on the natural map (dense; for rank-deficient W where the first stalls),
+with :class:`FrictionData`, the problem's arrays as every friction method uses them.
 """
 
 from __future__ import annotations
+
+from functools import cached_property
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..kernels.friction import (
+from ...kernels.friction import (
     alart_curnier,
     modified_velocity,
     modified_velocity_jacobian,
@@ -19,8 +21,8 @@ from ..kernels.friction import (
     project_cones,
     projection_jacobian,
 )
-from ..kernels.friction_newton import scales
-from ..model.friction import FrictionContactProblem
+from ...kernels.friction_newton import scales
+from . import FrictionProgram
 
 NEWTON_STEPS = 50
 """Most steps of one run of Newton (those that converge here take 5 to 35)."""
@@ -31,24 +33,40 @@ LSTSQ_MAX = 600
 
 
 class FrictionData:
-    """The problem's arrays as the solvers use them: W as compressed rows, the scale ρ_c of
-    each contact's Alart–Curnier function (:func:`scales`)."""
+    """The problem's arrays as the friction methods use them, built when first asked for (a
+    problem the compiled call certifies never needs its compressed rows): W as compressed rows,
+    W dense, and the scale ρ_c of each contact's Alart–Curnier function (:func:`scales`)."""
 
-    def __init__(self, problem: FrictionContactProblem) -> None:
-        if sp.issparse(problem.W):
-            self.W = sp.csr_matrix(problem.W, dtype=float)
-            self.W.sum_duplicates()
-        else:  # every entry stored: no scan for zeros, which costs more than a sweep
-            n = problem.q.size
-            self.W = sp.csr_matrix((np.asarray(problem.W, dtype=float).ravel(),
-                                    np.tile(np.arange(n), n), np.arange(0, n * n + 1, n)),
-                                   shape=(n, n))
-        self.q = problem.q
-        self.mu = problem.mu
-        self.d = problem.contact_dim
+    def __init__(self, program: FrictionProgram) -> None:
+        self.program = program
+        self.q = program.q
+        self.mu = program.mu
+        self.d = program.contact_dim
         self.n = self.q.size
         self.qn = float(np.linalg.norm(self.q)) or 1.0
-        self.rho = scales(self.W.diagonal(), self.d)
+
+    @cached_property
+    def W(self) -> sp.csr_matrix:
+        """W as compressed rows (every entry of a dense W stored: no scan for zeros, which
+        costs more than a sweep)."""
+        W = self.program.W
+        if sp.issparse(W):
+            rows = sp.csr_matrix(W, dtype=float)
+            rows.sum_duplicates()
+            return rows
+        n = self.n
+        return sp.csr_matrix((np.asarray(W, dtype=float).ravel(), np.tile(np.arange(n), n),
+                              np.arange(0, n * n + 1, n)), shape=(n, n))
+
+    @cached_property
+    def dense(self) -> np.ndarray:
+        """W as a dense C-contiguous float array."""
+        W = self.program.W
+        return np.ascontiguousarray(W.toarray() if sp.issparse(W) else W, dtype=float)
+
+    @cached_property
+    def rho(self) -> np.ndarray:
+        return scales(self.W.diagonal(), self.d)
 
     def velocity(self, r: np.ndarray) -> np.ndarray:
         """u = W r + q."""
@@ -117,7 +135,7 @@ def lstsq_newton(data: FrictionData, r: np.ndarray, tol: float) -> tuple[np.ndar
     steps J Δ = −F (LAPACK's rank-revealing gelsy; J is singular where W is) with
     J = I − D_P(I − D_ũ W), and backtracking on ‖F‖. Dense: for at most :data:`LSTSQ_MAX`
     unknowns. Returns what :func:`newton` returns."""
-    W, q, mu, d = data.W.toarray(), data.q, data.mu, data.d
+    W, q, mu, d = data.dense, data.q, data.mu, data.d
     n, m = data.n, mu.size
     u = W @ r + q
     F = natural_map(r, u, mu, d)
