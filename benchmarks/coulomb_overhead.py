@@ -11,27 +11,13 @@ the median over repeated calls of ``iq.solve(problem, iq.Coulomb(μ))`` and of
 
 from __future__ import annotations
 
-import statistics
-import time
-from collections.abc import Callable
-
 import impactqp as iq
 
 from .friction_impacts import spheres_in_a_row
+from .friction_steps import per_step
 
 MU = 0.3
 REPEATS = 2000
-
-
-def median_seconds(call: Callable[[], object], repeats: int = REPEATS) -> float:
-    """Median wall-clock seconds of ``call`` after one warm-up call."""
-    call()
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        call()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
 
 
 def cases() -> dict[str, iq.ImpactProblem]:
@@ -44,10 +30,10 @@ def main() -> None:
     for label, problem in cases().items():
         law = iq.Coulomb(MU)
         local = law.local_problem(problem)[0]
-        a = median_seconds(lambda p=problem, law=law: iq.solve(p, law))
-        b = median_seconds(lambda local=local: iq.solve_friction(local))
+        a = per_step(lambda p=problem, law=law: iq.solve(p, law), 1, REPEATS)
+        b = per_step(lambda local=local: iq.solve_friction(local), 1, REPEATS)
         backend = iq.solve(problem, law).backend
-        print(f"{label}: iq.solve(Coulomb) {a * 1e6:.1f} µs, solve_friction {b * 1e6:.1f} µs, "
+        print(f"{label}: iq.solve(Coulomb) {a:.1f} µs, solve_friction {b:.1f} µs (medians), "
               f"ratio {a / b:.2f} (backend {backend!r})")
 
 

@@ -89,8 +89,8 @@ def solve_local(problem: FrictionContactProblem, backend: str, tol: float) -> Ou
         u = problem.velocity(sol.r)
         return (sol, u), certify_friction(problem, sol.r, u, tol=tol)
 
-    candidates = plan(backends.FRICTION, problem, finish, backend)
-    return solve_certified(candidates, named=backend != "auto", tol=tol)
+    planned = plan(backends.FRICTION, problem, finish, backend)
+    return solve_certified(planned, named=backend != "auto", tol=tol)
 
 
 def _result(out: Outcome, seconds: float) -> FrictionResult:

@@ -2,9 +2,9 @@
 certified loop of impactqp, for quadratic programs, cone programs and frictional contact
 problems (docs/theory.md §9).
 
-The caller hands a list of :class:`Candidate` (backend, form, program, and ``finish``: the
-caller's recovery of its answer from the backend's solution together with its certificate).
-``"auto"`` builds that list from the registry; a named backend is one candidate. Iterative
+The caller hands a :class:`Plan` (form, program, ``finish``: the caller's recovery of its
+answer from the backend's solution together with its certificate, and the backends to try):
+``"auto"`` lists them from the registry, a named backend is tried alone. Iterative
 answers are polished (docs/theory.md §9, §15) and quadratic and cone programs retried once
 with a tighter tolerance; a failed certificate never becomes a success. Every QP backend sees
 the program normalized to order one (:mod:`.scaling`), so answers do not depend on units. This
@@ -18,8 +18,7 @@ import logging
 import math
 import weakref
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -34,7 +33,7 @@ from ..errors import (
 )
 from . import backends
 from .backends.exact import MAX_CONSTRAINTS
-from .kinds import QPKind, kind_of
+from .kinds import kind_of
 from .program import QuadraticProgram
 
 Finish = Callable[[Any], tuple[Any, ResidualChecks]]
@@ -58,20 +57,19 @@ FAST_PATHS = ("kernel", "isotonic")
 """Exact special-structure backends that ``"auto"`` tries before any general one."""
 
 
-@dataclass(frozen=True)
-class Candidate:
-    """One way to try: a backend on a program of a given form; ``checked`` when the
-    backend is known to take the program (else the loop asks when it gets there)."""
+class Plan(NamedTuple):
+    """The ways to try one program of a given form: its ``backends`` in order, and
+    ``checked`` when each is known to take the program (else the loop asks when it gets
+    there)."""
 
-    backend: str
     form: str
     program: Any
     finish: Finish
+    backends: Sequence[str]
     checked: bool = True
 
 
-@dataclass(frozen=True)
-class Outcome:
+class Outcome(NamedTuple):
     """A certified answer and how it was reached: the backend's ``solution`` it was recovered
     from and the registry name of the ``backend`` (one the caller may pass back)."""
 
@@ -123,8 +121,8 @@ def _auto_order(qp: QuadraticProgram, form: str) -> list[str]:
     return names
 
 
-def plan(form: str, qp: Any, finish: Finish, backend: str) -> list[Candidate]:
-    """The candidates for one program: the auto order, or the named backend alone.
+def plan(form: str, qp: Any, finish: Finish, backend: str) -> Plan:
+    """The plan for one program: the auto order, or the named backend alone.
 
     Raises
     ------
@@ -134,13 +132,12 @@ def plan(form: str, qp: Any, finish: Finish, backend: str) -> list[Candidate]:
         A named backend that cannot take the program (the message says why).
     """
     if backend == "auto":
-        checked = form in backends.FORMS
-        return [Candidate(name, form, qp, finish, checked) for name in auto_order(qp, form)]
+        return Plan(form, qp, finish, auto_order(qp, form), form in backends.FORMS)
     entry, _ = backends.parse_backend(backend)
     reason = backends.unsuitable(entry, qp, form)
     if reason is not None:
         raise BackendUnsuitableError(reason)
-    return [Candidate(backend, form, qp, finish)]
+    return Plan(form, qp, finish, (backend,))
 
 
 Stage = tuple[str, Callable[[], Any], Finish]
@@ -167,13 +164,13 @@ def solve_in_forms(stages: Sequence[Stage], backend: str,
     unsuitable, failures, log = [], [], []
     for form, build, finish in stages:
         try:
-            candidates = plan(form, build(), finish, backend)
+            planned = plan(form, build(), finish, backend)
         except BackendUnsuitableError as exc:
             unsuitable.append(str(exc))
             LOG.info("%s form refused by %s: %s", form, backend, exc)
             continue
         try:
-            out = solve_certified(candidates, named=backend != "auto", options=options)
+            out = solve_certified(planned, named=backend != "auto", options=options)
         except CertificateError as exc:
             failures.append(str(exc))
             _note(log, f"{form} form: {exc}", logging.INFO)
@@ -190,10 +187,10 @@ def _better(new: ResidualChecks, old: ResidualChecks) -> bool:
     return new.ok and (not old.ok or not math.isfinite(b) or a <= b)
 
 
-def solve_certified(candidates: Sequence[Candidate], *, named: bool,
-                    tol: float = 1e-10, options: dict | None = None) -> Outcome:
-    """The one certified loop: try each candidate (all of one form) until an answer passes
-    its certificate, for quadratic programs, cone programs and frictional contact problems
+def solve_certified(planned: Plan, *, named: bool, tol: float = 1e-10,
+                    options: dict | None = None) -> Outcome:
+    """The one certified loop: try each backend of the plan until an answer passes its
+    certificate, for quadratic programs, cone programs and frictional contact problems
     alike (how each kind is run and polished: :mod:`.kinds`). Iterative answers are polished
     and kept when their certificate is at least as good; every attempt is recorded.
 
@@ -204,26 +201,27 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
     NoSolutionError
         The impulse-form LCP has no feasible point (the law has no solution).
     CertificateError
-        No candidate produced an answer within the certificate's tolerance.
+        No backend produced an answer within the certificate's tolerance.
     """
+    form, program, finish = planned.form, planned.program, planned.finish
     log: list[str] = []
-    kind = kind_of(candidates[0].form) if candidates else QPKind()
+    kind = kind_of(form)
     warm, warm_value = None, math.inf  # the best uncertified answer, where a method starts
-    for cand in candidates:
-        entry, sub = backends.parse_backend(cand.backend)
+    for name in planned.backends:
+        entry, sub = backends.parse_backend(name)
         try:
             module = backends.load(entry)
         except UnknownBackendError:
             if named:
                 raise
-            _note(log, f"{cand.backend}: not installed", logging.INFO)
+            _note(log, f"{name}: not installed", logging.INFO)
             continue
-        if not cand.checked:
-            reason = backends.unsuitable(entry, cand.program, cand.form)
+        if not planned.checked:
+            reason = backends.unsuitable(entry, program, form)
             if reason is not None:
-                _note(log, f"{cand.backend}: unsuitable ({reason})", logging.DEBUG)
+                _note(log, f"{name}: unsuitable ({reason})")
                 continue
-        prepared = kind.prepare(entry, cand.program)
+        prepared = kind.prepare(entry, program)
         for attempt_tol in kind.tolerances(entry, tol):
             try:
                 raw = kind.run(module, entry, sub, prepared, attempt_tol, options, warm)
@@ -232,32 +230,32 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
             except (BackendUnsuitableError, UnknownBackendError) as exc:
                 if named:
                     raise
-                _note(log, f"{cand.backend}: unsuitable ({exc})", logging.INFO)
+                _note(log, f"{name}: unsuitable ({exc})", logging.INFO)
                 break
             except (SolverError, NoSolutionError, FloatingPointError, ValueError,
                     np.linalg.LinAlgError) as exc:
-                _note(log, f"{cand.backend} ({cand.form}): {exc}")
+                _note(log, f"{name} ({form}): {exc}")
                 if entry.exact:
                     break
                 continue
             sol = kind.solution(prepared, raw)
-            answer, cert = cand.finish(sol)
+            answer, cert = finish(sol)
             if not entry.exact:
                 polished = kind.polish(prepared, raw, attempt_tol)
                 if polished is not None:
                     sol_p = kind.solution(prepared, polished)
-                    answer_p, cert_p = cand.finish(sol_p)
+                    answer_p, cert_p = finish(sol_p)
                     if _better(cert_p, cert):
-                        _note(log, f"{sol.backend} ({cand.form}): polished, certified")
+                        _note(log, f"{sol.backend} ({form}): polished, certified")
                         _verdict(cert_p)
-                        return Outcome(answer_p, cert_p, sol_p, sol.backend, cand.form, log)
+                        return Outcome(answer_p, cert_p, sol_p, sol.backend, form, log)
             if cert.ok:
-                _note(log, f"{sol.backend} ({cand.form}): certified")
+                _note(log, f"{sol.backend} ({form}): certified")
                 _verdict(cert)
-                return Outcome(answer, cert, sol, sol.backend, cand.form, log)
-            name, value = cert.worst
+                return Outcome(answer, cert, sol, sol.backend, form, log)
+            worst, value = cert.worst
             if value < warm_value:
                 warm, warm_value = sol, value
-            _note(log, f"{cand.backend} ({cand.form}, tol {attempt_tol:.0e}): certificate "
-                       f"failed, {name} = {value:.1e}")
-    raise kind.failure([c.program for c in candidates], log)
+            _note(log, f"{name} ({form}, tol {attempt_tol:.0e}): certificate failed, "
+                       f"{worst} = {value:.1e}")
+    raise kind.failure(program, log)

@@ -65,6 +65,6 @@ def solve_cone(program: ConeProgram, backend: str = "clarabel", *, tol: float = 
         checks = program.certificate(sol.x, sol.z, accept)
         return dataclasses.replace(sol, checks=checks), checks
 
-    candidates = plan(backends.CONE, program, finish, backend)
-    return solve_certified(candidates, named=backend != "auto", tol=tol,
+    planned = plan(backends.CONE, program, finish, backend)
+    return solve_certified(planned, named=backend != "auto", tol=tol,
                            options=options).answer

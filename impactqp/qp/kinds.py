@@ -52,9 +52,8 @@ class QPKind:
         # velocities off by 1e-6), so this is always tried.
         return polish(prepared[0], raw)
 
-    def failure(self, programs: list[Any], log: list[str]) -> Exception:
-        impulse = [p for p in programs if p.nonnegative]
-        if impulse and not lcp_feasible(normalize(impulse[0])[0]):
+    def failure(self, program: QuadraticProgram, log: list[str]) -> Exception:
+        if program.nonnegative and not lcp_feasible(normalize(program)[0]):
             return NoSolutionError("the LCP 0 ≤ Λ ⟂ GΛ + q ≥ 0 has no feasible point, so the "
                                    "law has no solution for this pre-impact velocity")
         return CertificateError("no backend met the certificate: " + "; ".join(log))
@@ -85,13 +84,13 @@ class ConeKind:
     def polish(self, prepared: Any, raw: Any, tol: float) -> None:
         return None
 
-    def failure(self, programs: list[Any], log: list[str]) -> Exception:
+    def failure(self, program: Any, log: list[str]) -> Exception:
         return CertificateError("no backend certified the cone program: " + "; ".join(log))
 
 
 class FrictionKind:
     """Local frictional contact problems: a friction method's ``solve_friction`` once, at the
-    tolerance, from the best answer so far; the reaction projected onto the cones last, then
+    tolerance, from the best answer so far (each method returns r projected onto the cones),
     finished by Newton when the method leaves that to the loop and is short of tol/2."""
 
     def __init__(self) -> None:
@@ -107,10 +106,8 @@ class FrictionKind:
 
     def run(self, module: ModuleType, entry: Backend, sub: str | None, prepared: FrictionData,
             tol: float, options: dict | None, warm: FrictionSolution | None) -> FrictionSolution:
-        start = np.zeros_like(prepared.q) if warm is None else warm.r
-        found = module.solve_friction(prepared, start, tol=tol, method=entry.name)
-        return FrictionSolution(project_cones(found.r, prepared.mu, prepared.d),
-                                found.iterations, found.backend, found.polish_steps)
+        start = None if warm is None else warm.r  # None: the method's own start, r = 0
+        return module.solve_friction(prepared, start, tol=tol, method=entry.name)
 
     def solution(self, prepared: FrictionData, raw: FrictionSolution) -> FrictionSolution:
         return raw
@@ -123,7 +120,7 @@ class FrictionKind:
         return FrictionSolution(project_cones(r, prepared.mu, prepared.d),
                                 raw.iterations + steps, raw.backend)
 
-    def failure(self, programs: list[Any], log: list[str]) -> Exception:
+    def failure(self, program: Any, log: list[str]) -> Exception:
         return CertificateError("no method certified the frictional contact problem: "
                                 + "; ".join(log))
 

@@ -183,7 +183,6 @@ def parse_backend(name: object) -> tuple[Backend, str | None]:
     return entry, sub
 
 
-@cache
 def load(entry: Backend) -> ModuleType:
     """Import a backend's module.
 
@@ -192,11 +191,21 @@ def load(entry: Backend) -> ModuleType:
     UnknownBackendError
         When the solver it wraps is not installed (the message says what to install).
     """
+    module = _LOADED.get(entry.module)
+    if module is not None:
+        return module
     try:
-        return importlib.import_module(f".{entry.module}", __name__)
+        module = importlib.import_module(f".{entry.module}", __name__)
     except ImportError as exc:  # a missing optional solver must not break impactqp
         raise UnknownBackendError(f"backend {entry.name!r} is not installed ({exc}); "
                                   f"install {entry.install}") from exc
+    _LOADED[entry.module] = module
+    return module
+
+
+_LOADED: dict[str, ModuleType] = {}
+"""The backend modules imported so far, by module name (a lookup per attempt, not a hash
+of the whole entry)."""
 
 
 def check_options(backend: str, options: object) -> dict[str, object]:

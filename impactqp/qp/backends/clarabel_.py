@@ -87,7 +87,7 @@ def solve_cone(program: ConeProgram, *, tol: float = 1e-10, solver: str | None =
                         backend="clarabel", iterations=int(sol.iterations))
 
 
-def solve_friction(data: FrictionData, start: np.ndarray, *, tol: float,
+def solve_friction(data: FrictionData, start: np.ndarray | None, *, tol: float,
                    method: str) -> FrictionSolution:
     """The fixed point of second-order cone programs from ``start``
     (:func:`impactqp.qp.friction.methods.socp`)."""

@@ -73,7 +73,7 @@ def unsuitable_friction(program: FrictionProgram) -> str | None:
     return None
 
 
-def solve_friction(data: FrictionData, start: np.ndarray, *, tol: float,
+def solve_friction(data: FrictionData, start: np.ndarray | None, *, tol: float,
                    method: str) -> FrictionSolution:
     """The problem whole in one compiled call (:func:`impactqp.qp.friction.methods.small`)."""
     return methods.small(data, tol)

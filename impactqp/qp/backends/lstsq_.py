@@ -19,6 +19,6 @@ def unsuitable_friction(program: FrictionProgram) -> str | None:
     return None
 
 
-def solve_friction(data: FrictionData, start: np.ndarray, *, tol: float,
+def solve_friction(data: FrictionData, start: np.ndarray | None, *, tol: float,
                    method: str) -> FrictionSolution:
     return newton_method(data, start, tol, method)

@@ -11,6 +11,6 @@ from ..friction.methods import newton_method
 from ..friction.newton import FrictionData
 
 
-def solve_friction(data: FrictionData, start: np.ndarray, *, tol: float,
+def solve_friction(data: FrictionData, start: np.ndarray | None, *, tol: float,
                    method: str) -> FrictionSolution:
     return newton_method(data, start, tol, method)

@@ -11,6 +11,6 @@ from ..friction.methods import gauss_seidel
 from ..friction.newton import FrictionData
 
 
-def solve_friction(data: FrictionData, start: np.ndarray, *, tol: float,
+def solve_friction(data: FrictionData, start: np.ndarray | None, *, tol: float,
                    method: str) -> FrictionSolution:
     return gauss_seidel(data, start, tol, method)

@@ -9,8 +9,7 @@ the caller's certificate decides, as for every other program.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 
@@ -25,8 +24,7 @@ class FrictionProgram(Protocol):
     n_contacts: int
 
 
-@dataclass(frozen=True)
-class FrictionSolution:
+class FrictionSolution(NamedTuple):
     """A friction backend's answer.
 
     Attributes

@@ -15,7 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...errors import SolverError
-from ...kernels.friction import modified_velocity, nsgs_rows
+from ...kernels.friction import modified_velocity, nsgs_rows, project_cones
 from ...kernels.friction_newton import scales, solve_small
 from ..cone_solve import solve_cone
 from ..cones import ConeProgram, friction_cone_rows
@@ -163,7 +163,8 @@ def short_nsgs_route(data: FrictionData, tol: float) -> tuple[np.ndarray, int, b
 
 def small(data: FrictionData, tol: float) -> FrictionSolution:
     """The ``"kernel"`` method: the problem whole in one compiled call
-    (:func:`impactqp.kernels.friction_newton.solve_small`), W made dense.
+    (:func:`impactqp.kernels.friction_newton.solve_small`, which leaves r projected onto the
+    cones), W made dense.
 
     Raises
     ------
@@ -178,32 +179,38 @@ def small(data: FrictionData, tol: float) -> FrictionSolution:
     return FrictionSolution(r, int(its), "kernel")
 
 
-def socp(data: FrictionData, start: np.ndarray, tol: float) -> FrictionSolution:
-    """The ``"clarabel"`` method: :func:`socp_route` from ``start``, polished by Newton when
-    it ends short of the tolerance."""
-    r, its, finished = socp_route(data, start, tol)
-    return FrictionSolution(r, its, "clarabel", 0 if finished else NEWTON_STEPS)
+def _from(data: FrictionData, start: np.ndarray | None) -> np.ndarray:
+    """Where a method that takes a start begins: ``start``, or r = 0."""
+    return np.zeros_like(data.q) if start is None else start
 
 
-def gauss_seidel(data: FrictionData, start: np.ndarray, tol: float,
+def socp(data: FrictionData, start: np.ndarray | None, tol: float) -> FrictionSolution:
+    """The ``"clarabel"`` method: :func:`socp_route` from ``start`` (None: r = 0), polished by
+    Newton when it ends short of the tolerance."""
+    r, its, finished = socp_route(data, _from(data, start), tol)
+    return FrictionSolution(project_cones(r, data.mu, data.d), its, "clarabel",
+                            0 if finished else NEWTON_STEPS)
+
+
+def gauss_seidel(data: FrictionData, start: np.ndarray | None, tol: float,
                  method: str) -> FrictionSolution:
     """The ``"nsgs-short"`` method (:func:`short_nsgs_route` from r = 0) and the ``"nsgs"``
     one (:data:`NSGS_SWEEPS` sweeps from ``start``, then up to :data:`POLISH_STEPS` Newton
     steps when short of the tolerance)."""
     if method == "nsgs-short":
         r, its, _ = short_nsgs_route(data, tol)
-        return FrictionSolution(r, its, method)
-    r, its, _ = nsgs_route(data, start, tol, NSGS_SWEEPS)
-    return FrictionSolution(r, its, method, POLISH_STEPS)
+        return FrictionSolution(project_cones(r, data.mu, data.d), its, method)
+    r, its, _ = nsgs_route(data, _from(data, start), tol, NSGS_SWEEPS)
+    return FrictionSolution(project_cones(r, data.mu, data.d), its, method, POLISH_STEPS)
 
 
-def newton_method(data: FrictionData, start: np.ndarray, tol: float,
+def newton_method(data: FrictionData, start: np.ndarray | None, tol: float,
                   method: str) -> FrictionSolution:
     """The ``"newton"`` and ``"newton-damped"`` methods (Alart–Curnier's Newton from r = 0
     with the shift factor of :data:`NEWTON_SHIFT`) and ``"newton-lstsq"`` (the least-squares
-    Newton on the natural map from ``start``)."""
+    Newton on the natural map from ``start``); both end with r projected onto the cones."""
     if method == "newton-lstsq":
-        r, its, _ = lstsq_newton(data, start, tol)
+        r, its, _ = lstsq_newton(data, _from(data, start), tol)
     else:
         r, its, _ = newton(data, np.zeros_like(data.q), tol, NEWTON_SHIFT[method])
     return FrictionSolution(r, its, method)

@@ -6,7 +6,7 @@ with :class:`FrictionData`, the problem's arrays as every friction method uses t
 
 from __future__ import annotations
 
-from functools import cached_property
+from collections.abc import Callable
 
 import numpy as np
 import scipy.linalg as sla
@@ -33,9 +33,10 @@ LSTSQ_MAX = 600
 
 
 class FrictionData:
-    """The problem's arrays as the friction methods use them, built when first asked for (a
-    problem the compiled call certifies never needs its compressed rows): W as compressed rows,
-    W dense, and the scale ρ_c of each contact's Alart–Curnier function (:func:`scales`)."""
+    """The problem's arrays as the friction methods use them, each built when first asked for
+    (a problem the compiled call certifies never needs its compressed rows): W as compressed
+    rows, W dense, ‖q‖, and the scale ρ_c of each contact's Alart–Curnier function
+    (:func:`scales`)."""
 
     def __init__(self, program: FrictionProgram) -> None:
         self.program = program
@@ -43,30 +44,48 @@ class FrictionData:
         self.mu = program.mu
         self.d = program.contact_dim
         self.n = self.q.size
-        self.qn = float(np.linalg.norm(self.q)) or 1.0
+        self._rows: sp.csr_matrix | None = None
+        self._dense: np.ndarray | None = None
+        self._qn: float | None = None
+        self._rho: np.ndarray | None = None
 
-    @cached_property
+    @property
     def W(self) -> sp.csr_matrix:
         """W as compressed rows (every entry of a dense W stored: no scan for zeros, which
         costs more than a sweep)."""
-        W = self.program.W
-        if sp.issparse(W):
-            rows = sp.csr_matrix(W, dtype=float)
-            rows.sum_duplicates()
-            return rows
-        n = self.n
-        return sp.csr_matrix((np.asarray(W, dtype=float).ravel(), np.tile(np.arange(n), n),
-                              np.arange(0, n * n + 1, n)), shape=(n, n))
+        if self._rows is None:
+            W = self.program.W
+            if sp.issparse(W):
+                self._rows = sp.csr_matrix(W, dtype=float)
+                self._rows.sum_duplicates()
+            else:
+                n = self.n
+                self._rows = sp.csr_matrix((np.asarray(W, dtype=float).ravel(),
+                                            np.tile(np.arange(n), n),
+                                            np.arange(0, n * n + 1, n)), shape=(n, n))
+        return self._rows
 
-    @cached_property
+    @property
     def dense(self) -> np.ndarray:
         """W as a dense C-contiguous float array."""
-        W = self.program.W
-        return np.ascontiguousarray(W.toarray() if sp.issparse(W) else W, dtype=float)
+        if self._dense is None:
+            W = self.program.W
+            self._dense = np.ascontiguousarray(W.toarray() if sp.issparse(W) else W,
+                                               dtype=float)
+        return self._dense
 
-    @cached_property
+    @property
+    def qn(self) -> float:
+        """‖q‖ (1 for q = 0)."""
+        if self._qn is None:
+            self._qn = float(np.linalg.norm(self.q)) or 1.0
+        return self._qn
+
+    @property
     def rho(self) -> np.ndarray:
-        return scales(self.W.diagonal(), self.d)
+        if self._rho is None:
+            self._rho = scales(self.W.diagonal(), self.d)
+        return self._rho
 
     def velocity(self, r: np.ndarray) -> np.ndarray:
         """u = W r + q."""
@@ -75,6 +94,32 @@ class FrictionData:
     def error(self, r: np.ndarray) -> float:
         """‖F(r)‖/‖q‖."""
         return float(np.linalg.norm(natural_map(r, self.velocity(r), self.mu, self.d))) / self.qn
+
+    def finished(self, r: np.ndarray, f: float, tol: float) -> np.ndarray | None:
+        """r projected onto the cones when ‖F(r)‖ = ``f`` is within tol/2·‖q‖ and the
+        projected r too (projecting moves r by up to ‖F‖, hence u by up to ‖W‖‖F‖); else
+        None."""
+        if f > 0.5 * tol * self.qn:
+            return None
+        rp = project_cones(r, self.mu, self.d)
+        return rp if self.error(rp) <= 0.5 * tol else None
+
+
+def backtrack(r: np.ndarray, step: np.ndarray, f: float,
+              residual: Callable[[np.ndarray], np.ndarray]
+              ) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """Armijo backtracking on ‖residual‖ along ``step`` from r (‖residual(r)‖ = f): the first
+    of t = 1, 1/2, … (down to 1e-8) with ‖residual(r + t·step)‖ ≤ (1 − 10⁻⁴t)f, as
+    (r + t·step, its residual, its norm); None when there is none (no descent: stalled)."""
+    t = 1.0
+    while t > 1e-8:
+        r_try = r + t * step
+        res = residual(r_try)
+        f_try = float(np.linalg.norm(res))
+        if f_try <= (1.0 - 1e-4 * t) * f:
+            return r_try, res, f_try
+        t *= 0.5
+    return None
 
 
 def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
@@ -99,10 +144,9 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
     f = float(np.linalg.norm(phi))
     steps = 0
     while True:
-        if np.linalg.norm(natural_map(r, u, mu, d)) <= 0.5 * tol * data.qn:
-            rp = project_cones(r, mu, d)
-            if data.error(rp) <= 0.5 * tol:
-                return rp, steps, True
+        rp = data.finished(r, float(np.linalg.norm(natural_map(r, u, mu, d))), tol)
+        if rp is not None:
+            return rp, steps, True
         if steps == max_steps:
             break
         steps += 1
@@ -113,18 +157,12 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
             step = spla.splu(sp.csc_matrix(J)).solve(-phi)
         except RuntimeError:  # an exactly singular J
             break
-        t = 1.0
-        while t > 1e-8:
-            r_try = r + t * step
-            u_try = data.velocity(r_try)
-            phi_try = alart_curnier(r_try, u_try, mu, rho, d, False, A, B)
-            f_try = float(np.linalg.norm(phi_try))
-            if f_try <= (1.0 - 1e-4 * t) * f:
-                break
-            t *= 0.5
-        else:
+        found = backtrack(r, step, f, lambda x: alart_curnier(x, data.velocity(x), mu, rho,
+                                                              d, False, A, B))
+        if found is None:
             break  # no descent: stalled
-        r, u = r_try, u_try
+        r = found[0]
+        u = data.velocity(r)
         phi = alart_curnier(r, u, mu, rho, d, True, A, B)
         f = float(np.linalg.norm(phi))
     return project_cones(r, mu, d), steps, False
@@ -142,10 +180,9 @@ def lstsq_newton(data: FrictionData, r: np.ndarray, tol: float) -> tuple[np.ndar
     f = float(np.linalg.norm(F))
     steps = 0
     while True:
-        if f <= 0.5 * tol * data.qn:
-            rp = project_cones(r, mu, d)
-            if data.error(rp) <= 0.5 * tol:
-                return rp, steps, True
+        rp = data.finished(r, f, tol)
+        if rp is not None:
+            return rp, steps, True
         if steps == LSTSQ_STEPS:
             break
         steps += 1
@@ -155,16 +192,9 @@ def lstsq_newton(data: FrictionData, r: np.ndarray, tol: float) -> tuple[np.ndar
         J = np.einsum("cij,cjk->cik", DP, DUW).reshape(n, n) + np.eye(n)
         J -= sla.block_diag(*DP)
         step = sla.lstsq(J, -F, lapack_driver="gelsy", check_finite=False)[0]
-        t = 1.0
-        while t > 1e-8:
-            r_try = r + t * step
-            u_try = W @ r_try + q
-            F_try = natural_map(r_try, u_try, mu, d)
-            f_try = float(np.linalg.norm(F_try))
-            if f_try <= (1.0 - 1e-4 * t) * f:
-                break
-            t *= 0.5
-        else:
+        found = backtrack(r, step, f, lambda x: natural_map(x, W @ x + q, mu, d))
+        if found is None:
             break  # no descent: stalled
-        r, u, F, f = r_try, u_try, F_try, f_try
+        r, F, f = found
+        u = W @ r + q
     return project_cones(r, mu, d), steps, False
