@@ -137,7 +137,7 @@ class Coulomb(ImpactLaw):
 
     @property
     def default_backend(self) -> str:
-        """The backend ``iq.solve(..., backend="auto")`` uses: :attr:`method`."""
+        """The backend ``iq.solve(..., backend="auto")`` uses: the law's ``method``."""
         return self.method
 
     # --- coefficients -----------------------------------------------------------------
