@@ -189,7 +189,7 @@ def test_named_fast_paths_serve_other_laws_and_lcps() -> None:
 def test_readme_table_is_the_registry() -> None:
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     assert backend_table() in readme
-    rows = re.findall(r"^\| `\"([a-z]+)\"` \|", readme, flags=re.M)
+    rows = re.findall(r"^\| `\"([a-z-]+)\"` \|", readme, flags=re.M)
     assert rows == ["auto"] + BACKENDS
     assert [law.name for law in LAWS] == ["moreau", "newton", "fremond", "sector", "reflection",
                                           "lzb"]

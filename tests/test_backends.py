@@ -122,7 +122,7 @@ def test_polish_makes_an_ill_conditioned_chain_exact():
     n = 10_000
     p = iq.newtons_cradle(n)
     r = iq.moreau(p, 0.0, backend="clarabel")
-    assert r.backend == "clarabel+polish"
+    assert r.backend == "clarabel" and any("polished" in a for a in r.attempts)
     np.testing.assert_allclose(r.u_plus, 1.0 / n, rtol=1e-9)
 
 

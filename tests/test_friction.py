@@ -20,9 +20,9 @@ from impactqp.kernels.friction import (
     projection_jacobian,
 )
 from impactqp.kernels.friction_newton import lu_solve, scales, solve_small
-from impactqp.laws import friction as friction_law
-from impactqp.laws import friction_newton
 from impactqp.model.friction import certify_friction
+from impactqp.qp.friction import methods as friction_methods
+from impactqp.qp.friction import newton as friction_newton
 
 BACKENDS = ("auto", "newton", "clarabel", "nsgs")
 
@@ -153,7 +153,7 @@ def test_rank_deficient_W_with_a_known_solution(mu: float) -> None:
 def general_route(problem):
     """``auto`` without the compiled call of a few contacts."""
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(friction_law, "SMALL_CONTACTS", 0)
+        patch.setattr(friction_methods, "SMALL_CONTACTS", 0)
         return iq.solve_friction(problem)
 
 
@@ -166,7 +166,7 @@ def test_least_squares_newton_agrees_with_newton_on_alart_curnier(mu: float) -> 
     H = rng.standard_normal((m * d // 2, m * d))
     problem = iq.FrictionContactProblem(H.T @ H / 9.0, H.T @ rng.standard_normal(9), mu)
     data = friction_newton.FrictionData(problem)
-    start = friction_law._nsgs_route(data, np.zeros(m * d), 1e-8, 5)[0]
+    start = friction_methods.nsgs_route(data, np.zeros(m * d), 1e-8, 5)[0]
     found = [friction_newton.lstsq_newton(data, start, 1e-8),
              friction_newton.newton(data, start, 1e-8)]
     for r, _, ok in found:
@@ -246,7 +246,7 @@ def test_no_solution_is_a_certificate_error() -> None:
     problem = iq.FrictionContactProblem(np.zeros((3, 3)), [-1.0, 0.0, 0.0], 0.5)
     with pytest.raises(iq.CertificateError, match="natural_map|clarabel"):
         iq.solve_friction(problem)
-    with pytest.raises(iq.CertificateError, match="newton-damped: .*natural_map"):
+    with pytest.raises(iq.CertificateError, match=r"newton \(friction, .*natural_map"):
         iq.solve_friction(problem, backend="newton")
 
 
@@ -428,7 +428,10 @@ def test_zero_free_velocity_gives_zero_reaction() -> None:
 
 def test_result_fields() -> None:
     res = iq.solve_friction(random_problem(3, 3, 0.5, seed=1), backend="clarabel")
-    assert res.backend == "clarabel+newton" and res.iterations >= 1 and res.solve_time > 0
+    assert res.backend == "clarabel" and res.iterations >= 1 and res.solve_time > 0
+    assert res.success and res.status == "solved" and "clarabel" in res.message
+    assert res.attempts[-1].startswith("clarabel (friction)")
+    assert len(repr(res)) < 200 and "FrictionResult" in repr(res)
     assert res.error == res.certificate.error
 
 

@@ -226,7 +226,8 @@ def test_a_frictional_file_without_law_asks_for_mu(capsys, tmp_path):
     (["--mu", "0.1,0.2"], "mu must be one number or one per contact"),
     (["--mu", "x"], "--mu must be numbers"),
     (["--e", "2"], "restitution must lie in [0, 1]"),
-    (["--backend", "osqp"], "method must be one of auto, clarabel, nsgs"),
+    (["--backend", "osqp"], "'osqp' does not solve frictional contact problems"),
+    (["--backend", "lemke"], "unknown backend 'lemke'"),
 ])
 def test_solve_frictional_bad_input_exits_2(capsys, flags, message):
     code, out, err = run(capsys, "solve", SAMPLE, *flags)

@@ -83,7 +83,7 @@ def abh_error(W, q, mu, d, r, qn):
 @kernel
 def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
     """Semismooth Newton on Alart–Curnier's function for a dense W, updating ``r`` in place:
-    the iteration of ``impactqp.laws.friction_newton.newton`` (docs/theory.md §15), its steps
+    the iteration of ``impactqp.qp.friction.newton.newton`` (docs/theory.md §15), its steps
     (J + λI)Δ = −Φ solved by :func:`lu_solve`. Once within tolerance it takes one step more
     and keeps it if it is better (near a solution a step gains digits quadratically: the few
     contacts of a time step are answered to round-off, not just to the tolerance). Returns

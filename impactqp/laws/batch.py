@@ -124,6 +124,8 @@ def _fast_path(problem: ImpactProblem, law: ImpactLaw, backend: str):
     for name in names:
         entry = backends.REGISTRY[name]
         for form in law.preferred_forms(problem):
+            if form not in backends.FORMS:  # rows of a frictional problem go one by one
+                continue
             qp = law.program(problem, form)
             reason = backends.unsuitable(entry, qp, form)
             if reason is None:

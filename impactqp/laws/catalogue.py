@@ -24,8 +24,8 @@ table)."""
 
 FRICTIONAL_LAWS: tuple[type[ImpactLaw], ...] = (Coulomb,)
 """The law classes impactqp ships for frictional contacts (docs/theory.md §16): solved
-through their local problem by the methods of :func:`~impactqp.solve_friction`, not by the
-QP backends, so they have no column in the backend table."""
+through their local problem (form ``"friction"``) by the registry's friction methods, as
+:func:`~impactqp.solve_friction` solves it."""
 
 NAMED_LAWS: dict[str, type[ImpactLaw]] = {law.name: law for law in (*LAWS, *FRICTIONAL_LAWS)
                                           if law.by_name}
@@ -50,7 +50,8 @@ def law_named(name: object, coefficients: Any = None) -> ImpactLaw:
 
 def laws_served(entry: backends.Backend) -> dict[str, tuple[str, ...]]:
     """For each shipped law, the forms in which ``entry`` can solve it (empty: not at all)."""
-    return {law.name: tuple(f for f in law.forms if f in entry.forms) for law in LAWS}
+    return {law.name: tuple(f for f in law.forms if f in entry.forms)
+            for law in (*LAWS, *FRICTIONAL_LAWS)}
 
 
 def available_backends() -> list[dict]:
@@ -73,11 +74,12 @@ def available_backends() -> list[dict]:
 
 def backend_table() -> str:
     """The laws × backends table in Markdown (what the README shows)."""
-    names = [law.name for law in LAWS]
+    names = [law.name for law in (*LAWS, *FRICTIONAL_LAWS)]
     head = "| backend | " + " | ".join(names) + " | serves |"
     rows = [head, "|" + "---|" * (len(names) + 2)]
     rows.append("| `\"auto\"` | " + " | ".join("✓" for _ in names)
-                + " | fast path if one applies, else QP backends, falling back on failure |")
+                + " | fast path if one applies, else QP backends (friction methods for "
+                "Coulomb), falling back on failure |")
     for item in available_backends():
         cells = []
         for name in names:

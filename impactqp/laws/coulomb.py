@@ -5,8 +5,10 @@ At each contact c (d = 2 or 3 columns of W, the normal first) the impulse Λ_c a
 Newton-shifted contact velocity U_c = W_cᵀu⁺ + e_c γ⁻_n,c e_n satisfy De Saxcé's
 complementarity Λ_c ∈ K_μc ⟂ U_c + μ_c‖U_T,c‖e_n ∈ K*_μc, with M(u⁺ − u⁻) = WΛ. Eliminating
 u⁺ leaves the local problem U = GΛ + q of :class:`~impactqp.FrictionContactProblem`
-(G = WᵀM⁻¹W, q = Wᵀu⁻ plus e∘γ⁻_n on the normal rows), solved and certified by
-:func:`~impactqp.solve_friction`; u⁺ = u⁻ + M⁻¹WΛ.
+(G = WᵀM⁻¹W, q = Wᵀu⁻ plus e∘γ⁻_n on the normal rows), posed once in contact units as the
+law's program of form ``"friction"`` and solved by the registry's friction methods through the
+one certified loop, like any law's program; u⁺ = u⁻ + M⁻¹WΛ, and the law's certificate is the
+only one computed.
 """
 
 from __future__ import annotations
@@ -16,23 +18,18 @@ from typing import Any
 import numpy as np
 
 from ..base.arrays import as_array
-from ..errors import CertificateError, InputError, NonFiniteError, RestitutionError
+from ..errors import InputError, NonFiniteError, RestitutionError
 from ..model.admissible import AdmissibleSet
 from ..model.friction import FrictionContactProblem, certify_friction, friction_coefficients
 from ..model.problem import ImpactProblem
 from ..model.residuals import impact_residuals, normalized_rows
 from ..model.structure import ImpactStructure
+from ..qp.backends import FRICTION
+from ..qp.friction import FrictionSolution
 from .base import Answer, ImpactLaw
-from .friction import FRICTION_BACKENDS, solve_friction
+from .friction import FRICTION_BACKENDS
 
 __all__ = ["Coulomb", "local_problem"]
-
-SOLVE_TOL = 1e-10
-"""Tolerance the local problem is solved to first (a tenth of the default certificate's)."""
-
-LOOSE_TOL = 1e-7
-"""Tolerance tried when :data:`SOLVE_TOL` is not reached; the certificate at the caller's
-tolerance still decides whether the answer is returned."""
 
 
 def local_problem(structure: ImpactStructure, u_minus: np.ndarray, mu: np.ndarray,
@@ -86,8 +83,11 @@ class Coulomb(ImpactLaw):
         Friction coefficients, one for all contacts or one per contact, each ≥ 0.
     restitution : float or (m,) array_like
         Newton's coefficients e_c ∈ [0, 1] of the normal velocities.
-    method : {"auto", "clarabel", "nsgs"}
-        The method of :func:`~impactqp.solve_friction` for the local problem.
+    method : str
+        The friction method of the local problem when ``iq.solve`` is called with
+        ``backend="auto"``: ``"auto"`` or a name of
+        :data:`~impactqp.laws.friction.FRICTION_BACKENDS` (``backend=`` of ``iq.solve``, when
+        named, takes precedence).
 
     Attributes
     ----------
@@ -112,7 +112,7 @@ class Coulomb(ImpactLaw):
 
     name = "coulomb"
     title = "Coulomb's law"
-    closed_form_backend = "solve_friction"
+    forms = (FRICTION,)
     by_name = True
     coefficient_keys = ("mu", "e")
     coefficient_symbol = "(μ, e)"
@@ -133,6 +133,13 @@ class Coulomb(ImpactLaw):
                              f"{method!r}")
         self.method = method
         self._per_contact: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._posed: tuple[ImpactStructure, np.ndarray, FrictionContactProblem,
+                           np.ndarray] | None = None
+
+    @property
+    def default_backend(self) -> str:
+        """The backend ``iq.solve(..., backend="auto")`` uses: the law's ``method``."""
+        return self.method
 
     # --- coefficients -----------------------------------------------------------------
     @classmethod
@@ -201,19 +208,34 @@ class Coulomb(ImpactLaw):
         """The local problem of this impact in contact units and the units s
         (:func:`local_problem`): its reaction r is sΛ."""
         self.check(problem)
-        return local_problem(problem.structure, problem.u_minus,
-                             *self.per_contact(problem.n_contacts))
+        return self._local(problem.structure, problem.u_minus)
+
+    def _local(self, structure: ImpactStructure,
+               u_minus: np.ndarray) -> tuple[FrictionContactProblem, np.ndarray]:
+        """:func:`local_problem` of (structure, u⁻), posed once: the program and the
+        certificate of one solve share it (u⁻ of a problem is read-only, so the same array
+        means the same problem)."""
+        posed = self._posed
+        if posed is not None and posed[0] is structure and posed[1] is u_minus \
+                and not u_minus.flags.writeable:
+            return posed[2], posed[3]
+        local, units = local_problem(structure, u_minus, *self.per_contact(structure.n_contacts))
+        self._posed = structure, u_minus, local, units
+        return local, units
 
     # --- solve ------------------------------------------------------------------------
-    def closed_form(self, problem: ImpactProblem) -> Answer:
-        """Solve the local problem (:func:`~impactqp.solve_friction`) and recover
-        u⁺ = u⁻ + M⁻¹WΛ."""
-        local, units = self.local_problem(problem)
-        try:
-            found = solve_friction(local, backend=self.method, tol=SOLVE_TOL)
-        except CertificateError:
-            found = solve_friction(local, backend=self.method, tol=LOOSE_TOL)
-        impulses = found.r / units
+    def preferred_forms(self, problem: ImpactProblem) -> tuple[str, ...]:
+        return self.forms
+
+    def program(self, problem: ImpactProblem, form: str) -> FrictionContactProblem:
+        """The local problem in contact units (:meth:`local_problem`), the law's one program
+        (form ``"friction"``), for the registry's friction methods (the entry points have
+        checked the problem)."""
+        return self._local(problem.structure, problem.u_minus)[0]
+
+    def recover(self, problem: ImpactProblem, form: str, solution: FrictionSolution) -> Answer:
+        """Λ = r/s and u⁺ = u⁻ + M⁻¹WΛ from the local problem's reaction r."""
+        impulses = solution.r / self._local(problem.structure, problem.u_minus)[1]
         u_plus = problem.u_minus + problem.structure.impulse_velocity(impulses)
         return Answer(u_plus, impulses, None)
 
@@ -241,9 +263,9 @@ class Coulomb(ImpactLaw):
                             u_plus: np.ndarray, impulses: np.ndarray) -> dict[str, float]:
         if structure.m == 0:
             return dict.fromkeys(FRICTION_RESIDUALS, 0.0)
-        mu, e = self.per_contact(structure.n_contacts)
+        e = self.per_contact(structure.n_contacts)[1]
         d = structure.contact_dim
-        local, units = local_problem(structure, u_minus, mu, e)
+        local, units = self._local(structure, u_minus)
         with np.errstate(over="ignore", invalid="ignore"):
             checks = certify_friction(local, units * impulses).values
             shifted_normal = (structure.Wt_times(u_plus)[::d] +

@@ -90,8 +90,9 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         ``iq.Moreau(eps)``, ``iq.Newton(e)``, ``iq.Fremond(E)``, ``iq.SectorLaw()``,
         ``iq.ReflectionLaw()`` or any subclass of :class:`impactqp.ImpactLaw`.
     backend : str
-        ``"auto"`` (exact fast paths first, then QP solvers, falling back on failure) or a
-        registered backend (:func:`impactqp.available_backends`), tried alone.
+        ``"auto"`` (exact fast paths first, then QP solvers, falling back on failure; for
+        Coulomb's law the friction methods in the registry's order) or a registered backend
+        that serves the law's program (:func:`impactqp.available_backends`), tried alone.
     form : {"auto", "velocity", "impulse"}
         Which program to solve, for laws that have several (they give the same u⁺).
     tol : float
@@ -131,6 +132,8 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
             return solve(problem, law, backend, form=form, tol=tol, options=options)
     start = time.perf_counter()
     tol = validate(problem, law, backend, form, tol)
+    if backend == "auto":  # a law may name the backend its own "auto" means (Coulomb's method)
+        backend = getattr(law, "default_backend", "auto")
     if options is not None:
         options = backends.check_options(backend, options)
     planned = plan(problem, law, backend, form)  # units, collapse and path, in one Route

@@ -1,8 +1,13 @@
-"""The result of one impact law on one impact problem (scipy-style: status, message, time)."""
+"""The results of impactqp's solvers, one family (scipy's ``OptimizeResult`` is the model):
+:class:`ImpactResult` of an impact law on an impact problem and :class:`FrictionResult` of a
+local frictional contact problem, both :class:`CertifiedResult` — ``success``, ``status``,
+``message``, ``backend``, ``attempts``, ``solve_time`` and the recomputed ``certificate``.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
 
@@ -11,10 +16,37 @@ import numpy as np
 from ..base.checks import ResidualChecks
 from ..model.admissible import Membership
 from ..model.classify import Classification, classify
+from ..model.friction import FrictionCertificate
 from ..model.problem import ImpactProblem
 
 
-class ImpactResult:
+class CertifiedResult:
+    """What every certified answer of impactqp says of itself.
+
+    A result is only returned when its certificate passes, so ``status`` is ``"solved"`` and
+    ``ok`` and ``success`` are True (as scipy's ``OptimizeResult`` and cvxpy's status say
+    so); ``backend`` is the registry name of what produced the numbers, one the caller may
+    pass back as ``backend=``; ``attempts`` lists what was tried, in order.
+    """
+
+    status = "solved"
+    backend: str
+    attempts: list[str]
+    solve_time: float
+    certificate: ResidualChecks
+
+    @property
+    def ok(self) -> bool:
+        """The certificate's verdict (True for every returned result)."""
+        return self.certificate.ok
+
+    @property
+    def success(self) -> bool:
+        """The same as :attr:`ok` (scipy's name)."""
+        return self.ok
+
+
+class ImpactResult(CertifiedResult):
     """Post-impact state computed by a law, with its recomputed certificate.
 
     A result is only returned when ``certificate.ok``; physical admissibility (u⁺ ∈ S) is a
@@ -72,8 +104,6 @@ class ImpactResult:
         self.attempts = attempts or []
         self._z = z
 
-    status = "solved"
-
     @property
     def certificate(self) -> ResidualChecks:
         """The recomputed residuals of the law that was solved (see the class docstring)."""
@@ -81,13 +111,6 @@ class ImpactResult:
         if not isinstance(cert, ResidualChecks):
             cert = self._certificate = cert()
         return cert
-
-    @property
-    def ok(self) -> bool:
-        """The certificate's verdict (True for every returned result)."""
-        return self.certificate.ok
-
-    success = ok
 
     @property
     def message(self) -> str:
@@ -141,3 +164,52 @@ class ImpactResult:
         return (f"ImpactResult(law={self.law!r}, backend={self.backend!r}, "
                 f"u_plus={np.array2string(self.u_plus, precision=6)}, "
                 f"certificate={self.certificate.summary()})")
+
+
+@dataclass(frozen=True, repr=False)
+class FrictionResult(CertifiedResult):
+    """A certified answer of :func:`impactqp.solve_friction` (docs/theory.md §15).
+
+    Attributes
+    ----------
+    r, u : ndarray
+        The reaction and the velocity u = W r + q.
+    error : float
+        ‖F‖/‖q‖, the natural-map error of the certificate (ABH).
+    certificate : FrictionCertificate
+        The recomputed checks; ``certificate.ok`` is always True here.
+    iterations : int
+        Sweeps, cone programs and Newton steps done.
+    solve_time : float
+        Wall-clock seconds.
+    backend : str
+        The friction method that produced the answer, a name ``backend=`` takes
+        (``"kernel"``, ``"nsgs-short"``, ``"newton"``, ``"clarabel"``, ...; ``attempts`` says
+        whether Newton polished it).
+    attempts : list of str
+        What was tried, in order.
+    status, message, success, ok
+        As for :class:`ImpactResult`.
+    """
+
+    r: np.ndarray
+    u: np.ndarray
+    error: float
+    certificate: FrictionCertificate
+    iterations: int
+    solve_time: float
+    backend: str
+    attempts: list[str] = field(default_factory=list)
+
+    @property
+    def message(self) -> str:
+        return (f"frictional contact problem solved by {self.backend} in {self.iterations} "
+                f"iterations, {self.solve_time * 1e3:.3g} ms; certificate "
+                f"{self.certificate.summary()}")
+
+    def __repr__(self) -> str:
+        d = self.certificate.values
+        return (f"FrictionResult(unknowns={self.r.size}, backend={self.backend!r}, "
+                f"status={self.status!r}, error={self.error:.1e}, "
+                f"certificate={'ok' if self.certificate.ok else 'FAILED'} "
+                f"(tol {self.certificate.tol:.0e}, {len(d)} checks))")

@@ -1,12 +1,15 @@
-"""Run programs on backends until one answer passes the caller's own certificate.
+"""Run programs on backends until one answer passes the caller's own certificate: the one
+certified loop of impactqp, for quadratic programs, cone programs and frictional contact
+problems (docs/theory.md §9).
 
-The caller hands a list of :class:`Candidate` (backend, form, program, and ``finish``: the
-caller's recovery of its answer from a :class:`~impactqp.qp.program.QPSolution` together
-with its certificate). ``"auto"`` builds that list from the registry; a named backend is
-one candidate. Iterative answers are polished (docs/theory.md §9) and retried once with a
-tighter tolerance; a failed certificate never becomes a success. Every backend sees the
-program normalized to order one (:mod:`.scaling`), so answers do not depend on units. This
-layer knows nothing of impacts: the certificate is whatever ``finish`` returns.
+The caller hands a :class:`Plan` (form, program, ``finish``: the caller's recovery of its
+answer from the backend's solution together with its certificate, and the backends to try):
+``"auto"`` lists them from the registry, a named backend is tried alone. Iterative
+answers are polished (docs/theory.md §9, §15) and quadratic and cone programs retried once
+with a tighter tolerance; a failed certificate never becomes a success. Every QP backend sees
+the program normalized to order one (:mod:`.scaling`), so answers do not depend on units. This
+layer knows nothing of impacts: the certificate is whatever ``finish`` returns, and the
+backend an answer reports is always a name the caller can pass back.
 """
 
 from __future__ import annotations
@@ -15,11 +18,9 @@ import logging
 import math
 import weakref
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
-from scipy.optimize import linprog
 
 from ..base.checks import ResidualChecks
 from ..errors import (
@@ -32,11 +33,11 @@ from ..errors import (
 )
 from . import backends
 from .backends.exact import MAX_CONSTRAINTS
-from .polish import polish
-from .program import QPSolution, QuadraticProgram
-from .scaling import Scaling, normalize
+from .kinds import kind_of
+from .program import QuadraticProgram
 
-Finish = Callable[[QPSolution], tuple[Any, ResidualChecks]]
+Finish = Callable[[Any], tuple[Any, ResidualChecks]]
+"""The caller's recovery of its answer from a backend's solution, with its certificate."""
 
 LOG = logging.getLogger(__name__)
 
@@ -56,34 +57,40 @@ FAST_PATHS = ("kernel", "isotonic")
 """Exact special-structure backends that ``"auto"`` tries before any general one."""
 
 
-@dataclass(frozen=True)
-class Candidate:
-    """One way to try: a backend on a program of a given form."""
+class Plan(NamedTuple):
+    """The ways to try one program of a given form: its ``backends`` in order, and
+    ``checked`` when each is known to take the program (else the loop asks when it gets
+    there)."""
 
-    backend: str
     form: str
-    program: QuadraticProgram
+    program: Any
     finish: Finish
+    backends: Sequence[str]
+    checked: bool = True
 
 
-@dataclass(frozen=True)
-class Outcome:
-    """A certified answer and how it was reached."""
+class Outcome(NamedTuple):
+    """A certified answer and how it was reached: the backend's ``solution`` it was recovered
+    from and the registry name of the ``backend`` (one the caller may pass back)."""
 
     answer: Any
     checks: ResidualChecks
+    solution: Any
     backend: str
     form: str
     attempts: list[str]
 
 
-def auto_order(qp: QuadraticProgram, form: str) -> list[str]:
-    """The backends ``"auto"`` tries on ``qp``, least overhead and exact first (measured in
-    benchmarks/: the kernel and isotonic regression beat every QP solver where they apply;
-    NNLS is exact and fastest on dense impulse forms; PIQP is 3–5× faster than Clarabel on
-    sparse impacts of 10⁴ contacts and as accurate after polishing).
-
-    The order depends on the program's shape only, so it is kept per owner and tag."""
+def auto_order(qp: Any, form: str) -> list[str]:
+    """The backends ``"auto"`` tries on ``qp``, least overhead and exact first. Cone and
+    friction programs: :data:`~impactqp.qp.backends.AUTO_ORDER` (whether each takes ``qp`` is
+    asked when the loop reaches it: most answers come from the first). Quadratic programs
+    (measured in benchmarks/): the kernel and isotonic regression beat every QP solver where
+    they apply; NNLS is exact and fastest on dense impulse forms; PIQP is 3–5× faster than
+    Clarabel on sparse impacts of 10⁴ contacts and as accurate after polishing; that order
+    depends on the program's shape only, so it is kept per owner and tag."""
+    if form not in backends.FORMS:
+        return list(backends.AUTO_ORDER[form])
     if qp.cache_owner is None:
         return _auto_order(qp, form)
     per_owner = _ORDERS.setdefault(qp.cache_owner, {})
@@ -114,8 +121,8 @@ def _auto_order(qp: QuadraticProgram, form: str) -> list[str]:
     return names
 
 
-def plan(form: str, qp: QuadraticProgram, finish: Finish, backend: str) -> list[Candidate]:
-    """The candidates for one program: the auto order, or the named backend alone.
+def plan(form: str, qp: Any, finish: Finish, backend: str) -> Plan:
+    """The plan for one program: the auto order, or the named backend alone.
 
     Raises
     ------
@@ -125,15 +132,15 @@ def plan(form: str, qp: QuadraticProgram, finish: Finish, backend: str) -> list[
         A named backend that cannot take the program (the message says why).
     """
     if backend == "auto":
-        return [Candidate(name, form, qp, finish) for name in auto_order(qp, form)]
+        return Plan(form, qp, finish, auto_order(qp, form), form in backends.FORMS)
     entry, _ = backends.parse_backend(backend)
     reason = backends.unsuitable(entry, qp, form)
     if reason is not None:
         raise BackendUnsuitableError(reason)
-    return [Candidate(backend, form, qp, finish)]
+    return Plan(form, qp, finish, (backend,))
 
 
-Stage = tuple[str, Callable[[], QuadraticProgram], Finish]
+Stage = tuple[str, Callable[[], Any], Finish]
 
 
 def solve_in_forms(stages: Sequence[Stage], backend: str,
@@ -157,27 +164,22 @@ def solve_in_forms(stages: Sequence[Stage], backend: str,
     unsuitable, failures, log = [], [], []
     for form, build, finish in stages:
         try:
-            candidates = plan(form, build(), finish, backend)
+            planned = plan(form, build(), finish, backend)
         except BackendUnsuitableError as exc:
             unsuitable.append(str(exc))
             LOG.info("%s form refused by %s: %s", form, backend, exc)
             continue
         try:
-            out = solve_certified(candidates, named=backend != "auto", options=options)
+            out = solve_certified(planned, named=backend != "auto", options=options)
         except CertificateError as exc:
             failures.append(str(exc))
             _note(log, f"{form} form: {exc}", logging.INFO)
             continue
-        return Outcome(out.answer, out.checks, out.backend, out.form, log + out.attempts)
+        return Outcome(out.answer, out.checks, out.solution, out.backend, out.form,
+                       log + out.attempts)
     if failures:
         raise CertificateError("; ".join(failures))
     raise BackendUnsuitableError("; ".join(dict.fromkeys(unsuitable)))
-
-
-def lcp_feasible(qp: QuadraticProgram) -> bool:
-    """For the impulse form: is there x ≥ 0 with Px + c ≥ 0? (For PSD P: solvable iff so.)"""
-    res = linprog(np.zeros(qp.n_vars), A_ub=-qp.P, b_ub=qp.c, bounds=(0, None), method="highs")
-    return bool(res.status == 0)
 
 
 def _better(new: ResidualChecks, old: ResidualChecks) -> bool:
@@ -185,9 +187,12 @@ def _better(new: ResidualChecks, old: ResidualChecks) -> bool:
     return new.ok and (not old.ok or not math.isfinite(b) or a <= b)
 
 
-def solve_certified(candidates: Sequence[Candidate], *, named: bool,
-                    tol: float = 1e-10, options: dict | None = None) -> Outcome:
-    """Try each candidate until one answer passes its certificate.
+def solve_certified(planned: Plan, *, named: bool, tol: float = 1e-10,
+                    options: dict | None = None) -> Outcome:
+    """The one certified loop: try each backend of the plan until an answer passes its
+    certificate, for quadratic programs, cone programs and frictional contact problems
+    alike (how each kind is run and polished: :mod:`.kinds`). Iterative answers are polished
+    and kept when their certificate is at least as good; every attempt is recorded.
 
     Raises
     ------
@@ -196,61 +201,61 @@ def solve_certified(candidates: Sequence[Candidate], *, named: bool,
     NoSolutionError
         The impulse-form LCP has no feasible point (the law has no solution).
     CertificateError
-        No candidate produced an answer within the certificate's tolerance.
+        No backend produced an answer within the certificate's tolerance.
     """
+    form, program, finish = planned.form, planned.program, planned.finish
     log: list[str] = []
-    settings = {"options": options} if options else {}
-    for cand in candidates:
-        entry, sub = backends.parse_backend(cand.backend)
+    kind = kind_of(form)
+    warm, warm_value = None, math.inf  # the best uncertified answer, where a method starts
+    for name in planned.backends:
+        entry, sub = backends.parse_backend(name)
         try:
             module = backends.load(entry)
         except UnknownBackendError:
             if named:
                 raise
-            _note(log, f"{cand.backend}: not installed", logging.INFO)
+            _note(log, f"{name}: not installed", logging.INFO)
             continue
-        unit, scaling = (cand.program, Scaling(1.0, 1.0)) if entry.scale_free \
-            else normalize(cand.program)
-        for attempt_tol in ((tol,) if entry.exact else (tol, tol * 1e-2)):
+        if not planned.checked:
+            reason = backends.unsuitable(entry, program, form)
+            if reason is not None:
+                _note(log, f"{name}: unsuitable ({reason})")
+                continue
+        prepared = kind.prepare(entry, program)
+        for attempt_tol in kind.tolerances(entry, tol):
             try:
-                sol_unit = module.solve(unit, tol=attempt_tol, solver=sub, **settings)
+                raw = kind.run(module, entry, sub, prepared, attempt_tol, options, warm)
             except InputError:  # the user's options: theirs to mend, not a solver failure
                 raise
             except (BackendUnsuitableError, UnknownBackendError) as exc:
                 if named:
                     raise
-                _note(log, f"{cand.backend}: unsuitable ({exc})", logging.INFO)
+                _note(log, f"{name}: unsuitable ({exc})", logging.INFO)
                 break
             except (SolverError, NoSolutionError, FloatingPointError, ValueError,
                     np.linalg.LinAlgError) as exc:
-                _note(log, f"{cand.backend} ({cand.form}): {exc}")
+                _note(log, f"{name} ({form}): {exc}")
                 if entry.exact:
                     break
                 continue
-            sol = scaling.solution(sol_unit)
-            answer, cert = cand.finish(sol)
+            sol = kind.solution(prepared, raw)
+            answer, cert = finish(sol)
             if not entry.exact:
-                # iterative answers stop at a tolerance: solve their active set exactly and
-                # keep that when its certificate is at least as good. Small residuals do not
-                # mean accurate velocities on ill-conditioned impacts (a 10⁵-ball chain
-                # passes at 1e-9 with velocities off by 1e-6), so this is always tried.
-                polished = polish(unit, sol_unit)
+                polished = kind.polish(prepared, raw, attempt_tol)
                 if polished is not None:
-                    answer_p, cert_p = cand.finish(scaling.solution(polished))
+                    sol_p = kind.solution(prepared, polished)
+                    answer_p, cert_p = finish(sol_p)
                     if _better(cert_p, cert):
-                        _note(log, f"{sol.backend}+polish ({cand.form}): certified")
+                        _note(log, f"{sol.backend} ({form}): polished, certified")
                         _verdict(cert_p)
-                        return Outcome(answer_p, cert_p, f"{sol.backend}+polish", cand.form,
-                                       log)
+                        return Outcome(answer_p, cert_p, sol_p, sol.backend, form, log)
             if cert.ok:
-                _note(log, f"{sol.backend} ({cand.form}): certified")
+                _note(log, f"{sol.backend} ({form}): certified")
                 _verdict(cert)
-                return Outcome(answer, cert, sol.backend, cand.form, log)
-            name, value = cert.worst
-            _note(log, f"{cand.backend} ({cand.form}, tol {attempt_tol:.0e}): certificate "
-                       f"failed, {name} = {value:.1e}")
-    impulse = [c.program for c in candidates if c.program.nonnegative]
-    if impulse and not lcp_feasible(normalize(impulse[0])[0]):
-        raise NoSolutionError("the LCP 0 ≤ Λ ⟂ GΛ + q ≥ 0 has no feasible point, so the law "
-                              "has no solution for this pre-impact velocity")
-    raise CertificateError("no backend met the certificate: " + "; ".join(log))
+                return Outcome(answer, cert, sol, sol.backend, form, log)
+            worst, value = cert.worst
+            if value < warm_value:
+                warm, warm_value = sol, value
+            _note(log, f"{name} ({form}, tol {attempt_tol:.0e}): certificate failed, "
+                       f"{worst} = {value:.1e}")
+    raise kind.failure(program, log)

@@ -3,8 +3,9 @@
 
 A named backend must list the ``"cone"`` form (:data:`~impactqp.qp.backends.CONE`); any
 other refuses by name and says which backends take cones. ``"auto"`` tries those backends
-in registry order. Each is run at the requested tolerance and once more a hundred times
-tighter; an answer is returned only when its certificate, recomputed by
+in :data:`~impactqp.qp.backends.AUTO_ORDER`. The certified loop
+(:func:`~impactqp.qp.certified.solve_certified`) runs each at the requested tolerance and once
+more a hundred times tighter; an answer is returned only when its certificate, recomputed by
 :meth:`~impactqp.qp.cones.ConeProgram.certificate`, is within ``accept``.
 """
 
@@ -13,14 +14,10 @@ from __future__ import annotations
 import dataclasses
 
 from ..base.arrays import check_tol
-from ..errors import (
-    BackendUnsuitableError,
-    CertificateError,
-    InputError,
-    SolverError,
-    UnknownBackendError,
-)
+from ..base.checks import NamedChecks
+from ..errors import InputError
 from . import backends
+from .certified import plan, solve_certified
 from .cones import ConeProgram, ConeSolution
 
 ACCEPT = 1e-8
@@ -63,31 +60,11 @@ def solve_cone(program: ConeProgram, backend: str = "clarabel", *, tol: float = 
         raise InputError(f"program must be a ConeProgram, got {type(program).__name__}")
     tol, accept = check_tol(tol), check_tol(accept, "accept")
     options = backends.check_options(backend, options)
-    names = backends.cone_backends() if backend == "auto" else (backend,)
-    failures: list[str] = []
-    for name in names:
-        entry, sub = backends.parse_backend(name)
-        reason = backends.unsuitable(entry, program, backends.CONE)
-        if reason is not None:
-            if backend != "auto":
-                raise BackendUnsuitableError(reason)
-            failures.append(reason)
-            continue
-        try:
-            module = backends.load(entry)
-        except UnknownBackendError as exc:
-            if backend != "auto":
-                raise
-            failures.append(str(exc))
-            continue
-        for attempt in (tol, tol * 1e-2):
-            try:
-                sol = module.solve_cone(program, tol=attempt, solver=sub, options=options)
-            except SolverError as exc:
-                failures.append(f"{name} (tol {attempt:.0e}): {exc}")
-                continue
-            checks = program.certificate(sol.x, sol.z, accept)
-            if checks.ok:
-                return dataclasses.replace(sol, checks=checks)
-            failures.append(f"{sol.backend} (tol {attempt:.0e}): certificate {checks.summary()}")
-    raise CertificateError("no backend certified the cone program: " + "; ".join(failures))
+
+    def finish(sol: ConeSolution) -> tuple[ConeSolution, NamedChecks]:
+        checks = program.certificate(sol.x, sol.z, accept)
+        return dataclasses.replace(sol, checks=checks), checks
+
+    planned = plan(backends.CONE, program, finish, backend)
+    return solve_certified(planned, named=backend != "auto", tol=tol,
+                           options=options).answer

@@ -40,7 +40,7 @@ class LCPResult:
     residuals : dict
         Largest violations of z ≥ 0, w ≥ 0 and abs(zᵢwᵢ), scaled.
     backend : str
-        What produced z (``"kernel"``, ``"nnls"``, ``"clarabel+polish"``, ...).
+        What produced z (``"kernel"``, ``"nnls"``, ``"clarabel"``, ...): a name ``backend=`` takes.
     tol : float
     attempts : list of str
         What was tried, in order.

@@ -73,13 +73,9 @@ def solve_law(problem: ImpactProblem, law: str, coefficients: Any,
               backend: str = "auto") -> ImpactResult:
     """Apply the law called ``law`` (docs/theory.md §3, §6, §10, §16) through
     :func:`impactqp.solve`, with exactly its checks (a closed-form law refuses a named
-    backend, as in Python); for a frictional law (Coulomb's) ``backend`` is the method of its
-    local problem (:data:`~impactqp.laws.friction.FRICTION_BACKENDS`)."""
-    impact_law = law_named(law, coefficients)
-    if impact_law.frictional:
-        impact_law = type(impact_law)(impact_law.mu, impact_law.restitution, method=backend)
-        backend = "auto"
-    return solve(problem, impact_law, backend)
+    backend, as in Python); for Coulomb's law ``backend`` is a friction method of the registry
+    (:data:`~impactqp.laws.friction.FRICTION_BACKENDS`), as for :func:`impactqp.solve`."""
+    return solve(problem, law_named(law, coefficients), backend)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -107,7 +103,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--mu", help="Coulomb's friction coefficients ≥ 0: one number or one per "
                                 "contact, e.g. 0.3")
     p.add_argument("--backend", default="auto",
-                   help="QP backend (default auto); for coulomb the method of its local "
-                        f"problem: {', '.join(FRICTION_BACKENDS)}")
+                   help="backend of the registry (default auto; iq.available_backends()): a "
+                        "QP backend, or for coulomb a friction method: "
+                        f"{', '.join(FRICTION_BACKENDS)}")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=run)

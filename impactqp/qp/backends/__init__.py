@@ -4,12 +4,17 @@ A backend is a module with ``solve(qp, *, tol, solver=None) -> QPSolution`` and,
 serves only some programs, ``unsuitable(qp) -> str | None`` (why it cannot take ``qp``).
 Backends that solve many right-hand sides at once also have ``solve_many``; backends that
 take cone programs (:mod:`impactqp.qp.cones`) have ``solve_cone(program, *, tol, solver,
-options) -> ConeSolution``. Backends know programs only (:mod:`impactqp.qp.program`), never
-impacts or laws (docs/theory.md §9).
+options) -> ConeSolution``; backends that take local frictional contact problems
+(:mod:`impactqp.qp.friction`) have ``solve_friction(data, start, *, tol, method) ->
+FrictionSolution`` and, where they serve only some, ``unsuitable_friction(program)``.
+Backends know programs only (:mod:`impactqp.qp.program`), never impacts or laws
+(docs/theory.md §9).
 
 Each entry declares the program forms it serves (``"velocity"``: general ``Ax ≥ b``;
-``"impulse"``: ``x ≥ 0``, an LCP; ``"cone"``: a :class:`~impactqp.qp.cones.ConeProgram`),
-whether its answers are exact (no polishing needed), and what it is for.
+``"impulse"``: ``x ≥ 0``, an LCP; ``"cone"``: a :class:`~impactqp.qp.cones.ConeProgram`;
+``"friction"``: u = W r + q, r ∈ K_μ ⟂ ũ ∈ K*_μ), whether its answers are exact (no polishing
+needed), and what it is for; :data:`AUTO_ORDER` says in which order ``"auto"`` tries the
+entries of the cone and friction forms.
 :func:`available_backends` lists them with their install state.
 """
 
@@ -22,8 +27,6 @@ from functools import cache
 from types import ModuleType
 
 from ...errors import BackendUnsuitableError, InputError, UnknownBackendError
-from ..cones import ConeProgram
-from ..program import QuadraticProgram
 
 FORMS = ("velocity", "impulse")
 """The forms of quadratic programs (the ``form=`` of :func:`impactqp.solve`)."""
@@ -31,6 +34,10 @@ FORMS = ("velocity", "impulse")
 CONE = "cone"
 """The form of cone programs (:class:`~impactqp.qp.cones.ConeProgram`), served by the
 entries that list it among their forms."""
+
+FRICTION = "friction"
+"""The form of local frictional contact problems (:mod:`impactqp.qp.friction`, e.g.
+:class:`~impactqp.FrictionContactProblem`), served by the friction methods."""
 
 
 @dataclass(frozen=True)
@@ -79,8 +86,9 @@ class Backend:
 
 
 REGISTRY: dict[str, Backend] = {b.name: b for b in (
-    Backend("kernel", "kernel", "numba", "numba", ("impulse",), True,
-            "compiled active-set search: dense impulse form, at most 400 contacts",
+    Backend("kernel", "kernel", "numba", "numba", ("impulse", FRICTION), True,
+            "compiled active-set search: dense impulse form, at most 400 contacts; friction: "
+            "dense Newton and NSGS in one compiled call, at most 32 contacts",
             scale_free=True),
     Backend("isotonic", "isotonic", "scipy", "scipy", ("velocity",), True,
             "weighted isotonic regression: velocity form of 1-D chains, O(N)", scale_free=True),
@@ -88,8 +96,9 @@ REGISTRY: dict[str, Backend] = {b.name: b for b in (
             "active-set enumeration, at most 14 constraints: the reference"),
     Backend("nnls", "nnls_", "numba", "numba", ("impulse",), True,
             "compiled NNLS on the Cholesky-scaled impulse form: dense, at most 400 contacts"),
-    Backend("clarabel", "clarabel_", "clarabel", "clarabel", FORMS + (CONE,), False,
-            "Clarabel's own API (interior point), sparse",
+    Backend("clarabel", "clarabel_", "clarabel", "clarabel", FORMS + (CONE, FRICTION), False,
+            "Clarabel's own API (interior point), sparse; friction: a fixed point of "
+            "second-order cone programs, finished by Newton",
             options="attributes of clarabel.DefaultSettings (max_iter, tol_gap_abs, ...)"),
     Backend("osqp", "osqp_", "osqp", "osqp", FORMS, False, "OSQP (operator splitting), sparse",
             options="OSQP settings of its setup (max_iter, eps_abs, rho, ...)"),
@@ -102,9 +111,32 @@ REGISTRY: dict[str, Backend] = {b.name: b for b in (
             "any solver installed for qpsolvers ('qpsolvers:NAME', e.g. daqp, piqp, highs; "
             "'qpsolvers' alone: the best installed one for the program)",
             sub_solver="optional", options="keyword arguments of the qpsolvers solver"),
+    Backend("nsgs-short", "nsgs_", "numba", "numba", (FRICTION,), False,
+            "friction: 100 projected Gauss–Seidel sweeps, then Newton (more sweeps while they "
+            "gain); cheapest on well-conditioned problems"),
+    Backend("newton", "newton_", "scipy", "scipy", (FRICTION,), False,
+            "friction: Alart–Curnier semismooth Newton from r = 0, sparse LU steps"),
+    Backend("newton-damped", "newton_", "scipy", "scipy", (FRICTION,), False,
+            "friction: Alart–Curnier Newton with a ten times larger shift of its Jacobian"),
+    Backend("newton-lstsq", "lstsq_", "scipy", "scipy", (FRICTION,), False,
+            "friction: least-squares Newton on the natural map, dense, at most 600 unknowns "
+            "(rank-deficient W)"),
+    Backend("nsgs", "nsgs_", "numba", "numba", (FRICTION,), False,
+            "friction: up to 20000 projected Gauss–Seidel sweeps, then Newton"),
 )}
 
-QP_BACKENDS = tuple(REGISTRY)
+AUTO_ORDER = {
+    CONE: ("clarabel", "cvxpy"),
+    FRICTION: ("kernel", "nsgs-short", "newton", "clarabel", "newton-damped", "newton-lstsq",
+               "nsgs"),
+}
+"""The order in which ``"auto"`` tries the entries of the cone and friction forms (the
+quadratic programs' order depends on the program, :func:`impactqp.qp.certified.auto_order`).
+Friction: cheapest where each works first — one compiled call for a few contacts, a short
+NSGS on well-conditioned problems, Newton from r = 0 most of the rest, the SOCP fixed point the
+badly conditioned ones, the damped and least-squares Newton some rank-deficient ones, a long
+NSGS last; the SOCP route, the least-squares Newton and the long NSGS start from the best
+answer so far (docs/theory.md §15)."""
 
 #: how each solver (qpsolvers or cvxpy name, lower case) spells its stopping tolerances
 TOLERANCE_OPTIONS: dict[str, tuple[str, ...]] = {
@@ -151,7 +183,6 @@ def parse_backend(name: object) -> tuple[Backend, str | None]:
     return entry, sub
 
 
-@cache
 def load(entry: Backend) -> ModuleType:
     """Import a backend's module.
 
@@ -160,11 +191,21 @@ def load(entry: Backend) -> ModuleType:
     UnknownBackendError
         When the solver it wraps is not installed (the message says what to install).
     """
+    module = _LOADED.get(entry.module)
+    if module is not None:
+        return module
     try:
-        return importlib.import_module(f".{entry.module}", __name__)
+        module = importlib.import_module(f".{entry.module}", __name__)
     except ImportError as exc:  # a missing optional solver must not break impactqp
         raise UnknownBackendError(f"backend {entry.name!r} is not installed ({exc}); "
                                   f"install {entry.install}") from exc
+    _LOADED[entry.module] = module
+    return module
+
+
+_LOADED: dict[str, ModuleType] = {}
+"""The backend modules imported so far, by module name (a lookup per attempt, not a hash
+of the whole entry)."""
 
 
 def check_options(backend: str, options: object) -> dict[str, object]:
@@ -187,24 +228,32 @@ def check_options(backend: str, options: object) -> dict[str, object]:
     return dict(options)
 
 
+def serving(form: str) -> tuple[str, ...]:
+    """Names of the backends that serve ``form``, in registry order."""
+    return tuple(b.name for b in REGISTRY.values() if form in b.forms)
+
+
 def cone_backends() -> tuple[str, ...]:
     """Names of the backends that take cone programs (:data:`CONE` among their forms)."""
-    return tuple(b.name for b in REGISTRY.values() if CONE in b.forms)
+    return serving(CONE)
 
 
-def unsuitable(entry: Backend, qp: QuadraticProgram | ConeProgram, form: str) -> str | None:
+_KINDS = {CONE: "cone programs", FRICTION: "frictional contact problems"}
+
+
+def unsuitable(entry: Backend, qp: object, form: str) -> str | None:
     """Why ``entry`` cannot solve ``qp`` (a program of ``form``), or None when it can."""
-    if form == CONE and CONE not in entry.forms:
-        return (f"{entry.name!r} does not solve cone programs; the backends that take cones "
-                "are " + ", ".join(map(repr, cone_backends())))
+    if form in _KINDS and form not in entry.forms:
+        return (f"{entry.name!r} does not solve {_KINDS[form]}; the backends that do are "
+                + ", ".join(map(repr, serving(form))))
     if form not in entry.forms:
         return f"{entry.name!r} does not solve the {form} form (it serves: {entry.serves})"
     module = load(entry)
-    check = getattr(module, "unsuitable", None)
+    check = getattr(module, "unsuitable_friction" if form == FRICTION else "unsuitable", None)
     return None if check is None else check(qp)
 
 
-def check_suitable(entry: Backend, qp: QuadraticProgram | ConeProgram, form: str) -> None:
+def check_suitable(entry: Backend, qp: object, form: str) -> None:
     """Raise BackendUnsuitableError naming why ``entry`` cannot take ``qp``."""
     reason = unsuitable(entry, qp, form)
     if reason is not None:

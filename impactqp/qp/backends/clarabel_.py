@@ -3,6 +3,8 @@
 Ax ≥ b is passed as −Ax + s = −b with s in the non-negative cone; Clarabel's dual z of
 that cone is then the multiplier y ≥ 0 of Ax ≥ b. A cone program
 (:class:`~impactqp.qp.cones.ConeProgram`) is Clarabel's own standard form and goes in as it is.
+A frictional contact problem is solved as a fixed point of such cone programs
+(:func:`impactqp.qp.friction.methods.socp_route`).
 """
 
 from __future__ import annotations
@@ -13,6 +15,9 @@ import scipy.sparse as sp
 
 from ...errors import InputError, SolverError
 from ..cones import ConeProgram, ConeSolution
+from ..friction import FrictionSolution
+from ..friction.methods import socp
+from ..friction.newton import FrictionData
 from ..program import QPSolution, QuadraticProgram
 
 _GOOD = {"Solved": "solved", "AlmostSolved": "solved_inaccurate"}
@@ -80,3 +85,10 @@ def solve_cone(program: ConeProgram, *, tol: float = 1e-10, solver: str | None =
     sol, status = run(P, program.c, program.A, program.b, cones, tol, options)
     return ConeSolution(x=np.array(sol.x), z=np.array(sol.z), s=np.array(sol.s), status=status,
                         backend="clarabel", iterations=int(sol.iterations))
+
+
+def solve_friction(data: FrictionData, start: np.ndarray | None, *, tol: float,
+                   method: str) -> FrictionSolution:
+    """The fixed point of second-order cone programs from ``start``
+    (:func:`impactqp.qp.friction.methods.socp`)."""
+    return socp(data, start, tol)

@@ -1,4 +1,6 @@
-"""The ``"kernel"`` backend: the compiled active-set search for dense LCPs.
+"""The ``"kernel"`` backend: the compiled active-set search for dense LCPs, and the compiled
+call that solves a frictional contact problem of a few contacts whole (form ``"friction"``,
+docs/theory.md §15).
 
 Serves the impulse form ``x ≥ 0`` with a dense P of at most :data:`MAX_VARIABLES` variables
 (docs/theory.md §9) by :func:`impactqp.kernels.active_set.lcp_psd`. The support found last is
@@ -14,6 +16,8 @@ import numpy as np
 
 from ...errors import NoSolutionError, SolverError
 from ...kernels.active_set import NO_SOLUTION, SOLVED, lcp_psd_rows, solve_lcp_psd
+from ..friction import FrictionProgram, FrictionSolution, methods
+from ..friction.newton import FrictionData
 from ..program import QPSolution, QuadraticProgram
 
 MAX_VARIABLES = 400
@@ -59,3 +63,17 @@ def solve_many(qp: QuadraticProgram, C: np.ndarray, *, tol: float = 1e-10,
     X, Y, status = lcp_psd_rows(P, np.ascontiguousarray(C, dtype=float), _warm_start(qp),
                                 20 * qp.n_vars + 50)
     return X, Y, status == SOLVED
+
+
+def unsuitable_friction(program: FrictionProgram) -> str | None:
+    if program.n_contacts > methods.SMALL_CONTACTS:
+        return (f"'kernel' takes frictional problems of at most {methods.SMALL_CONTACTS} "
+                f"contacts, got "
+                f"{program.n_contacts}")
+    return None
+
+
+def solve_friction(data: FrictionData, start: np.ndarray | None, *, tol: float,
+                   method: str) -> FrictionSolution:
+    """The problem whole in one compiled call (:func:`impactqp.qp.friction.methods.small`)."""
+    return methods.small(data, tol)

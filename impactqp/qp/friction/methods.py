@@ -1,0 +1,220 @@
+"""The friction methods of the registry, on :class:`~.newton.FrictionData` (docs/theory.md
+§15): a projected Gauss–Seidel (NSGS, compiled, on the compressed rows of W), short or long;
+the fixed point of second-order cone programs (Anitescu's relaxation with the De Saxcé term
+s_c = μ_c‖u_T,c‖ and the skew part of W lagged from the previous iterate), solved by Clarabel;
+and the compiled call that solves a problem of a few contacts whole. The Newton methods are in
+:mod:`.newton`. Each returns r and the work done; the certified loop
+(:mod:`impactqp.qp.certified`) projects, polishes and certifies.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.sparse as sp
+
+from ...errors import SolverError
+from ...kernels.friction import modified_velocity, nsgs_rows, project_cones
+from ...kernels.friction_newton import scales, solve_small
+from ..cone_solve import solve_cone
+from ..cones import ConeProgram, friction_cone_rows
+from . import FrictionSolution
+from .newton import NEWTON_STEPS, FrictionData, lstsq_newton, newton
+
+SOCP_ROUNDS = 30
+"""Most SOCPs of the fixed point on s = μ‖u_T‖."""
+POLISH_STEPS = 20
+"""Most Newton steps after NSGS (where they converge they take fewer than 10; where NSGS
+failed, Newton from there tends to fail too, and r = 0 is tried next)."""
+NEWTON_SHIFT = {"newton": 1.0, "newton-damped": 10.0}
+"""The factor κ of the shift κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²)·I added to Newton's Jacobian by each
+variant: the damped one converges on some problems where the other stalls, and takes more
+steps on the rest."""
+NEWTON_FROM = 1e-3
+"""Error ‖F‖/‖q‖ below which the SOCP route tries Newton (from farther it tends to stall)."""
+NSGS_SWEEPS = 20000
+"""Most sweeps of the projected Gauss–Seidel."""
+NSGS_SHORT = 100
+"""Sweeps of the projected Gauss–Seidel that ``auto`` tries first (cheap where it works)."""
+NSGS_MORE = 2000
+"""Most sweeps ``nsgs-short`` adds when Newton did not finish in the time the first sweeps'
+rate predicts they need (KaplasTower: 1100 sweeps reach 1e-8 in 0.17 s, while Newton from
+100 sweeps takes 20 steps, 0.35 s); it adds none when that prediction is above this."""
+QUICK_POLISH = 4
+"""Newton steps ``nsgs-short`` tries before sweeping on when its sweeps predict they reach
+the tolerance within :data:`NSGS_MORE` more (Newton converges in a few steps when it does)."""
+NSGS_LOCAL = 3
+"""Most projected fixed-point steps on one contact's local problem per sweep (more are
+wasted while the other contacts still move: on the FCLib problems 10 took as many sweeps as
+3 and cost up to 2.5 times more; 1 took more sweeps on some)."""
+SMALL_CONTACTS = 32
+"""Most contacts of a problem that ``auto`` first solves in one compiled call, W made dense
+(:func:`impactqp.kernels.friction_newton.solve_small`: dense Newton and NSGS, no cone
+program); on random well-conditioned problems it beats the general route up to ~50 contacts
+(20 contacts: 0.13 ms against 1.3 ms)."""
+
+
+def _socp(P: sp.csc_matrix, c: np.ndarray, mu: np.ndarray, d: int) -> np.ndarray:
+    """min ½ rᵀPr + cᵀr over r ∈ K_μ (one cone per contact): a cone program solved and
+    certified through the backend registry (Clarabel; docs/theory.md §9).
+
+    Contacts with μ > 0 are second-order cones (μ r_n, r_T); frictionless ones a
+    non-negative r_n and r_T = 0 (a zero cone), listed first."""
+    C, cones = friction_cone_rows(mu, d)
+    # r is positively homogeneous in c: solved for c of order one (a power of two, exact),
+    # where the interior-point tolerances are meant (at max|cᵢ| = 1e50 Clarabel reported
+    # the program dual infeasible)
+    k = int(np.frexp(np.abs(c).max())[1])
+    # an iterate of the fixed point (its end is judged by certify_friction): certified at
+    # 1e-6, what Clarabel's answers reach on rank-deficient W (3e-7 measured on PerioBox)
+    program = ConeProgram(P, np.ldexp(c, -k), -C, np.zeros(C.shape[0]), cones)
+    return np.ldexp(solve_cone(program, "clarabel", tol=1e-10, accept=1e-6).x, k)
+
+
+def socp_route(data: FrictionData, r0: np.ndarray, tol: float) -> tuple[np.ndarray, int, bool]:
+    """The fixed point of SOCPs on s = μ‖u_T‖e_n and the skew part of W (lagged), halving
+    the change of s when the error grows; from an error of :data:`NEWTON_FROM` on, Newton
+    is tried each time the error has fallen tenfold, and its answer returned if it passes.
+    Returns r, the rounds and Newton steps done, and whether Newton gave r."""
+    W, q, mu, d = data.W, data.q, data.mu, data.d
+    P = sp.csc_matrix(0.5 * (W + W.T))
+    skew = 0.5 * (W - W.T)
+    r = r0.copy()
+    s = _lag(data, r)
+    best_r, best_err = r, data.error(r)
+    tried = NEWTON_FROM * 10.0
+    rounds = 0
+    for _ in range(SOCP_ROUNDS):
+        rounds += 1
+        r_new = _socp(P, q + skew @ r + s, mu, d)
+        err = data.error(r_new)
+        if err < best_err:
+            best_r, best_err = r_new, err
+            r, s = r_new, _lag(data, r_new)
+        else:
+            s = 0.5 * (s + _lag(data, r_new))  # damped
+            r = 0.5 * (r + r_new)
+        if best_err <= 0.1 * tried:
+            tried = best_err
+            r_pol, steps, ok = newton(data, best_r, tol)
+            rounds += steps
+            if ok:
+                return r_pol, rounds, True
+    return best_r, rounds, False
+
+
+def _lag(data: FrictionData, r: np.ndarray) -> np.ndarray:
+    """ũ − u = μ‖u_T‖e_n at u = W r + q: the De Saxcé term the SOCP holds fixed."""
+    u = data.velocity(r)
+    return modified_velocity(u, data.mu, data.d) - u
+
+
+def nsgs_route(data: FrictionData, r0: np.ndarray, tol: float,
+                sweeps: int) -> tuple[np.ndarray, int, float]:
+    """The compiled projected Gauss–Seidel from r0 to the tolerance (or ``sweeps``), in two
+    halves. Returns r, the sweeps done and the sweeps its rate over the second half predicts
+    are still needed (0 when done, infinity when the error did not fall)."""
+    r = np.array(r0, dtype=float)
+    W = data.W
+    first = sweeps // 2
+    done, err = nsgs_rows(W.indptr, W.indices, W.data, data.q, data.mu, data.d, r, 0.5 * tol,
+                          first, NSGS_LOCAL)
+    if err <= 0.5 * tol or done == sweeps:
+        return r, int(done), 0.0 if err <= 0.5 * tol else math.inf
+    more, err_more = nsgs_rows(W.indptr, W.indices, W.data, data.q, data.mu, data.d, r,
+                               0.5 * tol, sweeps - first, NSGS_LOCAL)
+    if err_more <= 0.5 * tol:
+        left = 0.0
+    elif 0.0 < err_more < err:
+        left = more * math.log(0.5 * tol / err_more) / math.log(err_more / err)
+    else:
+        left = math.inf
+    return r, int(done + more), left
+
+
+def short_nsgs_route(data: FrictionData, tol: float) -> tuple[np.ndarray, int, bool]:
+    """:data:`NSGS_SHORT` sweeps from r = 0, then Newton from there: :data:`QUICK_POLISH`
+    steps when the sweeps' rate predicts they reach the tolerance within :data:`NSGS_MORE`
+    more, else up to ``POLISH_STEPS``. When Newton has not succeeded, the sweeps go on from
+    their r, in rounds of the predicted number, for as long as
+    each round gains a factor ten in ‖F‖ (else their r is returned, to the next method) and
+    up to :data:`NSGS_MORE` sweeps, after which Newton is tried again (docs/theory.md §15).
+    Returns r, the sweeps and steps done, and whether Newton was run last."""
+    r, its, left = nsgs_route(data, np.zeros_like(data.q), tol, NSGS_SHORT)
+    if left == 0.0 and data.error(r) <= 0.5 * tol:
+        return r, its, False
+    r_pol, steps, ok = newton(data, r, tol,
+                              max_steps=QUICK_POLISH if left <= NSGS_MORE else POLISH_STEPS)
+    its += steps
+    if ok or left > NSGS_MORE or data.error(r_pol) <= 0.5 * tol:
+        return r_pol, its, True
+    more = 0
+    err = data.error(r)
+    while more < NSGS_MORE:
+        rounds = int(min(max(left, NSGS_SHORT), NSGS_MORE - more))
+        r, done, left = nsgs_route(data, r, tol, rounds)
+        more += done
+        err_round = data.error(r)
+        if err_round <= 0.5 * tol:
+            return r, its + more, False
+        if not err_round <= 0.1 * err:  # stalling: NSGS will not get there soon
+            return r, its + more, False
+        err = err_round
+    r, steps, _ = newton(data, r, tol, max_steps=POLISH_STEPS)
+    return r, its + more + steps, True
+
+
+def small(data: FrictionData, tol: float) -> FrictionSolution:
+    """The ``"kernel"`` method: the problem whole in one compiled call
+    (:func:`impactqp.kernels.friction_newton.solve_small`, which leaves r projected onto the
+    cones), W made dense.
+
+    Raises
+    ------
+    SolverError
+        The call ended outside half the tolerance (the next method takes over)."""
+    W = data.dense
+    r = np.empty_like(data.q)
+    its, ok = solve_small(W, data.q, data.mu, scales(W.diagonal(), data.d), data.d, tol, r,
+                          NEWTON_STEPS, NSGS_SHORT, NSGS_LOCAL)
+    if not ok:
+        raise SolverError(f"kernel: not within tol/2 after {int(its)} iterations")
+    return FrictionSolution(r, int(its), "kernel")
+
+
+def _from(data: FrictionData, start: np.ndarray | None) -> np.ndarray:
+    """Where a method that takes a start begins: ``start``, or r = 0."""
+    return np.zeros_like(data.q) if start is None else start
+
+
+def socp(data: FrictionData, start: np.ndarray | None, tol: float) -> FrictionSolution:
+    """The ``"clarabel"`` method: :func:`socp_route` from ``start`` (None: r = 0), polished by
+    Newton when it ends short of the tolerance."""
+    r, its, finished = socp_route(data, _from(data, start), tol)
+    return FrictionSolution(project_cones(r, data.mu, data.d), its, "clarabel",
+                            0 if finished else NEWTON_STEPS)
+
+
+def gauss_seidel(data: FrictionData, start: np.ndarray | None, tol: float,
+                 method: str) -> FrictionSolution:
+    """The ``"nsgs-short"`` method (:func:`short_nsgs_route` from r = 0) and the ``"nsgs"``
+    one (:data:`NSGS_SWEEPS` sweeps from ``start``, then up to :data:`POLISH_STEPS` Newton
+    steps when short of the tolerance)."""
+    if method == "nsgs-short":
+        r, its, _ = short_nsgs_route(data, tol)
+        return FrictionSolution(project_cones(r, data.mu, data.d), its, method)
+    r, its, _ = nsgs_route(data, _from(data, start), tol, NSGS_SWEEPS)
+    return FrictionSolution(project_cones(r, data.mu, data.d), its, method, POLISH_STEPS)
+
+
+def newton_method(data: FrictionData, start: np.ndarray | None, tol: float,
+                  method: str) -> FrictionSolution:
+    """The ``"newton"`` and ``"newton-damped"`` methods (Alart–Curnier's Newton from r = 0
+    with the shift factor of :data:`NEWTON_SHIFT`) and ``"newton-lstsq"`` (the least-squares
+    Newton on the natural map from ``start``); both end with r projected onto the cones."""
+    if method == "newton-lstsq":
+        r, its, _ = lstsq_newton(data, _from(data, start), tol)
+    else:
+        r, its, _ = newton(data, np.zeros_like(data.q), tol, NEWTON_SHIFT[method])
+    return FrictionSolution(r, its, method)

@@ -1,0 +1,200 @@
+"""Newton's methods for local frictional contact problems (docs/theory.md §15): the
+semismooth Newton on Alart–Curnier's function with shifted sparse LU steps, and the
+least-squares Newton on the natural map (dense; for rank-deficient W where the first stalls),
+with :class:`FrictionData`, the problem's arrays as every friction method uses them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ...kernels.friction import (
+    alart_curnier,
+    modified_velocity,
+    modified_velocity_jacobian,
+    natural_map,
+    project_cones,
+    projection_jacobian,
+)
+from ...kernels.friction_newton import scales
+from . import FrictionProgram
+
+NEWTON_STEPS = 50
+"""Most steps of one run of Newton (those that converge here take 5 to 35)."""
+LSTSQ_STEPS = 60
+"""Most steps of the least-squares Newton."""
+LSTSQ_MAX = 600
+"""Most unknowns d·m for the least-squares Newton (a dense QR per step: 0.1 s at 858)."""
+
+
+class FrictionData:
+    """The problem's arrays as the friction methods use them, each built when first asked for
+    (a problem the compiled call certifies never needs its compressed rows): W as compressed
+    rows, W dense, ‖q‖, and the scale ρ_c of each contact's Alart–Curnier function
+    (:func:`scales`)."""
+
+    def __init__(self, program: FrictionProgram) -> None:
+        self.program = program
+        self.q = program.q
+        self.mu = program.mu
+        self.d = program.contact_dim
+        self.n = self.q.size
+        self._rows: sp.csr_matrix | None = None
+        self._dense: np.ndarray | None = None
+        self._qn: float | None = None
+        self._rho: np.ndarray | None = None
+
+    @property
+    def W(self) -> sp.csr_matrix:
+        """W as compressed rows (every entry of a dense W stored: no scan for zeros, which
+        costs more than a sweep)."""
+        if self._rows is None:
+            W = self.program.W
+            if sp.issparse(W):
+                self._rows = sp.csr_matrix(W, dtype=float)
+                self._rows.sum_duplicates()
+            else:
+                n = self.n
+                self._rows = sp.csr_matrix((np.asarray(W, dtype=float).ravel(),
+                                            np.tile(np.arange(n), n),
+                                            np.arange(0, n * n + 1, n)), shape=(n, n))
+        return self._rows
+
+    @property
+    def dense(self) -> np.ndarray:
+        """W as a dense C-contiguous float array."""
+        if self._dense is None:
+            W = self.program.W
+            self._dense = np.ascontiguousarray(W.toarray() if sp.issparse(W) else W,
+                                               dtype=float)
+        return self._dense
+
+    @property
+    def qn(self) -> float:
+        """‖q‖ (1 for q = 0)."""
+        if self._qn is None:
+            self._qn = float(np.linalg.norm(self.q)) or 1.0
+        return self._qn
+
+    @property
+    def rho(self) -> np.ndarray:
+        if self._rho is None:
+            self._rho = scales(self.W.diagonal(), self.d)
+        return self._rho
+
+    def velocity(self, r: np.ndarray) -> np.ndarray:
+        """u = W r + q."""
+        return self.W @ r + self.q
+
+    def error(self, r: np.ndarray) -> float:
+        """‖F(r)‖/‖q‖."""
+        return float(np.linalg.norm(natural_map(r, self.velocity(r), self.mu, self.d))) / self.qn
+
+    def finished(self, r: np.ndarray, f: float, tol: float) -> np.ndarray | None:
+        """r projected onto the cones when ‖F(r)‖ = ``f`` is within tol/2·‖q‖ and the
+        projected r too (projecting moves r by up to ‖F‖, hence u by up to ‖W‖‖F‖); else
+        None."""
+        if f > 0.5 * tol * self.qn:
+            return None
+        rp = project_cones(r, self.mu, self.d)
+        return rp if self.error(rp) <= 0.5 * tol else None
+
+
+def backtrack(r: np.ndarray, step: np.ndarray, f: float,
+              residual: Callable[[np.ndarray], np.ndarray]
+              ) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """Armijo backtracking on ‖residual‖ along ``step`` from r (‖residual(r)‖ = f): the first
+    of t = 1, 1/2, … (down to 1e-8) with ‖residual(r + t·step)‖ ≤ (1 − 10⁻⁴t)f, as
+    (r + t·step, its residual, its norm); None when there is none (no descent: stalled)."""
+    t = 1.0
+    while t > 1e-8:
+        r_try = r + t * step
+        res = residual(r_try)
+        f_try = float(np.linalg.norm(res))
+        if f_try <= (1.0 - 1e-4 * t) * f:
+            return r_try, res, f_try
+        t *= 0.5
+    return None
+
+
+def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
+            max_steps: int = NEWTON_STEPS) -> tuple[np.ndarray, int, bool]:
+    """Semismooth Newton on Alart–Curnier's function Φ (docs/theory.md §15) from r: steps
+    (J + λI)Δ = −Φ with J = A + B W (A, B block-diagonal, from
+    :func:`impactqp.kernels.friction.alart_curnier`) and λ = κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²) (J is
+    singular where W is; the shift vanishes with Φ), by sparse LU, then backtracking on ‖Φ‖.
+
+    Stops when the projected r is within tol/2 in ‖F‖/‖q‖ (projecting moves r by up to ‖F‖,
+    hence u by up to ‖W‖‖F‖), after ``max_steps`` steps, or when the line search fails.
+    Returns r projected onto the cones, the steps done, and whether that r is within tol/2
+    (the certificate's figure)."""
+    W, q, mu, d, rho = data.W, data.q, data.mu, data.d, data.rho
+    n, m = data.n, mu.size
+    A = np.empty((m, d, d))
+    B = np.empty((m, d, d))
+    blocks = (np.arange(m), np.arange(m + 1))
+    scale = float(np.linalg.norm(alart_curnier(np.zeros(n), q, mu, rho, d, False, A, B)))
+    u = data.velocity(r)
+    phi = alart_curnier(r, u, mu, rho, d, True, A, B)
+    f = float(np.linalg.norm(phi))
+    steps = 0
+    while True:
+        rp = data.finished(r, float(np.linalg.norm(natural_map(r, u, mu, d))), tol)
+        if rp is not None:
+            return rp, steps, True
+        if steps == max_steps:
+            break
+        steps += 1
+        shift = kappa * min(f / (scale or 1.0), 1e-2)
+        J = (sp.bsr_matrix((A, *blocks), shape=(n, n)) + shift * sp.identity(n)
+             + sp.bsr_matrix((B, *blocks), shape=(n, n)) @ W)
+        try:
+            step = spla.splu(sp.csc_matrix(J)).solve(-phi)
+        except RuntimeError:  # an exactly singular J
+            break
+        found = backtrack(r, step, f, lambda x: alart_curnier(x, data.velocity(x), mu, rho,
+                                                              d, False, A, B))
+        if found is None:
+            break  # no descent: stalled
+        r = found[0]
+        u = data.velocity(r)
+        phi = alart_curnier(r, u, mu, rho, d, True, A, B)
+        f = float(np.linalg.norm(phi))
+    return project_cones(r, mu, d), steps, False
+
+
+def lstsq_newton(data: FrictionData, r: np.ndarray, tol: float) -> tuple[np.ndarray, int, bool]:
+    """Semismooth Newton on F(r) = r − P_K(r − ũ(Wr + q)) from r: minimum-norm least-squares
+    steps J Δ = −F (LAPACK's rank-revealing gelsy; J is singular where W is) with
+    J = I − D_P(I − D_ũ W), and backtracking on ‖F‖. Dense: for at most :data:`LSTSQ_MAX`
+    unknowns. Returns what :func:`newton` returns."""
+    W, q, mu, d = data.dense, data.q, data.mu, data.d
+    n, m = data.n, mu.size
+    u = W @ r + q
+    F = natural_map(r, u, mu, d)
+    f = float(np.linalg.norm(F))
+    steps = 0
+    while True:
+        rp = data.finished(r, f, tol)
+        if rp is not None:
+            return rp, steps, True
+        if steps == LSTSQ_STEPS:
+            break
+        steps += 1
+        DP = projection_jacobian(r - modified_velocity(u, mu, d), mu, d)
+        DUW = np.einsum("cij,cjk->cik", modified_velocity_jacobian(u, mu, d),
+                        W.reshape(m, d, n))
+        J = np.einsum("cij,cjk->cik", DP, DUW).reshape(n, n) + np.eye(n)
+        J -= sla.block_diag(*DP)
+        step = sla.lstsq(J, -F, lapack_driver="gelsy", check_finite=False)[0]
+        found = backtrack(r, step, f, lambda x: natural_map(x, W @ x + q, mu, d))
+        if found is None:
+            break  # no descent: stalled
+        r, F, f = found
+        u = W @ r + q
+    return project_cones(r, mu, d), steps, False
