@@ -2,9 +2,10 @@
 problem (issue 25: the law poses its local problem once, solves it through the registry and
 builds one certificate; target ≤ 1.5×).
 
-Two impacts: a sphere on a plane (one contact, ``iq.sphere_on_plane``) and three spheres in a
-row on a plane (five contacts, :func:`benchmarks.friction_impacts.spheres_in_a_row`). For
-each, the medians over repeated calls of ``iq.solve(problem, iq.Coulomb(μ))`` and of
+Two impacts: a sphere on a plane (one contact, ``iq.friction.sphere_on_plane``) and three
+spheres in a row on a plane (five contacts,
+:func:`benchmarks.friction_impacts.spheres_in_a_row`). For each, the medians over repeated
+calls of ``iq.solve(problem, iq.Coulomb(μ))`` and of
 ``iq.solve_friction(local)`` on the law's own local problem in contact units
 (``law.local_problem(problem)[0]``, posed untimed), and of the law's certificate alone. The
 calls alternate, so that a machine shared with other work slows them alike. Run:
@@ -42,7 +43,7 @@ def alternating_medians(calls: list[Callable[[], object]], repeats: int = REPEAT
 
 def cases() -> dict[str, iq.ImpactProblem]:
     five = spheres_in_a_row(3)  # 2·3 − 1 = 5 contacts
-    return {"sphere on a plane": iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0]),
+    return {"sphere on a plane": iq.friction.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0]),
             "5 contacts": iq.ImpactProblem(five.M, five.H, five.v_minus, contact_dim=3)}
 
 

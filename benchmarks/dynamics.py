@@ -119,7 +119,7 @@ def lzb_run(n: int) -> tuple[float, bool]:
     """Seconds of one LZB impact of ``n`` steel balls (radius 1 cm, Siconos' ChainOfBalls
     material: 7780 kg/m³, E = 203 GPa, ν = 0.3, Hertz 3/2, e = 1, striker at 1 m/s) and
     its certificate's verdict."""
-    chain = iq.monodisperse_chain(n, 0.01, density=7780, young=203e9, poisson=0.3)
+    chain = iq.chains.monodisperse_chain(n, 0.01, density=7780, young=203e9, poisson=0.3)
     law = LZB(chain.stiffness, exponent=1.5, restitution=1.0)
     start = time.perf_counter()
     result = iq.solve(chain.problem, law)

@@ -11,17 +11,17 @@ one-step problem with its default Lemke solver):
     Siconos' BouncingBallTS example as it ships: a ball of radius 0.1, m = 1, q₀ = 1, v₀ = 0,
     g = 9.81, e = 0.9, h = 0.005, T = 10 (2000 steps). Siconos' model has 3 DOF (height,
     horizontal position, angle; inertia 2/5·m·r²) and the relation y = q₀ (height of the
-    lowest point); impactqp's ``iq.bouncing_ball()`` is its one moving DOF. Both record the
-    height and velocity at every step (the example stores them too), and the agreement is
+    lowest point); impactqp's ``iq.simulation.bouncing_ball()`` is its one moving DOF. Both
+    record the height and velocity at every step (the example stores them too), and the agreement is
     the largest difference over the whole trajectory.
 ``cradle``
-    Newton's cradle on pendulums, ``iq.cradle_system(N)``: linearized pendulums (restoring
-    force −(mg/L)qᵢ, L = 1), gaps q_{i+1} − qᵢ, the left ball released from −0.1; e = 1,
+    Newton's cradle on pendulums, ``iq.simulation.cradle_system(N)``: linearized pendulums
+    (restoring force −(mg/L)qᵢ, L = 1), gaps q_{i+1} − qᵢ, the left ball released from −0.1; e = 1,
     h = 10⁻³. In Siconos: one ``LagrangianLinearTIDS`` per ball with stiffness K = mg/L and
     one ``LagrangianLinearTIR`` H = (−1, 1) per neighbour pair.
 ``column``
-    A column of beads falling on the ground, ``iq.bead_chain`` (m = 1, R = 0.1, 1 mm apart,
-    the lowest 1 mm above the ground), e = 0.9, h = 10⁻³.
+    A column of beads falling on the ground, ``iq.simulation.bead_chain`` (m = 1, R = 0.1,
+    1 mm apart, the lowest 1 mm above the ground), e = 0.9, h = 10⁻³.
 
 impactqp's timer covers ``iq.simulate`` (its set-up included, the model built before);
 Siconos' covers the ``computeOneStep``/``nextStep`` loop (the model and simulation objects
@@ -72,11 +72,11 @@ def impactqp_model(system: str, n: int) -> Any:
     import impactqp as iq
 
     if system == "ball":  # radius 0: the height of the lowest point, as in Siconos' example
-        return iq.bouncing_ball(mass=BALL_MASS, q0=BALL_Q0, v0=0.0, gravity=GRAVITY)
+        return iq.simulation.bouncing_ball(mass=BALL_MASS, q0=BALL_Q0, v0=0.0, gravity=GRAVITY)
     if system == "cradle":
-        return iq.cradle_system(n, mass=1.0, length=LENGTH, gravity=GRAVITY,
+        return iq.simulation.cradle_system(n, mass=1.0, length=LENGTH, gravity=GRAVITY,
                                 amplitude=AMPLITUDE)
-    return iq.bead_chain(n, radius=RADIUS, height=RADIUS + GAP, spacing=2 * RADIUS + GAP,
+    return iq.simulation.bead_chain(n, radius=RADIUS, height=RADIUS + GAP, spacing=2 * RADIUS + GAP,
                          gravity=GRAVITY)
 
 

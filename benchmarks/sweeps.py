@@ -42,7 +42,7 @@ def run_sweeps(suite: str, n_jobs: int = 2) -> list[dict[str, Any]]:
         times[jobs] = []
         for _ in range(runs):
             t0 = time.perf_counter()
-            maps[jobs] = iq.fremond_admissibility_map(p, a, b, samples=samples, seed=0,
+            maps[jobs] = iq.verification.fremond_admissibility_map(p, a, b, samples=samples, seed=0,
                                                       n_jobs=jobs, progress=False)
             times[jobs].append(time.perf_counter() - t0)
     same = all(np.array_equal(maps[1], maps[j]) for j in jobs_tried)

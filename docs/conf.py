@@ -3,7 +3,8 @@
 Build with ``sphinx-build -n -W --keep-going -b html docs docs/_build/html`` after
 ``pip install -e ".[docs]"`` (nitpicky, as CI does: every cross-reference must resolve).
 The API reference is generated from the numpydoc docstrings of the public names
-(``impactqp.__all__``); the theory note docs/theory.md is read by myst-parser; the command
+(``impactqp.__all__`` and the ``__all__`` of each public submodule); the theory note
+docs/theory.md is read by myst-parser; the command
 line's help texts are printed by its own parser (the ``impactqp-help`` directive below).
 """
 
@@ -70,9 +71,32 @@ def _help_text(path: str) -> str:
     return parser.format_help()
 
 
+PUBLIC_MODULES = ("impactqp", *(f"impactqp.{sub}" for sub in impactqp.SUBMODULES))
+
+
+def _public_reference(app, env, node, contnode):
+    """A bare name in a docstring (``:class:`ImpactResult```) rendered in another public
+    module's section, or an implementation path of a public object, resolves to the public
+    object of that name, at the top level or in the submodule that documents it."""
+    if node.get("refdomain") != "py":
+        return None
+    target = node["reftarget"].lstrip("~.")
+    domain = env.get_domain("py")
+    candidates = [target]
+    if target.startswith("impactqp."):  # an implementation path: its public name, if any
+        candidates.append(target.rsplit(".", 1)[1])
+    for module, short in ((m, c) for c in candidates for m in PUBLIC_MODULES):
+        name = f"{module}.{short}"
+        if name in domain.objects:
+            return domain.resolve_xref(env, node["refdoc"], app.builder, node["reftype"], name,
+                                       node, contnode)
+    return None
+
+
 def setup(app):
     """``.. impactqp-help:: [SUBCOMMAND ...]`` renders the command line's own help text, so
-    the command-line page cannot drift from the parser."""
+    the command-line page cannot drift from the parser; bare names resolve across the public
+    modules (:func:`_public_reference`)."""
     from docutils import nodes
     from sphinx.util.docutils import SphinxDirective
 
@@ -87,4 +111,5 @@ def setup(app):
             return [block]
 
     app.add_directive("impactqp-help", ImpactqpHelp)
+    app.connect("missing-reference", _public_reference)
     return {"parallel_read_safe": True}

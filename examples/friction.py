@@ -73,7 +73,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out", type=Path, help="folder for the sphere's problem file "
                                                  "(default: write nothing)")
     args = parser.parse_args(argv)
-    problem = iq.sphere_on_plane(MASS, RADIUS, U_MINUS)
+    problem = iq.friction.sphere_on_plane(MASS, RADIUS, U_MINUS)
     sphere_table(problem)
     fclib_table()
     if args.out is not None:

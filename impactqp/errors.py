@@ -3,9 +3,36 @@
 Every error the library raises on purpose derives from :class:`ImpactError`.
 Errors caused by the caller's input also derive from :class:`ValueError`, so
 ``except ValueError`` keeps working for code that does not know impactqp.
+
+This module is public: ``impactqp.errors`` holds every exception class; the top level of
+:mod:`impactqp` re-exports the base and the few that callers catch most.
 """
 
 from __future__ import annotations
+
+__all__ = [
+    "ImpactError",
+    "InputError",
+    "ShapeError",
+    "NonFiniteError",
+    "MassMatrixError",
+    "RestitutionError",
+    "UnknownBackendError",
+    "NonConvexLCPError",
+    "NonSymmetricLCPError",
+    "OutOfRangeError",
+    "ProblemFileError",
+    "OptionalDependencyError",
+    "BackendUnsuitableError",
+    "SolverError",
+    "NonFiniteStateError",
+    "NoSolutionError",
+    "CertificateError",
+    "SectorLawError",
+    "SectorInputError",
+    "SectorTableTooLarge",
+    "IntegrationBudgetError",
+]
 
 
 class ImpactError(Exception):

@@ -129,7 +129,7 @@ def test_save_fclib(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
 
 @pytest.fixture(scope="module")
 def trajectory() -> iq.Trajectory:
-    return iq.simulate(iq.bouncing_ball(), iq.Newton(0.9), 0.5, h=0.01)
+    return iq.simulate(iq.simulation.bouncing_ball(), iq.Newton(0.9), 0.5, h=0.01)
 
 
 @pytest.mark.parametrize("suffix, writer", [(".npz", "savez_compressed"), (".csv", "savetxt")])
@@ -164,7 +164,7 @@ def test_figures(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, trajectory) ->
         with pytest.raises(Interrupted):
             trajectory.plot("energy", path)
         with pytest.raises(Interrupted):
-            plot_comparison([iq.compare_chain(iq.monodisperse_chain(3))], path)
+            plot_comparison([iq.verification.compare_chain(iq.chains.monodisperse_chain(3))], path)
     assert_untouched(path)
     plot_sectors(path)
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -176,7 +176,7 @@ def test_animation(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     pytest.importorskip("matplotlib")
     from matplotlib.animation import Animation
 
-    cradle = iq.simulate(iq.cradle_system(3), iq.SectorLaw(), 1.0, scheme="event-driven",
+    cradle = iq.simulate(iq.simulation.cradle_system(3), iq.SectorLaw(), 1.0, scheme="event-driven",
                          h=0.05)
     path = previous(tmp_path / "c.gif")
     with monkeypatch.context() as patch:

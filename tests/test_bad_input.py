@@ -155,12 +155,13 @@ def test_dense_backends_refuse_large_sparse_problems(backend: str) -> None:
 
 
 def test_tables_and_maps() -> None:
-    refuses(lambda: iq.reflection_law_table("a"), "masses")
-    refuses(lambda: iq.reflection_law_table([1.0, 1j, 1.0]), "masses")
-    refuses(lambda: iq.sector_law_table("3"), "n_balls")
-    refuses(lambda: iq.continuous_mass_ratios(None), "k")
-    refuses(lambda: iq.fremond_admissibility_map(CRADLE, None, [0.0]), "a_values")
-    refuses(lambda: iq.fremond_admissibility_map(CRADLE, [np.nan], [0.0]), "a_values")
-    refuses(lambda: iq.fremond_admissibility_map(CRADLE, [0.5], [0.0], samples="a"), "samples")
-    refuses(lambda: iq.fremond_admissibility_map(None, [0.5], [0.0]), "problem")
+    refuses(lambda: iq.tables.reflection_law_table("a"), "masses")
+    refuses(lambda: iq.tables.reflection_law_table([1.0, 1j, 1.0]), "masses")
+    refuses(lambda: iq.tables.sector_law_table("3"), "n_balls")
+    refuses(lambda: iq.tables.continuous_mass_ratios(None), "k")
+    refuses(lambda: iq.verification.fremond_admissibility_map(CRADLE, None, [0.0]), "a_values")
+    refuses(lambda: iq.verification.fremond_admissibility_map(CRADLE, [np.nan], [0.0]), "a_values")
+    refuses(lambda: iq.verification.fremond_admissibility_map(CRADLE, [0.5], [0.0], samples="a"),
+            "samples")
+    refuses(lambda: iq.verification.fremond_admissibility_map(None, [0.5], [0.0]), "problem")
     refuses(lambda: iq.load_problem(None), "path")

@@ -96,8 +96,9 @@ def test_lazy_structure_serves_every_consumer(sparse):
 
 
 @pytest.mark.parametrize("masses,error", [
-    ([[1.0, 2.0]], iq.ShapeError), ([], iq.ShapeError), ([1.0, np.nan], iq.NonFiniteError),
-    ([1.0, np.inf], iq.NonFiniteError), ([1.0, 0.0], iq.MassMatrixError),
+    ([[1.0, 2.0]], iq.errors.ShapeError), ([], iq.errors.ShapeError),
+    ([1.0, np.nan], iq.errors.NonFiniteError),
+    ([1.0, np.inf], iq.errors.NonFiniteError), ([1.0, 0.0], iq.errors.MassMatrixError),
     ([1.0, -2.0], iq.InputError)])
 def test_chain_masses_checked(masses, error):
     with pytest.raises(error, match="masses"):

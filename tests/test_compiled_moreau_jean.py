@@ -19,10 +19,10 @@ from impactqp.simulation.step_law import MoreauJeanStep
 from impactqp.simulation.time_stepping import compiled_applies, moreau_jean
 
 SYSTEMS = {
-    "ball": (lambda: iq.bouncing_ball(), 0.005, 2.5),
-    "cradle3": (lambda: iq.cradle_system(3), 1e-3, 0.7),
-    "cradle5": (lambda: iq.cradle_system(5, released=2), 1e-3, 0.7),
-    "beads10": (lambda: iq.bead_chain(10), 1e-3, 0.6),
+    "ball": (lambda: iq.simulation.bouncing_ball(), 0.005, 2.5),
+    "cradle3": (lambda: iq.simulation.cradle_system(3), 1e-3, 0.7),
+    "cradle5": (lambda: iq.simulation.cradle_system(5, released=2), 1e-3, 0.7),
+    "beads10": (lambda: iq.simulation.bead_chain(10), 1e-3, 0.6),
 }
 
 
@@ -102,7 +102,7 @@ def test_compiled_loop_equals_the_python_loop(name, law, theta, record_every):
 
 
 def test_compiled_loop_reproduces_siconos_bouncing_ball():
-    tr = iq.simulate(iq.bouncing_ball(), iq.Newton(0.9), 10.0, h=0.005, theta=0.5)
+    tr = iq.simulate(iq.simulation.bouncing_ball(), iq.Newton(0.9), 10.0, h=0.005, theta=0.5)
     assert tr.settings["loop"] == "compiled" and tr.t.size == 2001
     ref = np.array(SICONOS_BOUNCING_BALL)
     k = ref[:, 0].astype(int)
@@ -174,7 +174,7 @@ class MyNewton(iq.Newton):
 @pytest.mark.parametrize("case", ["callable force", "user law", "sector law", "backend",
                                   "sparse"])
 def test_routing_rule(case):
-    ball = iq.bouncing_ball()
+    ball = iq.simulation.bouncing_ball()
     system, law, backend = ball, iq.Newton(0.9), "auto"
     if case == "callable force":
         system = iq.LinearSystem(ball.M, ball.q0, ball.v0, lambda t, q, v: [-9.81], ball.H,
@@ -182,11 +182,11 @@ def test_routing_rule(case):
     elif case == "user law":
         law = MyNewton(0.9)
     elif case == "sector law":
-        system, law = iq.cradle_system(3), iq.SectorLaw()
+        system, law = iq.simulation.cradle_system(3), iq.SectorLaw()
     elif case == "backend":
         backend = "clarabel"
     else:
-        system = iq.cradle_system(3, sparse=True)
+        system = iq.simulation.cradle_system(3, sparse=True)
     assert not compiled_applies(system, law, backend)
     tr = iq.simulate(system, law, 0.05, h=0.005, backend=backend)
     assert tr.settings["loop"] == "python"

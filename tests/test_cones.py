@@ -108,7 +108,7 @@ def test_the_registry_lists_the_cone_form() -> None:
     listed = {b["name"]: b["forms"] for b in iq.available_backends()}
     assert {name for name, forms in listed.items() if "cone" in forms} == {"clarabel", "cvxpy"}
     assert backends.cone_backends() == ("clarabel", "cvxpy")
-    with pytest.raises(iq.UnknownBackendError, match="not installed"):
+    with pytest.raises(iq.errors.UnknownBackendError, match="not installed"):
         solve_cone(soc_projection(np.ones(3)), "cvxpy:NOSUCHSOLVER")
 
 
@@ -134,22 +134,22 @@ def test_an_answer_that_fails_its_certificate_is_an_error(monkeypatch) -> None:
 
 
 BAD = [
-    (dict(cones=[Cone("soc", 2)]), iq.ShapeError, "add up to 2 rows but A has 3"),
+    (dict(cones=[Cone("soc", 2)]), iq.errors.ShapeError, "add up to 2 rows but A has 3"),
     (dict(cones=[Cone("soc", 0), Cone("soc", 3)]), iq.InputError, "size of cone 0.*≥ 1"),
     (dict(cones=[Cone("cone", 3)]), iq.InputError, "kind 'cone'"),
     (dict(cones=[("soc", 1.5), ("soc", 1.5)]), iq.InputError, "whole number"),
     (dict(cones=[Cone("nonnegative", -1), Cone("soc", 4)]), iq.InputError, "≥ 0"),
     (dict(cones="soc"), iq.InputError, "sequence of"),
     (dict(cones=[3]), iq.InputError, "pair"),
-    (dict(c=[np.nan, 0.0, 0.0]), iq.NonFiniteError, "c must be finite"),
-    (dict(b=[0.0, np.inf, 0.0]), iq.NonFiniteError, "b must be finite"),
-    (dict(A=sp.csc_matrix([[np.nan, 0, 0], [0, 1, 0], [0, 0, 1]])), iq.NonFiniteError,
+    (dict(c=[np.nan, 0.0, 0.0]), iq.errors.NonFiniteError, "c must be finite"),
+    (dict(b=[0.0, np.inf, 0.0]), iq.errors.NonFiniteError, "b must be finite"),
+    (dict(A=sp.csc_matrix([[np.nan, 0, 0], [0, 1, 0], [0, 0, 1]])), iq.errors.NonFiniteError,
      "A must be finite"),
     (dict(P=[[1.0, 2.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), iq.InputError,
      "symmetric"),
-    (dict(P=np.eye(2)), iq.ShapeError, "P must be 3 × 3"),
-    (dict(b=[0.0, 0.0]), iq.ShapeError, "b must have 3 entries"),
-    (dict(A=np.eye(3)[:, :2]), iq.ShapeError, "A must have 3 columns"),
+    (dict(P=np.eye(2)), iq.errors.ShapeError, "P must be 3 × 3"),
+    (dict(b=[0.0, 0.0]), iq.errors.ShapeError, "b must have 3 entries"),
+    (dict(A=np.eye(3)[:, :2]), iq.errors.ShapeError, "A must have 3 columns"),
 ]
 
 
@@ -168,7 +168,7 @@ def test_solve_cone_checks_its_arguments() -> None:
         solve_cone("not a program")
     with pytest.raises(iq.InputError, match="tol"):
         solve_cone(program, tol=0.0)
-    with pytest.raises(iq.UnknownBackendError, match="unknown backend"):
+    with pytest.raises(iq.errors.UnknownBackendError, match="unknown backend"):
         solve_cone(program, "mosek")
     with pytest.raises(iq.InputError, match="clarabel has no setting"):
         solve_cone(program, "clarabel", options={"no_such_setting": 1})

@@ -42,7 +42,7 @@ def test_sphere_on_plane_matches_the_closed_form(u, mu, e) -> None:
     expected, stick = sphere_closed_form(m, R, 0.4 * m * R * R, u, mu, e)
     # the effective tangential mass of a solid sphere is 2/7 m: stick iff |s| ≤ 7/2 μ(1+e)|vₙ|
     assert stick == (abs(u[0] + R * u[2]) <= 3.5 * mu * (1 + e) * abs(u[1]))
-    result = iq.solve(iq.sphere_on_plane(m, R, u), iq.Coulomb(mu, e))
+    result = iq.solve(iq.friction.sphere_on_plane(m, R, u), iq.Coulomb(mu, e))
     assert result.ok and result.certificate.natural_map <= 1e-9
     np.testing.assert_allclose(result.u_plus, expected, rtol=1e-9, atol=1e-9 * max(map(abs, u)))
     slip_after = result.u_plus[0] + R * result.u_plus[2]
@@ -61,7 +61,7 @@ def test_both_regimes_are_met() -> None:
 def test_point_mass_in_space_slides_along_its_slip(mu) -> None:
     u = np.array([3.0, 4.0, -2.0])
     e = 0.25
-    result = iq.solve(iq.point_on_plane(1.5, u), iq.Coulomb(mu, e))
+    result = iq.solve(iq.friction.point_on_plane(1.5, u), iq.Coulomb(mu, e))
     loss = min(5.0, mu * (1 + e) * 2.0)  # the tangential speed lost, at most all of it
     expected = np.array([3.0, 4.0, 0.0]) * (5.0 - loss) / 5.0
     expected[2] = e * 2.0
@@ -69,7 +69,7 @@ def test_point_mass_in_space_slides_along_its_slip(mu) -> None:
 
 
 def test_separating_contact_gets_no_impulse() -> None:
-    result = iq.solve(iq.point_on_plane(1.0, [1.0, 2.0]), iq.Coulomb(0.5, 0.5))
+    result = iq.solve(iq.friction.point_on_plane(1.0, [1.0, 2.0]), iq.Coulomb(0.5, 0.5))
     np.testing.assert_allclose(result.u_plus, [1.0, 2.0], atol=1e-12)
     np.testing.assert_allclose(result.impulses, 0.0, atol=1e-12)
 
@@ -102,9 +102,10 @@ def test_mu_zero_is_newton_on_the_normal_problem(d) -> None:
 
 
 def test_large_mu_sticks() -> None:
-    for p in (iq.sphere_on_plane(1.0, 0.3, [2.0, -1.0, 5.0]),
-              iq.sphere_on_plane(1.0, 0.3, [2.0, 1.0, -1.0, 0.5, 3.0, 1.0]),
-              iq.two_spheres([1.0, 3.0], [0.5, 0.2], [1, 0.3, 2, -1, 0.5, 0], normal=[1, 0.2])):
+    for p in (iq.friction.sphere_on_plane(1.0, 0.3, [2.0, -1.0, 5.0]),
+              iq.friction.sphere_on_plane(1.0, 0.3, [2.0, 1.0, -1.0, 0.5, 3.0, 1.0]),
+              iq.friction.two_spheres([1.0, 3.0], [0.5, 0.2], [1, 0.3, 2, -1, 0.5, 0],
+                                      normal=[1, 0.2])):
         gamma = iq.solve(p, iq.Coulomb(1e3, 0.5)).gamma_plus
         d = p.contact_dim
         np.testing.assert_allclose(gamma.reshape(-1, d)[:, 1:], 0.0, atol=1e-9)
@@ -115,8 +116,8 @@ def test_planar_and_spatial_models_agree() -> None:
     u2 = np.array([3.0, -1.0, 2.0])  # (vₓ, v_y = normal, ω about z)
     u3 = np.array([3.0, 0.0, -1.0, 0.0, -2.0, 0.0])  # (vₓ, v_y, v_z = normal, ω): ω_y = −ω
     for mu in (0.05, 0.5):
-        a = iq.solve(iq.sphere_on_plane(1.0, 0.5, u2), iq.Coulomb(mu, 0.3)).u_plus
-        b = iq.solve(iq.sphere_on_plane(1.0, 0.5, u3), iq.Coulomb(mu, 0.3)).u_plus
+        a = iq.solve(iq.friction.sphere_on_plane(1.0, 0.5, u2), iq.Coulomb(mu, 0.3)).u_plus
+        b = iq.solve(iq.friction.sphere_on_plane(1.0, 0.5, u3), iq.Coulomb(mu, 0.3)).u_plus
         np.testing.assert_allclose(b, [a[0], 0.0, a[1], 0.0, -a[2], 0.0], rtol=1e-9,
                                    atol=1e-12)
     # two spheres moving in the x–y plane: (v, ω_z) per sphere against (v, 0, 0, 0, ω_z)
@@ -124,9 +125,9 @@ def test_planar_and_spatial_models_agree() -> None:
     spatial = np.zeros(12)
     spatial[[0, 1, 5, 6, 7, 11]] = planar
     for mu in (0.05, 0.8):
-        a = iq.solve(iq.two_spheres([1, 2], [0.5, 1], planar, normal=[1, 0.3]),
+        a = iq.solve(iq.friction.two_spheres([1, 2], [0.5, 1], planar, normal=[1, 0.3]),
                      iq.Coulomb(mu, 0.4)).u_plus
-        b = iq.solve(iq.two_spheres([1, 2], [0.5, 1], spatial, normal=[1, 0.3, 0]),
+        b = iq.solve(iq.friction.two_spheres([1, 2], [0.5, 1], spatial, normal=[1, 0.3, 0]),
                      iq.Coulomb(mu, 0.4)).u_plus
         np.testing.assert_allclose(b[[0, 1, 5, 6, 7, 11]], a, rtol=1e-8, atol=1e-10)
         np.testing.assert_allclose(b[[2, 3, 4, 8, 9, 10]], 0.0, atol=1e-10)
@@ -134,7 +135,7 @@ def test_planar_and_spatial_models_agree() -> None:
 
 def test_two_spheres_conserve_momentum_and_angular_momentum_about_the_contact() -> None:
     masses, radii = np.array([1.0, 2.0]), np.array([0.5, 1.0])
-    p = iq.two_spheres(masses, radii, [1.0, 0.5, 2.0, -1.0, 0.2, -1.0], normal=[1, 0])
+    p = iq.friction.two_spheres(masses, radii, [1.0, 0.5, 2.0, -1.0, 0.2, -1.0], normal=[1, 0])
     u = iq.solve(p, iq.Coulomb(0.3, 0.5)).u_plus
     before, after = p.u_minus.reshape(2, 3), u.reshape(2, 3)
     np.testing.assert_allclose(masses @ after[:, :2], masses @ before[:, :2], rtol=1e-12)
@@ -200,7 +201,7 @@ def test_two_spheres_match_the_closed_form(mu, e) -> None:
     and the slip is stopped or reduced by μ(1+e)|γ⁻ₙ| G_tt/G_nn, G_nn = 1/m₁ + 1/m₂,
     G_tt = G_nn + R₁²/I₁ + R₂²/I₂."""
     m, R = np.array([1.0, 3.0]), np.array([0.5, 0.2])
-    p = iq.two_spheres(m, R, [1.0, 0.3, 2.0, -1.0, 0.5, 0.0], normal=[1.0, 0.2])
+    p = iq.friction.two_spheres(m, R, [1.0, 0.3, 2.0, -1.0, 0.5, 0.0], normal=[1.0, 0.2])
     g_nn = (1 / m).sum()
     g_tt = g_nn + (R ** 2 / (0.4 * m * R ** 2)).sum()
     gn, gt = p.gamma_minus
@@ -211,7 +212,7 @@ def test_two_spheres_match_the_closed_form(mu, e) -> None:
 
 
 def test_batch_equals_single_solves() -> None:
-    p = iq.sphere_on_plane(2.0, 0.5, [1.0, -1.0, 0.0])
+    p = iq.friction.sphere_on_plane(2.0, 0.5, [1.0, -1.0, 0.0])
     law = iq.Coulomb(0.3, 0.5)
     rows = np.random.default_rng(0).standard_normal((6, 3)) - [0.0, 2.0, 0.0]
     batch = iq.solve_batch(p, law, rows)
@@ -225,7 +226,7 @@ def test_batch_equals_single_solves() -> None:
 # --- the certificate ----------------------------------------------------------------------------
 
 def test_certificate_fails_corrupted_answers() -> None:
-    p = iq.sphere_on_plane(2.0, 0.5, [3.0, -1.0, 0.0])
+    p = iq.friction.sphere_on_plane(2.0, 0.5, [3.0, -1.0, 0.0])
     law = iq.Coulomb(0.1, 0.5)
     good = iq.solve(p, law)
     assert law.certificate(p, Answer(good.u_plus, good.impulses), 1e-9).ok
@@ -300,7 +301,7 @@ def test_membership_rank_deficient_uses_the_cone_program() -> None:
 
 
 def test_verify_law_on_coulomb_and_on_a_law_leaving_the_cone() -> None:
-    p = iq.sphere_on_plane(2.0, 0.5, [1.0, -1.0, 0.0])
+    p = iq.friction.sphere_on_plane(2.0, 0.5, [1.0, -1.0, 0.0])
     report = iq.verify_law(iq.Coulomb(0.3, 0.5), p, samples=40)
     assert {k: report.violations[k] for k in ("kinematic", "kinetic", "energetic",
                                               "law_error")} == dict.fromkeys(
@@ -342,27 +343,27 @@ def test_no_restitution_never_gains_energy_and_restitution_may() -> None:
 
 def test_bad_input_named_errors() -> None:
     M, W = np.eye(3), np.ones((3, 5))
-    with pytest.raises(iq.ShapeError, match="multiple of contact_dim"):
+    with pytest.raises(iq.errors.ShapeError, match="multiple of contact_dim"):
         iq.ImpactProblem(M, W, np.zeros(3), contact_dim=2)
     for d in (0, 4, 1.5, True):
         with pytest.raises(iq.InputError, match="contact_dim"):
             iq.ImpactProblem(M, np.ones((3, 6)), np.zeros(3), contact_dim=d)
     with pytest.raises(iq.InputError, match="mu"):
         iq.Coulomb(-0.1)
-    with pytest.raises(iq.NonFiniteError):
+    with pytest.raises(iq.errors.NonFiniteError):
         iq.Coulomb(np.nan)
-    with pytest.raises(iq.RestitutionError):
+    with pytest.raises(iq.errors.RestitutionError):
         iq.Coulomb(0.1, 1.5)
-    with pytest.raises(iq.RestitutionError):
+    with pytest.raises(iq.errors.RestitutionError):
         iq.Coulomb(0.1, -0.5)
     with pytest.raises(iq.InputError, match="method"):
         iq.Coulomb(0.1, method="simplex")
     with pytest.raises(iq.InputError):
         iq.Coulomb([[0.1]])
-    p = iq.point_on_plane(1.0, [1.0, -1.0])
-    with pytest.raises(iq.ShapeError, match="mu"):
+    p = iq.friction.point_on_plane(1.0, [1.0, -1.0])
+    with pytest.raises(iq.errors.ShapeError, match="mu"):
         iq.solve(p, iq.Coulomb([0.1, 0.2]))
-    with pytest.raises(iq.RestitutionError):
+    with pytest.raises(iq.errors.RestitutionError):
         iq.solve(p, iq.Coulomb(0.1, [0.1, 0.2]))
     with pytest.raises(iq.InputError, match="iq.Coulomb"):
         iq.solve(p, iq.Moreau(0.5))
@@ -380,19 +381,19 @@ def test_bad_input_named_errors() -> None:
     with pytest.raises(iq.InputError, match="normal_problem"):
         iq.classify(p, iq.solve(p, iq.Coulomb(0.1)).u_plus)
     with pytest.raises(iq.InputError):
-        iq.sphere_on_plane(-1.0, 0.5, [1.0, -1.0, 0.0])
-    with pytest.raises(iq.ShapeError):
-        iq.sphere_on_plane(1.0, 0.5, [1.0, -1.0])
-    with pytest.raises(iq.ShapeError):
-        iq.two_spheres([1.0], [0.5, 0.5], np.zeros(6))
-    with pytest.raises(iq.NonFiniteError):
-        iq.point_on_plane(1.0, [np.nan, -1.0])
+        iq.friction.sphere_on_plane(-1.0, 0.5, [1.0, -1.0, 0.0])
+    with pytest.raises(iq.errors.ShapeError):
+        iq.friction.sphere_on_plane(1.0, 0.5, [1.0, -1.0])
+    with pytest.raises(iq.errors.ShapeError):
+        iq.friction.two_spheres([1.0], [0.5, 0.5], np.zeros(6))
+    with pytest.raises(iq.errors.NonFiniteError):
+        iq.friction.point_on_plane(1.0, [np.nan, -1.0])
 
 
 def test_problem_files_keep_the_friction(tmp_path) -> None:
     """A frictional problem reads back with its contact_dim (never silently frictionless);
     its normal problem is a frictionless file (more in tests/test_friction_files.py)."""
-    p = iq.point_on_plane(1.0, [1.0, -1.0])
+    p = iq.friction.point_on_plane(1.0, [1.0, -1.0])
     back = iq.load_problem(iq.save_problem(p, tmp_path / "p.json")).problem
     assert back.contact_dim == 2
     np.testing.assert_array_equal(back.W, p.W)
@@ -403,7 +404,7 @@ def test_problem_files_keep_the_friction(tmp_path) -> None:
 
 
 def test_normal_problem_and_frictionless_default_unchanged() -> None:
-    p = iq.sphere_on_plane(1.0, 0.5, [1.0, -1.0, 0.0])
+    p = iq.friction.sphere_on_plane(1.0, 0.5, [1.0, -1.0, 0.0])
     normal = p.normal_problem()
     assert normal.contact_dim == 1 and normal.n_contacts == 1 == p.n_contacts
     assert p.n_impulses == 2 and normal.n_impulses == 1

@@ -80,10 +80,11 @@ def geometry_cases():
 
 
 def simulation_cases():
-    unit = iq.simulate(iq.bouncing_ball(q0=1.0), iq.Newton(0.9), 10.0, scheme="event-driven")
+    unit = iq.simulate(iq.simulation.bouncing_ball(q0=1.0), iq.Newton(0.9), 10.0,
+                       scheme="event-driven")
     for length in [1e-9, 1e-3, 1.0, 1e3, 1e9]:
         for mass in [1e-12, 1.0, 1e12]:
-            ball = iq.bouncing_ball(mass=mass, q0=length)
+            ball = iq.simulation.bouncing_ball(mass=mass, q0=length)
             t_end = 10.0 * np.sqrt(length)
             yield (f"event-driven L={length:g} m={mass:g}",
                    lambda ball=ball, t_end=t_end: iq.simulate(ball, iq.Newton(0.9), t_end,

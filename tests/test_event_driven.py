@@ -19,8 +19,9 @@ def _as_callable(system: iq.LinearSystem) -> iq.LinearSystem:
 
 
 @pytest.mark.parametrize("system, law", [
-    (iq.bouncing_ball(q0=1.0), iq.Newton(0.9)),
-    (iq.bouncing_ball(mass=3.0, q0=0.2, v0=1.5, gravity=1.62, radius=0.05), iq.Newton(0.5)),
+    (iq.simulation.bouncing_ball(q0=1.0), iq.Newton(0.9)),
+    (iq.simulation.bouncing_ball(mass=3.0, q0=0.2, v0=1.5, gravity=1.62, radius=0.05),
+     iq.Newton(0.5)),
 ])
 def test_exact_flight_matches_the_ode_path(system, law):
     exact = iq.simulate(system, law, 10.0, scheme="event-driven")
@@ -38,7 +39,7 @@ def test_exact_flight_matches_the_ode_path(system, law):
 def test_exact_flight_of_a_bead_column_starts_like_the_ode_path(n, law):
     """A falling column's micro-impacts are sensitive to round-off after a few events; its
     first ones agree."""
-    system = iq.bead_chain(n)
+    system = iq.simulation.bead_chain(n)
     exact = iq.simulate(system, law, 0.45, scheme="event-driven")
     ode = iq.simulate(_as_callable(system), law, 0.45, scheme="event-driven")
     for a, b in zip(exact.events[:3], ode.events[:3]):
@@ -49,7 +50,7 @@ def test_exact_flight_of_a_bead_column_starts_like_the_ode_path(n, law):
 
 def test_a_falling_ball_lands_when_the_closed_form_says():
     q0, g, e = 1.0, 9.81, 0.9
-    tr = iq.simulate(iq.bouncing_ball(q0=q0, gravity=g), iq.Newton(e), 3.5,
+    tr = iq.simulate(iq.simulation.bouncing_ball(q0=q0, gravity=g), iq.Newton(e), 3.5,
                      scheme="event-driven")
     t1 = np.sqrt(2 * q0 / g)
     k = np.arange(1, 6)
@@ -95,9 +96,10 @@ def test_grazing_impacts_are_found(m, k, c, v0):
 def test_the_same_motion_in_other_units_has_the_same_events(scale):
     """A ball dropped from q₀ = s under the same g: lengths scale by s, times by √s,
     velocities by √s; the default thresholds follow the system's own scales."""
-    unit = iq.simulate(iq.bouncing_ball(q0=1.0), iq.Newton(0.9), 10.0,
+    unit = iq.simulate(iq.simulation.bouncing_ball(q0=1.0), iq.Newton(0.9), 10.0,
                        scheme="event-driven")
-    scaled = iq.simulate(iq.bouncing_ball(q0=scale), iq.Newton(0.9), 10.0 * np.sqrt(scale),
+    scaled = iq.simulate(iq.simulation.bouncing_ball(q0=scale), iq.Newton(0.9),
+                         10.0 * np.sqrt(scale),
                          scheme="event-driven")
     assert len(scaled.events) == len(unit.events) > 100
     np.testing.assert_allclose(scaled.impact_times / np.sqrt(scale), unit.impact_times,
@@ -109,9 +111,9 @@ def test_the_same_motion_in_other_units_has_the_same_events(scale):
 def test_a_cradle_in_other_length_units_has_the_same_events(length):
     """Newton's cradle with lengths (amplitude and pendulum) in other units: the same
     impacts at the same times (the period √(L/g) scales with L)."""
-    unit = iq.simulate(iq.cradle_system(3, amplitude=0.1), iq.SectorLaw(), 3.0,
+    unit = iq.simulate(iq.simulation.cradle_system(3, amplitude=0.1), iq.SectorLaw(), 3.0,
                        scheme="event-driven")
-    other = iq.simulate(iq.cradle_system(3, amplitude=0.1 * length, length=length,
+    other = iq.simulate(iq.simulation.cradle_system(3, amplitude=0.1 * length, length=length,
                                          gravity=9.81 * length), iq.SectorLaw(), 3.0,
                         scheme="event-driven")
     np.testing.assert_allclose(other.impact_times, unit.impact_times, rtol=1e-9)

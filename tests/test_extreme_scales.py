@@ -60,7 +60,7 @@ def test_an_answer_among_the_subnormals_is_accurate_or_named():
 
 
 @pytest.mark.parametrize("make", [
-    lambda: iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0]).admissible_set(mu=0.3).contains(
+    lambda: iq.friction.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0]).admissible_set(mu=0.3).contains(
         [1e200, 0.0, 0.0]),
     lambda: iq.newtons_cradle(3, 1e-200).admissible_set().contains([0.0, 0.0, 1e16]),
     lambda: iq.newtons_cradle(3, 1.0).admissible_set().contains([0.0, 0.0, 1e300]),

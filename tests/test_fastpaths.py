@@ -72,11 +72,11 @@ def test_batch_equals_loop(make):
 
 def test_batch_rejects_bad_rows():
     p = iq.newtons_cradle()
-    with pytest.raises(iq.ShapeError, match="U_minus"):
+    with pytest.raises(iq.errors.ShapeError, match="U_minus"):
         iq.moreau_batch(p, np.zeros((4, 2)))
-    with pytest.raises(iq.NonFiniteError, match="U_minus"):
+    with pytest.raises(iq.errors.NonFiniteError, match="U_minus"):
         iq.moreau_batch(p, np.full((2, 3), np.nan))
-    with pytest.raises(iq.RestitutionError):
+    with pytest.raises(iq.errors.RestitutionError):
         iq.moreau_batch(p, np.zeros((2, 3)), eps=2.0)
 
 
@@ -89,5 +89,5 @@ def test_sector_law_batch_matches_single_calls():
         r = iq.sector_law(p.with_u_minus(U[i]))
         np.testing.assert_array_equal(b.u_plus[i], r.u_plus)
         np.testing.assert_allclose(b.impulses[i], r.impulses, atol=1e-14)
-    with pytest.raises(iq.SectorLawError):
+    with pytest.raises(iq.errors.SectorLawError):
         iq.sector_law_batch(iq.chain([1.0, 2.0, 1.0], [1.0, 0, 0]), U[:, :3])

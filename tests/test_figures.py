@@ -167,7 +167,7 @@ def test_figure_errors(tmp_path, monkeypatch):
     with pytest.raises(iq.InputError, match="exactly 2 independent"):
         plot_S(iq.newtons_cradle(4), tmp_path / "x.png")
     monkeypatch.setitem(sys.modules, "matplotlib.figure", None)
-    with pytest.raises(iq.OptionalDependencyError, match=r"pip install 'impactqp\[plot\]'"):
+    with pytest.raises(iq.errors.OptionalDependencyError, match=r"pip install 'impactqp\[plot\]'"):
         plot_cradle(tmp_path / "x.png")
     assert not (tmp_path / "x.png").exists()
 

@@ -84,7 +84,7 @@ BAD = [
 def test_bad_json_files_name_the_field(tmp_path, text, message):
     path = tmp_path / "bad.json"
     path.write_text(text)
-    with pytest.raises(iq.ProblemFileError) as info:
+    with pytest.raises(iq.errors.ProblemFileError) as info:
         iq.load_problem(path)
     assert message in str(info.value) and str(path) in str(info.value)
     assert isinstance(info.value, ValueError)
@@ -98,23 +98,23 @@ def test_bad_json_files_name_the_field(tmp_path, text, message):
 def test_bad_toml_files(tmp_path, text, message):
     path = tmp_path / "bad.toml"
     path.write_text(text)
-    with pytest.raises(iq.ProblemFileError) as info:
+    with pytest.raises(iq.errors.ProblemFileError) as info:
         iq.load_problem(path)
     assert message in str(info.value)
 
 
 def test_limits_and_paths(tmp_path, monkeypatch):
-    with pytest.raises(iq.ProblemFileError, match="suffix '.yaml'"):
+    with pytest.raises(iq.errors.ProblemFileError, match="suffix '.yaml'"):
         iq.load_problem(tmp_path / "p.yaml")
-    with pytest.raises(iq.ProblemFileError, match="cannot read"):
+    with pytest.raises(iq.errors.ProblemFileError, match="cannot read"):
         iq.load_problem(tmp_path / "missing.json")
     big = tmp_path / "big.json"
     big.write_text(json.dumps({"masses": [1.0] * 11, "u_minus": [0.0] * 11}))
     monkeypatch.setattr(files, "MAX_DOF", 10)
-    with pytest.raises(iq.ProblemFileError, match="limited to 10"):
+    with pytest.raises(iq.errors.ProblemFileError, match="limited to 10"):
         iq.load_problem(big)
     monkeypatch.setattr(files, "MAX_FILE_BYTES", 100)
-    with pytest.raises(iq.ProblemFileError, match="MB limit"):
+    with pytest.raises(iq.errors.ProblemFileError, match="MB limit"):
         iq.load_problem(big)
 
 
@@ -122,7 +122,7 @@ def test_toml_without_tomllib_says_what_to_install(tmp_path, monkeypatch):
     path = iq.save_problem(iq.newtons_cradle(), tmp_path / "c.toml")
     monkeypatch.setitem(sys.modules, "tomllib", None)
     monkeypatch.setitem(sys.modules, "tomli", None)
-    with pytest.raises(iq.ProblemFileError, match="pip install tomli"):
+    with pytest.raises(iq.errors.ProblemFileError, match="pip install tomli"):
         iq.load_problem(path)
 
 
@@ -130,7 +130,7 @@ def test_save_refuses_what_it_could_not_read(tmp_path):
     p = iq.newtons_cradle()
     with pytest.raises(iq.InputError, match="coefficients need a law"):
         iq.save_problem(p, tmp_path / "x.json", coefficients=0.5)
-    with pytest.raises(iq.ProblemFileError, match="eps must lie in"):
+    with pytest.raises(iq.errors.ProblemFileError, match="eps must lie in"):
         iq.save_problem(p, tmp_path / "x.json", law="moreau", coefficients=2.0)
     assert not (tmp_path / "x.json").exists()
 
@@ -152,7 +152,7 @@ def test_every_law_named_in_files_is_the_registrys() -> None:
     from impactqp.laws.catalogue import NAMED_LAWS, law_named
 
     cradle = iq.newtons_cradle(3)
-    sphere = iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.3])
+    sphere = iq.friction.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.3])
     frictional = iq.ImpactProblem(sphere.M, np.hstack([sphere.structure.W] * 2), sphere.u_minus,
                                   contact_dim=2)
     coefficients = {"eps": 0.5, "e": [1.0, 0.5], "E": [[0.5, 0.0], [0.0, 0.5]],

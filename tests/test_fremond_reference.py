@@ -27,7 +27,7 @@ E₀₂ = 0."""
 def column() -> iq.LinearSystem:
     """Three touching beads (spacing = diameter) dropped from 0.3 m: every contact closes
     together at the ground impact, so the coupling of E acts."""
-    return iq.bead_chain(3, radius=0.1, height=0.3, spacing=0.2)
+    return iq.simulation.bead_chain(3, radius=0.1, height=0.3, spacing=0.2)
 
 
 def lcp(G: np.ndarray, q: np.ndarray) -> np.ndarray:

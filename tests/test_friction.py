@@ -440,14 +440,14 @@ def test_result_fields() -> None:
 @pytest.mark.parametrize("args, kwargs, error", [
     ((np.eye(3), [1.0, 0, 0], -0.1), {}, iq.InputError),
     ((np.eye(3), [1.0, 0, 0], 0.1), {"contact_dim": 4}, iq.InputError),
-    ((np.eye(3), [1.0, 0, 0], 0.1), {"contact_dim": 2}, iq.ShapeError),
-    ((np.eye(4), [1.0, 0, 0], 0.1), {}, iq.ShapeError),
-    ((np.eye(6), np.zeros(6), [0.1, 0.2, 0.3]), {}, iq.ShapeError),
-    ((np.eye(3), [np.nan, 0, 0], 0.1), {}, iq.NonFiniteError),
-    ((np.full((3, 3), np.inf), [1.0, 0, 0], 0.1), {}, iq.NonFiniteError),
-    ((np.eye(3), [1.0, 0, 0], np.nan), {}, iq.NonFiniteError),
+    ((np.eye(3), [1.0, 0, 0], 0.1), {"contact_dim": 2}, iq.errors.ShapeError),
+    ((np.eye(4), [1.0, 0, 0], 0.1), {}, iq.errors.ShapeError),
+    ((np.eye(6), np.zeros(6), [0.1, 0.2, 0.3]), {}, iq.errors.ShapeError),
+    ((np.eye(3), [np.nan, 0, 0], 0.1), {}, iq.errors.NonFiniteError),
+    ((np.full((3, 3), np.inf), [1.0, 0, 0], 0.1), {}, iq.errors.NonFiniteError),
+    ((np.eye(3), [1.0, 0, 0], np.nan), {}, iq.errors.NonFiniteError),
     ((np.eye(3), [1.0, 0, 0], True), {}, iq.InputError),
-    ((np.eye(3), np.zeros(0), 0.1), {}, iq.ShapeError),
+    ((np.eye(3), np.zeros(0), 0.1), {}, iq.errors.ShapeError),
 ])
 def test_bad_inputs_are_named_errors(args, kwargs, error) -> None:
     with pytest.raises(error):
@@ -462,5 +462,5 @@ def test_bad_solver_arguments_are_named_errors() -> None:
         iq.solve_friction(problem, tol=2.0)
     with pytest.raises(iq.InputError, match="FrictionContactProblem"):
         iq.solve_friction((np.eye(3), np.zeros(3), 0.5))
-    with pytest.raises(iq.ShapeError):
+    with pytest.raises(iq.errors.ShapeError):
         certify_friction(problem, np.zeros(2))

@@ -32,14 +32,14 @@ def slip(mu: float) -> np.ndarray:
 
 def two_contacts() -> iq.ImpactProblem:
     """A disk landing on two collinear supports (two planar frictional contacts)."""
-    sphere = iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.3])
+    sphere = iq.friction.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.3])
     return iq.ImpactProblem(sphere.M, np.hstack([as_dense(sphere.W)] * 2), sphere.u_minus,
                             contact_dim=2)
 
 
 CASES = {
-    "planar": (lambda: iq.sphere_on_plane(2.0, 0.1, [1.0, -2.0, 0.5]), (0.3, 0.5)),
-    "spatial": (lambda: iq.two_spheres([1.0, 3.0], [0.1, 0.2], [1, 0.2, 0, 0, 0, 1,
+    "planar": (lambda: iq.friction.sphere_on_plane(2.0, 0.1, [1.0, -2.0, 0.5]), (0.3, 0.5)),
+    "spatial": (lambda: iq.friction.two_spheres([1.0, 3.0], [0.1, 0.2], [1, 0.2, 0, 0, 0, 1,
                                                                 -1, 0, 0.3, 0, 0.5, 0]),
                 (1 / 3, None)),
     "per contact": (two_contacts, (np.array([0.2, 0.7]), np.array([0.0, 1 / 3]))),
@@ -70,7 +70,7 @@ def test_frictional_problems_round_trip_exactly(tmp_path, suffix, case):
 
 def test_the_sample_file_is_the_builders_sphere_and_sticks():
     content = iq.load_problem(SAMPLE)
-    p = iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
+    p = iq.friction.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
     assert content.law == "coulomb" and content.coefficients == (0.3, 0.5)
     np.testing.assert_allclose(as_dense(content.problem.M), as_dense(p.M), rtol=1e-15)
     assert np.array_equal(as_dense(content.problem.W), as_dense(p.W))
@@ -121,7 +121,7 @@ BAD = [
 def test_bad_frictional_files_name_the_field(tmp_path, text, message):
     path = tmp_path / "bad.json"
     path.write_text(text, encoding="utf-8")
-    with pytest.raises(iq.ProblemFileError) as info:
+    with pytest.raises(iq.errors.ProblemFileError) as info:
         iq.load_problem(path)
     assert message in str(info.value) and str(path) in str(info.value)
 
@@ -129,12 +129,12 @@ def test_bad_frictional_files_name_the_field(tmp_path, text, message):
 def test_non_finite_mu_in_toml(tmp_path):
     path = tmp_path / "bad.toml"
     path.write_text(SAMPLE.read_text(encoding="utf-8").replace("mu = 0.3", "mu = nan"))
-    with pytest.raises(iq.ProblemFileError, match="mu must be finite"):
+    with pytest.raises(iq.errors.ProblemFileError, match="mu must be finite"):
         iq.load_problem(path)
 
 
 def test_saving_refuses_what_could_not_be_read_back(tmp_path):
-    p = iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
+    p = iq.friction.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
     with pytest.raises(iq.InputError, match=r"pair \(mu, e\)"):
         iq.save_problem(p, tmp_path / "a.toml", law="coulomb", coefficients=0.3)
     with pytest.raises(iq.InputError, match="acts on frictionless contacts"):
@@ -155,7 +155,7 @@ def test_coulomb_by_name_takes_the_pair():
         law_named("coulomb", 0.3)
     with pytest.raises(iq.InputError, match="needs its friction coefficient 'mu'"):
         law_named("coulomb", (None, 0.5))
-    with pytest.raises(iq.RestitutionError):
+    with pytest.raises(iq.errors.RestitutionError):
         law_named("coulomb", (0.3, 2.0))
 
 

@@ -26,7 +26,7 @@ def random_problem(m: int, mu: float, seed: int) -> iq.FrictionContactProblem:
 
 
 def sphere(mu_velocity=(1.0, -2.0, 0.0)) -> iq.ImpactProblem:
-    return iq.sphere_on_plane(1.0, 0.1, list(mu_velocity))
+    return iq.friction.sphere_on_plane(1.0, 0.1, list(mu_velocity))
 
 
 def test_available_backends_lists_the_friction_methods() -> None:
@@ -76,7 +76,7 @@ def test_coulomb_reports_the_friction_method_and_takes_backend() -> None:
         assert by_law.backend == method
     with pytest.raises(iq.BackendUnsuitableError, match="frictional contact problems"):
         iq.solve(p, iq.Coulomb(0.3), backend="osqp")
-    with pytest.raises(iq.UnknownBackendError):
+    with pytest.raises(iq.errors.UnknownBackendError):
         iq.solve(p, iq.Coulomb(0.3), backend="nope")
     with pytest.raises(iq.InputError, match="method"):
         iq.Coulomb(0.3, method="osqp")
@@ -87,7 +87,7 @@ def test_coulomb_agrees_with_solve_friction_on_its_local_problem() -> None:
     and u⁺ against u⁻ + M⁻¹WΛ recomputed from the problem's matrices."""
     rng = np.random.default_rng(7)
     for seed in range(4):
-        p = iq.sphere_on_plane(1.0, 0.1, rng.uniform(-2, 2, 6) - [0, 0, 3, 0, 0, 0])
+        p = iq.friction.sphere_on_plane(1.0, 0.1, rng.uniform(-2, 2, 6) - [0, 0, 3, 0, 0, 0])
         law = iq.Coulomb(0.4, 0.2)
         res = iq.solve(p, law)
         local, units = law.local_problem(p)

@@ -36,7 +36,7 @@ def test_every_method_takes_a_tiny_problem(backend):
 
 
 def test_coulomb_batches_rows_far_from_order_one():
-    problem = iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
+    problem = iq.friction.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
     law = iq.Coulomb(0.3, 0.5)
     U = np.array([[1.0, -2.0, 0.0], [1e200, -2e200, 0.0], [1e-200, -2e-200, 0.0]])
     batch = iq.solve_batch(problem, law, U)

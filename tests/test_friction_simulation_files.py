@@ -44,7 +44,7 @@ def assert_same_run(a: iq.Trajectory, b: iq.Trajectory) -> None:
 # --- the samples against the builders ----------------------------------------------------
 def test_the_sphere_file_is_the_builders_sphere():
     system, law, sim = read_simulation(SPHERE)
-    built = iq.rolling_sphere(mass=1.0, radius=R, gravity=G, velocity=V0, gap=-1e-9)
+    built = iq.simulation.rolling_sphere(mass=1.0, radius=R, gravity=G, velocity=V0, gap=-1e-9)
     assert system.contact_dim == built.contact_dim == 2 and system.n_contacts == 1
     np.testing.assert_allclose(as_dense(system.M),
                                as_dense(built.M), rtol=1e-15)
@@ -78,7 +78,7 @@ def test_the_sphere_file_rolls_at_five_sevenths():
 def test_the_incline_file_is_the_builders_block_and_stops_where_the_closed_form_says():
     tr = run_file(INCLINE)
     alpha, mu, v0, h = np.pi / 6, 0.7, 3.0, 0.002
-    built = iq.block_on_incline(alpha, mass=2.0, dim=2, speed=v0, gap=-1e-9)
+    built = iq.simulation.block_on_incline(alpha, mass=2.0, dim=2, speed=v0, gap=-1e-9)
     assert_same_run(tr, iq.simulate(built, iq.Coulomb(mu), 0.6, h=h))
     a = G * (np.sin(alpha) + mu * np.cos(alpha))  # deceleration up the slope
     up = np.array([np.cos(alpha), np.sin(alpha)])
@@ -104,7 +104,7 @@ def test_a_spatial_linear_file_is_the_builders_block_in_space(tmp_path):
     path = tmp_path / "block.json"
     path.write_text(json.dumps(SPATIAL))
     tr = run_file(path)
-    built = iq.block_on_incline(0.0, mass=2.0, dim=3, speed=1.0, gap=-1e-9)
+    built = iq.simulation.block_on_incline(0.0, mass=2.0, dim=3, speed=1.0, gap=-1e-9)
     built = iq.LinearSystem(built.M, built.q0, [1.0, 0.5, 0.0], built.constant_force, built.H,
                             built.b, contact_dim=3)
     assert_same_run(tr, iq.simulate(built, iq.Coulomb([0.25], 0.5), 0.6, h=0.005, theta=1.0))
@@ -233,7 +233,7 @@ def test_the_frictional_builders_run_from_files(tmp_path, capsys):
         "system": {"kind": "box_on_floor", "dim": 3, "velocity": [1.0, 0.0], "gap": -1e-9},
         "law": {"name": "coulomb", "mu": 0.5}, "simulation": {"t_end": 0.3, "h": 0.005}}))
     tr = run_file(path)
-    built = iq.box_on_floor(3, velocity=[1.0, 0.0], gap=-1e-9)
+    built = iq.simulation.box_on_floor(3, velocity=[1.0, 0.0], gap=-1e-9)
     assert_same_run(tr, iq.simulate(built, iq.Coulomb(0.5), 0.3, h=0.005))
     assert abs(tr.q[-1, 0] - 1.0 / (2 * 0.5 * G)) <= 5 * 0.005
     out = tmp_path / "box.csv"

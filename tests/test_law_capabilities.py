@@ -119,7 +119,7 @@ def test_parallel_contacts_collapse_by_the_declared_restitution():
 
 
 def test_simulations_take_the_compiled_loop_by_family():
-    ball = iq.bouncing_ball()
+    ball = iq.simulation.bouncing_ball()
     assert compiled_applies(ball, DeclaredNewton(0.9), "auto")
     assert not compiled_applies(ball, PlainNewton(0.9), "auto")
     fast = iq.simulate(ball, DeclaredNewton(0.9), 0.5, h=0.005)
@@ -146,7 +146,7 @@ def test_a_compliant_law_is_what_compare_laws_takes():
 
     for law in (iq.Moreau(0.5), NotCompliant()):
         with pytest.raises(iq.InputError, match="compliant"):
-            iq.compare_laws(iq.newtons_cradle(3), law)
+            iq.verification.compare_laws(iq.newtons_cradle(3), law)
 
 
 def test_the_route_of_one_impact_says_units_collapse_and_path():
@@ -168,7 +168,7 @@ def test_the_route_of_one_impact_says_units_collapse_and_path():
 
 
 def test_the_route_of_a_run_is_its_loop():
-    ball, cradle = iq.bouncing_ball(), iq.cradle_system(3)
+    ball, cradle = iq.simulation.bouncing_ball(), iq.simulation.cradle_system(3)
     assert plan_run(ball, iq.Moreau(0.5), "auto") == Route("run", "compiled")
     assert plan_run(cradle, iq.SectorLaw(), "auto").path == "python"
     assert plan_run(ball, iq.Moreau(0.5), "auto", compiled=False).path == "python"

@@ -24,7 +24,7 @@ def test_siconos_problem(path):
     M, q = read_lcp(path)
     kind = _kind(M)
     if kind != "psd":
-        with pytest.raises(iq.NonConvexLCPError):
+        with pytest.raises(iq.errors.NonConvexLCPError):
             iq.solve_lcp(M, q)
         return
     r = iq.solve_lcp(M, q)

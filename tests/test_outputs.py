@@ -26,7 +26,7 @@ def fifo(tmp_path):
 
 
 def test_python_writers_refuse_a_fifo(fifo, tmp_path):
-    tr = iq.simulate(iq.bouncing_ball(), iq.Newton(0.9), 0.5, h=0.01)
+    tr = iq.simulate(iq.simulation.bouncing_ball(), iq.Newton(0.9), 0.5, h=0.01)
     with pytest.raises(iq.InputError, match="not a regular file"):
         tr.save(fifo("run.npz"))
     with pytest.raises(iq.InputError, match="not a regular file"):

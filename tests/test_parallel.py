@@ -30,17 +30,17 @@ def test_local_processes_keep_order_and_results() -> None:
 
 
 def test_fremond_map_does_not_depend_on_workers() -> None:
-    one = iq.fremond_admissibility_map(CRADLE, A, B, samples=40, seed=3)
-    two = iq.fremond_admissibility_map(CRADLE, A, B, samples=40, seed=3, n_jobs=2)
+    one = iq.verification.fremond_admissibility_map(CRADLE, A, B, samples=40, seed=3)
+    two = iq.verification.fremond_admissibility_map(CRADLE, A, B, samples=40, seed=3, n_jobs=2)
     np.testing.assert_array_equal(one, two)
     assert one.any() and not one.all()  # the map has both verdicts: the test can fail
 
 
 def test_bad_jobs_and_client() -> None:
     with pytest.raises(iq.InputError, match="n_jobs"):
-        iq.fremond_admissibility_map(CRADLE, A, B, n_jobs=0)
+        iq.verification.fremond_admissibility_map(CRADLE, A, B, n_jobs=0)
     with pytest.raises(iq.InputError, match="client"):
-        iq.fremond_admissibility_map(CRADLE, A, B, client="localhost")
+        iq.verification.fremond_admissibility_map(CRADLE, A, B, client="localhost")
 
 
 def test_dask_local_cluster_gives_the_same_map() -> None:
@@ -48,11 +48,11 @@ def test_dask_local_cluster_gives_the_same_map() -> None:
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
-        on_dask = iq.fremond_admissibility_map(CRADLE, A, B, samples=40, seed=3,
+        on_dask = iq.verification.fremond_admissibility_map(CRADLE, A, B, samples=40, seed=3,
                                                client=client)
     np.testing.assert_array_equal(on_dask,
-                                  iq.fremond_admissibility_map(CRADLE, A, B, samples=40,
-                                                               seed=3))
+                                  iq.verification.fremond_admissibility_map(CRADLE, A, B,
+                                                                            samples=40, seed=3))
 
 
 def test_verify_law_does_not_depend_on_workers() -> None:

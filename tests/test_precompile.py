@@ -31,9 +31,10 @@ ev.register("numba:compile", Count())
 p = iq.newtons_cradle(3, 1.0)
 iq.moreau(p, 1.0); iq.moreau(p, 0.0); iq.sector_law(p)
 iq.solve_batch(p, iq.Moreau(0.5), np.random.default_rng(0).standard_normal((10, 3)))
-iq.solve(iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0]), iq.Coulomb(0.3, 0.5))
-iq.simulate(iq.bouncing_ball(q0=0.1), iq.Newton(0.5), 0.2, h=1e-2)
-iq.simulate(iq.block_on_incline(0.3, dim=2, speed=1.0), iq.Coulomb(0.5, 0.0), 0.05, h=1e-2)
+iq.solve(iq.friction.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0]), iq.Coulomb(0.3, 0.5))
+iq.simulate(iq.simulation.bouncing_ball(q0=0.1), iq.Newton(0.5), 0.2, h=1e-2)
+iq.simulate(iq.simulation.block_on_incline(0.3, dim=2, speed=1.0), iq.Coulomb(0.5, 0.0), 0.05,
+            h=1e-2)
 print("compilations", Count.n)
 """
 

@@ -23,7 +23,7 @@ from impactqp.tables.sector_table import sector_gamma_map, sector_law_table
 from impactqp.verification.sampled import sample_u_minus
 
 RNG = np.random.default_rng(11)
-M4, M6 = iq.continuous_mass_ratios(4), iq.continuous_mass_ratios(6)
+M4, M6 = iq.tables.continuous_mass_ratios(4), iq.tables.continuous_mass_ratios(6)
 
 
 def path_masses(ks: tuple[int, ...], x2: float) -> np.ndarray:
@@ -76,21 +76,21 @@ def test_angles_formula_and_range() -> None:
 @pytest.mark.parametrize("k, m2", [(3, 1.0), (4, math.sqrt(2) - 1), (5, math.sqrt(5) - 2),
                                    (6, 2 / math.sqrt(3) - 1)])
 def test_continuous_mass_ratios(k: int, m2: float) -> None:
-    m = iq.continuous_mass_ratios(k)
+    m = iq.tables.continuous_mass_ratios(k)
     assert m[1] == pytest.approx(m2, rel=1e-12) and m[0] == m[2] == 1.0
     assert coxeter_labels(contact_angles(problem(m).delassus)) == [k]
-    m = iq.continuous_mass_ratios(k, m1=2.0, m3=0.3)
+    m = iq.tables.continuous_mass_ratios(k, m1=2.0, m3=0.3)
     assert math.degrees(contact_angles(problem(m).delassus)[0]) == pytest.approx(180 / k)
     wall = shared_mass(math.pi / k, math.inf, 1.0)  # wall | ball | ball: m/1 = tan²(π/k)
     assert wall == pytest.approx(math.tan(math.pi / k) ** 2)
 
 
 def test_unattainable_ratios_are_refused() -> None:
-    with pytest.raises(iq.SectorInputError, match="infinitely heavy middle ball"):
-        iq.continuous_mass_ratios(2)
-    with pytest.raises(iq.SectorInputError, match="integer"):
-        iq.continuous_mass_ratios(1)
-    with pytest.raises(iq.SectorInputError, match="90"):
+    with pytest.raises(iq.errors.SectorInputError, match="infinitely heavy middle ball"):
+        iq.tables.continuous_mass_ratios(2)
+    with pytest.raises(iq.errors.SectorInputError, match="integer"):
+        iq.tables.continuous_mass_ratios(1)
+    with pytest.raises(iq.errors.SectorInputError, match="90"):
         shared_mass(math.pi / 2, 1.0, 1.0)
     # (6, 3) and (4, 4) are affine diagrams: 1 − cos²θ₁ − cos²θ₂ > 0 for real masses
     assert coxeter_type((6, 3)) is None and coxeter_type((4, 4)) is None
@@ -125,7 +125,7 @@ def test_long_equal_chain_and_sector_table() -> None:
 
 # --------------------------------------------------------------------------- groups, tables
 @pytest.mark.parametrize("masses, walls, name, order, reflections", [
-    (M4, {}, "B2", 8, 4), (iq.continuous_mass_ratios(5), {}, "I2(5)", 10, 5),
+    (M4, {}, "B2", 8, 4), (iq.tables.continuous_mass_ratios(5), {}, "I2(5)", 10, 5),
     (M6, {}, "G2", 12, 6), (np.ones(4), {}, "A3", 24, 6), (B3, {}, "B3", 48, 9),
     (H3, {}, "H3", 120, 15), (np.ones(3), {"left_wall": True}, "B3", 48, 9),
     (np.ones(2), {"right_wall": True}, "B2", 8, 4)])
@@ -153,7 +153,7 @@ def test_big_groups() -> None:
     p = problem(F4)
     assert check_reflection_problem(p).name == "F4"
     assert check_reflection_problem(problem(np.ones(8))).order == 40320
-    with pytest.raises(iq.SectorTableTooLarge, match="A7 has 40320"):
+    with pytest.raises(iq.errors.SectorTableTooLarge, match="A7 has 40320"):
         reflection_law_table(np.ones(8))
     u = RNG.normal(size=8)  # the law itself needs no table (checked by the opposite order)
     np.testing.assert_allclose(iq.reflection_law(iq.chain(np.ones(8), u)).u_plus, np.sort(u))
@@ -206,7 +206,7 @@ def test_continuous_across_every_cone_boundary(masses) -> None:
 def test_even_k_consistent_impacts_are_moreau_elastic(k: int) -> None:
     """For even k, w₀ = −1: on consistent u⁻ the law is u⁺ = 2 v_cm − u⁻, Moreau ε = 1,
     because an acute T_C lies in N, so u⁻ ∈ −T_C has z = prox(u⁻) = common velocity."""
-    p0 = problem(iq.continuous_mass_ratios(k))
+    p0 = problem(iq.tables.continuous_mass_ratios(k))
     for u in sample_u_minus(p0, 20, RNG, consistent_only=True):
         p = p0.with_u_minus(u)
         np.testing.assert_allclose(iq.reflection_law(p).u_plus,
@@ -236,11 +236,11 @@ def test_verify_law_reports_ok() -> None:
                                                     "m2 = 0.414214")])
 def test_angle_not_pi_over_k_has_no_continuous_law(masses, angle, k, fix) -> None:
     p = problem(np.array(masses), [1.0, 0.0, -1.0])
-    with pytest.raises(iq.SectorLawError, match="no continuous elastic law") as err:
+    with pytest.raises(iq.errors.SectorLawError, match="no continuous elastic law") as err:
         iq.reflection_law(p)
     msg = str(err.value)
     assert angle in msg and f"180°/{k} = " in msg and fix in msg and "discontinuous" in msg
-    with pytest.raises(iq.SectorLawError, match=angle):
+    with pytest.raises(iq.errors.SectorLawError, match=angle):
         reflection_law_table(masses)
     (a, _, _), (b, _, _) = (elastic_collisions(p, o) for o in ("left", "right"))
     assert np.abs(a - b).max() > 0.3  # two collision orders, two different outcomes
@@ -277,14 +277,14 @@ def test_gap_limits_agree_when_the_angle_is_pi_over_k() -> None:
 
 
 def test_other_refusals() -> None:
-    with pytest.raises(iq.SectorLawError, match=r"T_C = \{0\}"):
+    with pytest.raises(iq.errors.SectorLawError, match=r"T_C = \{0\}"):
         iq.reflection_law(problem(np.ones(2), left_wall=True, right_wall=True))
-    with pytest.raises(iq.SectorLawError, match="chains"):
+    with pytest.raises(iq.errors.SectorLawError, match="chains"):
         iq.reflection_law(iq.random_impact(3, 2))
     with pytest.raises(iq.InputError, match="order"):
         elastic_collisions(problem(np.ones(2)), "middle")
     single = iq.reflection_law(problem(np.array([2.0]), [3.0]))
     assert single.u_plus.tolist() == [3.0] and single.impulses.shape == (0,)
-    with pytest.raises(iq.SectorLawError, match="reflection_law gives the continuous"):
+    with pytest.raises(iq.errors.SectorLawError, match="reflection_law gives the continuous"):
         iq.sector_law(problem(M4))
     assert extended_masses(np.ones(2), left_wall=True).tolist() == [math.inf, 1.0, 1.0]

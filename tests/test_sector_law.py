@@ -90,23 +90,24 @@ def test_failed_certificate_raises() -> None:
 
 # --------------------------------------------------------------------------- errors
 def test_errors_say_why() -> None:
-    with pytest.raises(iq.SectorLawError, match="no continuous sorting law for unequal"):
+    with pytest.raises(iq.errors.SectorLawError, match="no continuous sorting law for unequal"):
         iq.sector_law(iq.chain([1.0, 2.0, 1.0], [1.0, 0.0, 0.0]))
-    with pytest.raises(iq.SectorLawError, match=r"180°/k \(here 70.53°\)"):
+    with pytest.raises(iq.errors.SectorLawError, match=r"180°/k \(here 70.53°\)"):
         iq.sector_law(iq.chain([1.0, 2.0, 1.0], [1.0, 0.0, 0.0]))  # cos = (1/2)/(3/2)
-    with pytest.raises(iq.SectorLawError, match=r"unequal masses\. impactqp\.reflection_law "
+    with pytest.raises(iq.errors.SectorLawError, match=r"unequal masses\. impactqp\.reflection_law "
                        r"gives the elastic law of any two balls\.$"):
         iq.sector_law(iq.chain([1.0, 2.0], [1.0, 0.0]))
     from impactqp.laws.sector import wedge_angles
 
     np.testing.assert_allclose(wedge_angles(np.ones(4)), [60.0, 60.0])  # π/3: k = 3
-    with pytest.raises(iq.SectorLawError, match="walls"):
+    with pytest.raises(iq.errors.SectorLawError, match="walls"):
         iq.sector_law(iq.chain([1.0, 1.0], [1.0, 0.0], left_wall=True))
-    with pytest.raises(iq.SectorLawError, match="chains"):
+    with pytest.raises(iq.errors.SectorLawError, match="chains"):
         iq.sector_law(iq.random_impact(3, 2))
     with pytest.raises(iq.InputError, match="ImpactProblem"):
         iq.sector_law(np.eye(3))
-    for exc in (iq.SectorLawError, iq.SectorInputError, iq.SectorTableTooLarge):
+    for exc in (iq.errors.SectorLawError, iq.errors.SectorInputError,
+                iq.errors.SectorTableTooLarge):
         assert issubclass(exc, iq.InputError) and issubclass(exc, ValueError)
 
 
@@ -211,7 +212,7 @@ def test_a_chain_is_recognized_from_its_matrices_however_it_was_built():
     M = np.eye(4)
     M[0, 1] = M[1, 0] = 0.1
     assert recognize_chain(iq.ImpactProblem(M, W, np.ones(4))) is None
-    with pytest.raises(iq.SectorLawError, match="1-D chains"):
+    with pytest.raises(iq.errors.SectorLawError, match="1-D chains"):
         iq.sector_law(iq.ImpactProblem(np.eye(4), W[:, ::-1], np.ones(4)))
 
 

@@ -17,11 +17,11 @@ SCHEMES = ["moreau-jean", "event-driven"]
 def test_too_many_steps_are_refused_before_running(scheme, t_end, h):
     if h is None:  # the default h = t_end/1000 is fine; t0 = -1e308 makes the span overflow
         with pytest.raises(iq.InputError, match="too small"):
-            iq.simulate(iq.bouncing_ball(), iq.Newton(0.9), t_end, scheme=scheme, t0=-1e308,
-                        h=1e300)
+            iq.simulate(iq.simulation.bouncing_ball(), iq.Newton(0.9), t_end, scheme=scheme,
+                        t0=-1e308, h=1e300)
         return
     with pytest.raises(iq.InputError, match="too small for t_end"):
-        iq.simulate(iq.bouncing_ball(), iq.Newton(0.9), t_end, scheme=scheme, h=h)
+        iq.simulate(iq.simulation.bouncing_ball(), iq.Newton(0.9), t_end, scheme=scheme, h=h)
 
 
 @pytest.mark.parametrize("scheme", SCHEMES)
@@ -37,10 +37,10 @@ def test_a_force_that_turns_nan_stops_the_run_with_its_time(scheme):
 
 def test_motion_beyond_the_float_range_is_a_named_error():
     system = iq.LinearSystem([[1.0]], [1.0], [1e300], [1e300], [[1.0]], [0.0])
-    with pytest.raises(iq.NonFiniteStateError, match="not finite at t ="):
+    with pytest.raises(iq.errors.NonFiniteStateError, match="not finite at t ="):
         iq.simulate(system, iq.Newton(0.9), 1e10, scheme="moreau-jean", h=1e7)
 
 
 def test_a_ball_at_rest_stays_finite_for_any_length_of_time():
-    tr = iq.simulate(iq.bouncing_ball(), iq.Newton(0.9), 1e300, scheme="event-driven")
+    tr = iq.simulate(iq.simulation.bouncing_ball(), iq.Newton(0.9), 1e300, scheme="event-driven")
     assert np.isfinite(tr.q).all() and abs(tr.q[-1, 0]) < 1e-9 and tr.t[-1] == 1e300

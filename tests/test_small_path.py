@@ -91,9 +91,9 @@ def test_warm_starts_do_not_change_answers() -> None:
 def test_the_certificate_is_built_on_first_read_from_the_checked_residuals() -> None:
     p = iq.newtons_cradle(3)
     r = iq.moreau(p, 0.5)
-    assert not isinstance(r._certificate, iq.Certificate)  # not built yet
+    assert not isinstance(r._certificate, iq.results.Certificate)  # not built yet
     cert = r.certificate
-    assert isinstance(cert, iq.Certificate) and r.certificate is cert and cert.ok
+    assert isinstance(cert, iq.results.Certificate) and r.certificate is cert and cert.ok
     assert set(cert.residuals) == {"momentum", "impulse_sign", "law_feasibility",
                                    "complementarity", "energy_balance", "duality_gap"}
     assert all(type(v) is float for v in cert.residuals.values())

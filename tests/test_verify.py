@@ -110,7 +110,7 @@ def test_fremond_gains_energy_on_consistent_u_minus() -> None:
 def test_fremond_map_cells() -> None:
     a = [0.0, 0.5, 1.0]
     b = [-0.5, 0.0, 0.5]
-    grid = iq.fremond_admissibility_map(CRADLE, a, b, samples=60, seed=0)
+    grid = iq.verification.fremond_admissibility_map(CRADLE, a, b, samples=60, seed=0)
     assert grid.shape == (3, 3) and grid.dtype == bool
     # b = 0: E = aI is Moreau's law, in S for every consistent u⁻ (docs/theory.md §3)
     assert grid[:, 1].all()
@@ -123,7 +123,7 @@ def test_fremond_map_cells() -> None:
     np.testing.assert_allclose(r.u_plus, [-0.5, 0.5, 1.0], atol=1e-9)
     assert r.energy_after == pytest.approx(1.5 * r.energy_before)
     assert not grid[2, 2]
-    triangular = iq.fremond_admissibility_map(CRADLE, [0.5], [0.0], samples=20,
+    triangular = iq.verification.fremond_admissibility_map(CRADLE, [0.5], [0.0], samples=20,
                                               family="triangular")
     assert triangular.tolist() == [[True]]
     np.testing.assert_array_equal(fremond_matrix(1, 2, 2, "triangular"),
@@ -132,9 +132,9 @@ def test_fremond_map_cells() -> None:
 
 # --------------------------------------------------------------------------- exact path
 def test_exact_certificate_of_tables() -> None:
-    rep = iq.verify_law(iq.sector_law_table(4))
+    rep = iq.verify_law(iq.tables.sector_law_table(4))
     assert rep.ok and rep.method == "exact" and rep.certificate.maximal_monotone
-    table = iq.sector_law_table(3)
+    table = iq.tables.sector_law_table(3)
     expanding = SectorTable(cones=[replace(c, Q=1.1 * c.Q) for c in table.cones],
                             G=table.G, W=table.W, n_balls=3)
     bad = iq.verify_law(expanding, CRADLE)
@@ -163,7 +163,7 @@ def test_law_errors_are_counted_not_raised() -> None:
 
 
 def test_bad_input() -> None:
-    with pytest.raises(iq.ShapeError, match="u⁺ must have shape"):
+    with pytest.raises(iq.errors.ShapeError, match="u⁺ must have shape"):
         iq.verify_law(lambda q: np.zeros(2), CRADLE, samples=5)
     with pytest.raises(iq.InputError, match="callable"):
         iq.verify_law(42, CRADLE)
@@ -172,11 +172,11 @@ def test_bad_input() -> None:
     with pytest.raises(iq.InputError, match="samples"):
         iq.verify_law(iq.sector_law, CRADLE, samples=1)
     with pytest.raises(iq.InputError, match="family"):
-        iq.fremond_admissibility_map(CRADLE, [0], [0], family="lower")
+        iq.verification.fremond_admissibility_map(CRADLE, [0], [0], family="lower")
     with pytest.raises(iq.InputError, match="family"):
         fremond_matrix(0, 0, 2, family="lower")
     with pytest.raises(iq.InputError, match="1-D"):
-        iq.fremond_admissibility_map(CRADLE, [[0, 1]], [0])
+        iq.verification.fremond_admissibility_map(CRADLE, [[0, 1]], [0])
 
 
 def test_a_laws_own_exception_is_reported_with_its_type_and_message():

@@ -20,7 +20,7 @@ computed in order-one units and scaled back (docs/theory.md §8): norms and prod
 
 class ResidualChecks(ABC):
     """Verdict shared by every certificate: each of its
-    :attr:`~impactqp.ResidualChecks.residuals` ≤ ``tol``."""
+    :attr:`~impactqp.results.ResidualChecks.residuals` ≤ ``tol``."""
 
     tol: float
 

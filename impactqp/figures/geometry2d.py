@@ -258,7 +258,7 @@ def sector_picture(radius: float = 1.0, sample_radius: float = 0.45) -> list[Wed
     Returns
     -------
     list of Wedge
-        One per cone, in the order of :func:`~impactqp.sector_law_table`.
+        One per cone, in the order of :func:`~impactqp.tables.sector_law_table`.
     """
     table = sector_law_table(3)
     L = sector_frame(table.G)

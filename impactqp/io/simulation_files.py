@@ -8,7 +8,7 @@ Three tables, stored as JSON or TOML (chosen by the file suffix)::
     kind = "cradle"                  # "bouncing_ball" | "cradle" | "bead_chain" |
                                      # "rolling_sphere" | "block_on_incline" |
                                      # "box_on_floor" | "linear"
-    n_balls = 5                      # the builder's own arguments (iq.cradle_system, ...);
+    n_balls = 5                      # the builder's own arguments (cradle_system, ...);
     amplitude = 0.1                  # "linear": M, q0, v0, force, stiffness, H, b,
                                      # contact_dim
     [law]

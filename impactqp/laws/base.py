@@ -70,7 +70,7 @@ class ImpactLaw(ABC):
     :meth:`recover` (a law solved through quadratic programs) or :meth:`closed_form`
     (``forms = ()``; returning u⁺ alone is enough, the impulses are recovered). Its
     :meth:`residuals` (by default momentum and Λ ≥ 0) make the law's
-    :class:`~impactqp.Certificate`; batches run a closed form row by row unless
+    :class:`~impactqp.results.Certificate`; batches run a closed form row by row unless
     :meth:`closed_form_rows` does better.
 
     Attributes

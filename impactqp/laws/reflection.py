@@ -47,7 +47,7 @@ class ReflectionLaw(ImpactLaw):
     """The elastic impact law of a chain with contact angles π/k, by reflections.
 
     Applies to chains (``impactqp.chain``) with any masses whose every angle of T_C is π/k
-    (see :func:`impactqp.continuous_mass_ratios`), free or with one wall. Kinematically
+    (see :func:`impactqp.tables.continuous_mass_ratios`), free or with one wall. Kinematically
     inconsistent u⁻ are fine: u⁺ ∈ S for every u⁻. The certificate's ``law_residual``
     compares γ⁺ with the table map (group order ≤ MAX_TABLE_ORDER) or, for larger groups,
     with the opposite collision order.

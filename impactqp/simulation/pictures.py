@@ -104,8 +104,9 @@ def frames_of(trajectory: Any, frames: int) -> tuple[np.ndarray, np.ndarray]:
 
 def animate(trajectory: Any, path: str | Path | None = None, *, length: float = 1.0,
             radius: float = 0.05, frames: int = 120, fps: int = 24, size: float = 3.2) -> Any:
-    """An animation of a run of balls on pendulums (:func:`impactqp.cradle_system`: qᵢ the
-    horizontal displacement of ball i), written when given a path.
+    """An animation of a run of balls on pendulums
+    (:func:`impactqp.simulation.cradle_system`: qᵢ the horizontal displacement of ball i),
+    written when given a path.
 
     Parameters
     ----------

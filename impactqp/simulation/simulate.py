@@ -61,8 +61,9 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
     Parameters
     ----------
     system : LinearSystem
-        ``iq.LinearSystem(M, q0, v0, force, H, b)`` or a builder's (``iq.bouncing_ball()``,
-        ``iq.cradle_system(n)``, ``iq.bead_chain(n)``).
+        ``iq.LinearSystem(M, q0, v0, force, H, b)`` or a builder's
+        (``iq.simulation.bouncing_ball()``, ``iq.simulation.cradle_system(n)``,
+        ``iq.simulation.bead_chain(n)``).
     law : ImpactLaw
         ``iq.Moreau(eps)``, ``iq.Newton(e)`` (one coefficient, or one per contact of the
         system), ``iq.Fremond(E)`` (m × m), ``iq.SectorLaw()``, ``iq.ReflectionLaw()`` or any

@@ -149,9 +149,9 @@ class Trajectory:
         return pictures.plot(self, kind, path, title=title, dofs=dofs)
 
     def animate(self, path: str | Path | None = None, **options: Any) -> Any:
-        """Animate the balls of a pendulum run (:func:`impactqp.cradle_system`), written when
-        given ``path`` (.gif or .mp4); ``options`` are ``length``, ``radius``, ``frames``,
-        ``fps`` and ``size``. Needs the ``plot`` extra (matplotlib).
+        """Animate the balls of a pendulum run (:func:`impactqp.simulation.cradle_system`),
+        written when given ``path`` (.gif or .mp4); ``options`` are ``length``, ``radius``,
+        ``frames``, ``fps`` and ``size``. Needs the ``plot`` extra (matplotlib).
 
         Returns
         -------

@@ -238,7 +238,7 @@ SectorCertificate = TableCertificate
 
 
 def certify_sector_table(table: Any, exact_energy: bool | None = None) -> TableCertificate:
-    """Run every docs/theory.md §7 check on ``table`` (a :class:`~impactqp.SectorTable`).
+    """Run every docs/theory.md §7 check on ``table`` (a :class:`~impactqp.tables.SectorTable`).
 
     Parameters
     ----------

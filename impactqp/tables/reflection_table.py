@@ -140,7 +140,7 @@ def reflection_law_table(masses: Any, *, left_wall: bool = False,
     ----------
     masses : (N,) array_like
         Ball masses; every angle of T_C must be π/k (e.g.
-        :func:`~impactqp.continuous_mass_ratios`).
+        :func:`~impactqp.tables.continuous_mass_ratios`).
     left_wall, right_wall : bool
         At most one wall (a contact like any other).
 

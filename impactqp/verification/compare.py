@@ -158,9 +158,9 @@ def compare_chain(chain: PhysicalChain, restitution: Any = 1.0, *, step: float |
     Parameters
     ----------
     chain : PhysicalChain
-        From :func:`~impactqp.monodisperse_chain`,
-        :func:`~impactqp.tapered_chain` or
-        :func:`~impactqp.ball_chain`.
+        From :func:`~impactqp.chains.monodisperse_chain`,
+        :func:`~impactqp.chains.tapered_chain` or
+        :func:`~impactqp.chains.ball_chain`.
     restitution : float or array_like
         LZB's energetic restitution per contact (1: elastic).
     step, rtol : optional

@@ -1,7 +1,7 @@
 """Exact verification of a piecewise-linear impact law on a chain (docs/theory.md §7).
 
 The docs/theory.md §7 certificate decides every condition on every cone; this module turns it into a
-:class:`~impactqp.LawReport` and, for each failed condition, looks for a concrete
+:class:`~impactqp.verification.LawReport` and, for each failed condition, looks for a concrete
 counterexample on the worst cone (its rays, its centroid and seeded interior directions),
 measured by the same residuals as the sampling verifier so that it can be rechecked.
 """

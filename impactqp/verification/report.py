@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 DEFAULT_TOL = 1e-7
-"""Tolerance on the dimensionless residuals of :class:`~impactqp.Membership`."""
+"""Tolerance on the dimensionless residuals of :class:`~impactqp.problems.Membership`."""
 
 ADMISSIBILITY = ("kinematic", "kinetic", "energetic")
 CONDITIONS = ADMISSIBILITY + ("non_expansive", "law_error")
@@ -21,7 +21,7 @@ class Counterexample:
 
     For ``"non_expansive"`` the offending pair is stacked: ``u_minus`` and ``u_plus`` have
     shape (2, n) and ``amount`` is ‖Δu⁺‖/‖Δu⁻‖ − 1; otherwise ``amount`` is the residual of
-    :class:`~impactqp.Membership` for that condition.
+    :class:`~impactqp.problems.Membership` for that condition.
 
     Attributes
     ----------

@@ -7,7 +7,7 @@ every answer is checked for the three conditions of S (kinematic γ⁺ ≥ 0, ki
 u⁺ − u⁻ ∈ N, energetic T⁺ ≤ T⁻) by the exact membership test of
 :class:`~impactqp.AdmissibleSet`. Maximal monotonicity is equivalent to non-expansiveness of
 u⁻ ↦ u⁺ in the metric M (docs/theory.md §6); its evidence is checked on every pair of
-samples. A piecewise-linear law (a :class:`~impactqp.SectorTable`, or any object with
+samples. A piecewise-linear law (a :class:`~impactqp.tables.SectorTable`, or any object with
 ``cones``, ``G`` and ``W``) is certified exactly instead (docs/theory.md §7).
 """
 
