@@ -27,7 +27,8 @@ MODULES: dict[str, tuple[str, ...]] = {
         "tests/test_mutants_admissible.py", "tests/test_admissible.py"),
     # the certificate of the laws and the model's residual assembly
     "impactqp/laws/certificate.py": (
-        "tests/test_mutants_certificate.py", "tests/test_verify.py", "tests/test_small_path.py", "tests/test_reflection_law.py"),
+        "tests/test_mutants_certificate.py", "tests/test_verify.py", "tests/test_small_path.py",
+        "tests/test_reflection_law.py"),
     "impactqp/model/residuals.py": (
         "tests/test_small_path.py", "tests/test_chain_certificate.py", "tests/test_verify.py"),
     # the chain's compiled pass
