@@ -1,5 +1,5 @@
 """``python -m benchmarks.mutation [--modules PATH ...] [--sample N] [--seed S] [--out DIR]
-[--list]``: mutation checks of the modules holding formulas and verdicts.
+[--merge] [--list]``: mutation checks of the modules holding formulas and verdicts.
 
 Each mutant is one small change made by cosmic-ray's operators (:data:`.mutation_config.
 OPERATORS`) to one module, in a scratch copy of the repository; the module's fast test files
@@ -144,9 +144,11 @@ def _baseline(tests: tuple[str, ...]) -> float:
     return time.perf_counter() - start
 
 
-def run(modules: list[str], n: int | None, seed: int, out: Path, progress: bool = True) -> dict:
+def run(modules: list[str], n: int | None, seed: int, out: Path, progress: bool = True,
+        merge: bool = False) -> dict:
     """Run the mutants of ``modules`` (``n`` drawn per module with ``seed``, or all) and write
-    ``summary.md`` and ``results.json`` in ``out``; return the results."""
+    ``summary.md`` and ``results.json`` in ``out`` (with ``merge``, replacing only these
+    modules' results in the ones already there); return the results."""
     *_, mutate_and_test, mutation_spec, test_outcome, _ = _cosmic_ray()
     rng = random.Random(seed)
     start = time.perf_counter()
@@ -181,11 +183,14 @@ def run(modules: list[str], n: int | None, seed: int, out: Path, progress: bool 
     finally:
         os.chdir(here)
         shutil.rmtree(scratch, ignore_errors=True)
-    results = {"seed": seed, "sample": n, "seconds": time.perf_counter() - start,
-               "operators": list(OPERATORS), "modules": per_module,
-               "command": "python -m benchmarks.mutation " + " ".join(
-                   ["--modules", *modules] + ([] if n is None else ["--sample", str(n)])
-                   + ["--seed", str(seed)])}
+    seconds = time.perf_counter() - start
+    for record in per_module:
+        record.update(sample=n, seed=seed, run_s=seconds * len(record["results"])
+                      / max(1, sum(len(r["results"]) for r in per_module)))
+    results = {"operators": list(OPERATORS), "modules": per_module}
+    if merge and (out / "results.json").is_file():
+        earlier = json.loads((out / "results.json").read_text(encoding="utf-8"))["modules"]
+        results["modules"] = [r for r in earlier if r["module"] not in modules] + per_module
     out.mkdir(parents=True, exist_ok=True)
     (out / "results.json").write_text(json.dumps(results, indent=1) + "\n", encoding="utf-8")
     (out / "summary.md").write_text(summary_markdown(results), encoding="utf-8")
@@ -206,6 +211,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="seed of the sample (default 0)")
     parser.add_argument("--out", type=Path, default=Path("benchmarks/results/mutation"),
                         help="output directory (default: benchmarks/results/mutation)")
+    parser.add_argument("--merge", action="store_true",
+                        help="replace only these modules' results in --out's results.json")
     parser.add_argument("--list", action="store_true",
                         help="print how many mutants each module has and stop")
     parser.add_argument("--no-progress", action="store_true", help="no line per mutant")
@@ -218,7 +225,7 @@ def main(argv: list[str] | None = None) -> int:
                   + " ".join(MODULES[module]))
         return 0
     results = run(args.modules, args.sample, args.seed, args.out.resolve(),
-                  progress=not args.no_progress)
+                  progress=not args.no_progress, merge=args.merge)
     print(f"wrote {args.out}/summary.md, results.json")
     survived = [m for mod in results["modules"] for m in mod["results"]
                 if m["status"] in ("survived", "error")]

@@ -21,6 +21,10 @@ def _pct(detected: int, judged: int) -> str:
     return f"{100.0 * detected / judged:.0f}%" if judged else "—"
 
 
+def _sample(mod: dict[str, Any]) -> str:
+    return "all" if mod.get("sample") is None else f"{mod['sample']} (seed {mod['seed']})"
+
+
 def _name(record: dict[str, Any]) -> str:
     return (f"line {record['line']} {record['operator'].removeprefix('core/')}"
             f" #{record['occurrence']}")
@@ -31,32 +35,31 @@ def summary_markdown(results: dict[str, Any]) -> str:
     modules = results["modules"]
     every = [r for mod in modules for r in mod["results"]]
     detected, judged = score(every)
-    sample = "every mutant" if results["sample"] is None else \
-        f"a sample of {results['sample']} mutants per module (seed {results['seed']})"
     lines = [
         "# impactqp mutation checks",
         "",
-        f"`{results['command']}` — {sample}, run time {results['seconds']:.0f} s. "
-        "Each mutant is one change by cosmic-ray's operators (listed in "
-        "benchmarks/mutation_config.py) in a scratch copy; the module's test files then run "
-        "with `NUMBA_DISABLE_JIT=1` and `pytest -x`. killed = a test failed (the first one "
-        "is named below); timeout = the tests ran past 4× the unmutated run (≥ 60 s); "
-        "equivalent = survived, and no input can tell it from the original (reason below); "
-        "score = (killed + timeout) / (mutants run − equivalent).",
+        "`python -m benchmarks.mutation` — each mutant is one change by cosmic-ray's "
+        "operators (listed in benchmarks/mutation_config.py) in a scratch copy; the module's "
+        "test files then run with `NUMBA_DISABLE_JIT=1` and `pytest -x`. killed = a test "
+        "failed (the first one is named below); timeout = the tests ran past 4× the "
+        "unmutated run (≥ 60 s); equivalent = survived, and no input can tell it from the "
+        "original (reason below); score = (killed + timeout) / (mutants run − equivalent). "
+        "run = mutants run: all of the module's, or a seeded random sample (column sample).",
         "",
         f"**Overall: {detected} of {judged} non-equivalent mutants detected "
-        f"({_pct(detected, judged)}).**",
+        f"({_pct(detected, judged)}), run time "
+        f"{sum(mod.get('run_s', 0.0) for mod in modules):.0f} s.**",
         "",
-        "| module | mutants | run | killed | timeout | survived | equivalent | error | score "
-        "| tests | unmutated run |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "| module | mutants | sample | run | killed | timeout | survived | equivalent | error "
+        "| score | tests | unmutated run |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for mod in modules:
         counts = Counter(r["status"] for r in mod["results"])
         d, j = score(mod["results"])
         tests = ", ".join(t.removeprefix("tests/") for t in mod["tests"])
         lines.append(
-            f"| {mod['module']} | {mod['mutants']} | {len(mod['results'])} "
+            f"| {mod['module']} | {mod['mutants']} | {_sample(mod)} | {len(mod['results'])} "
             f"| {counts['killed']} | {counts['timeout']} | {counts['survived']} "
             f"| {counts['equivalent']} | {counts['error']} | {_pct(d, j)} | {tests} "
             f"| {mod['baseline_s']:.1f} s |")

@@ -33,17 +33,17 @@ def test_score_counts_detected_among_the_non_equivalent() -> None:
 
 
 def test_report_names_killers_survivors_and_reasons() -> None:
-    results = {"seed": 3, "sample": 5, "seconds": 12.0, "command": "python -m x",
-               "operators": list(OPERATORS),
+    results = {"operators": list(OPERATORS),
                "modules": [{"module": "m.py", "tests": ["tests/test_a.py"], "mutants": 9,
-                            "baseline_s": 2.0, "timeout_s": 60.0,
+                            "baseline_s": 2.0, "timeout_s": 60.0, "sample": 5, "seed": 3,
+                            "run_s": 12.0,
                             "results": [_record("killed", 1, "tests/test_a.py::t"),
                                         _record("killed", 2, "tests/test_a.py::t"),
                                         _record("survived", 7),
                                         _record("equivalent", 8, reason="same float")]}]}
     text = summary_markdown(results)
-    assert "2 of 3 non-equivalent mutants detected (67%)" in text
-    assert "| m.py | 9 | 4 | 2 | 0 | 1 | 1 | 0 | 67% | test_a.py | 2.0 s |" in text
+    assert "2 of 3 non-equivalent mutants detected (67%), run time 12 s" in text
+    assert "| m.py | 9 | 5 (seed 3) | 4 | 2 | 0 | 1 | 1 | 0 | 67% | test_a.py | 2.0 s |" in text
     assert "| `tests/test_a.py::t` | 2 |" in text
     survivors = text.split("### Surviving mutants")[1].split("###")[0]
     assert "line 7" in survivors and "+x = a - b" in survivors and "line 1 " not in survivors
