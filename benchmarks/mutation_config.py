@@ -73,10 +73,53 @@ in these modules), the arithmetic replacements beyond one per operator pair (the
 the kept ones find), ``AddNot`` (the comparison negations cover it) and the variable
 replacers (random, not reproducible from a seed)."""
 
+_ABS = ("max(|·|) is ≥ 0 > −1: ``initial`` decides only for an empty array, which this one "
+        "never is")
+
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ("impactqp/base/checks.py", "core/NumberReplacer",
      "UNIT_RANGE = (1e-100, 1e100)", "UNIT_RANGE = (1e-100, 1e+100)"):
         "1e100 ± 1 rounds to the float 1e100: the constant is unchanged",
+    ("impactqp/kernels/active_set.py", "core/ReplaceFalseWithTrue",
+     "blocked[:] = False", "blocked[:] = True"):
+        "after a ray step (the only place this line survives; at the other two every test "
+        "with a non-trivial LCP fails) nothing reads ``blocked`` before the restoring move, "
+        "which has joined = −1 and so always reports moved and clears ``blocked``",
+    ("impactqp/model/admissible.py", "core/NumberReplacer",
+     'c = float(np.abs(du).max(initial=0.0))',
+     'c = float(np.abs(du).max(initial= -1.0))'):
+        _ABS,
+    ("impactqp/model/admissible.py", "core/NumberReplacer",
+     'c = float(np.abs(p.u_minus).max(initial=0.0))',
+     'c = float(np.abs(p.u_minus).max(initial= -1.0))'):
+        _ABS,
+    ("impactqp/model/admissible.py", "core/NumberReplacer",
+     'c = float(np.abs(self.problem.u_minus).max(initial=0.0))',
+     'c = float(np.abs(self.problem.u_minus).max(initial= -1.0))'):
+        _ABS,
+    ("impactqp/model/admissible.py", "core/NumberReplacer",
+     'scale = float(np.abs(self.problem.u_minus).max(initial=0.0))',
+     'scale = float(np.abs(self.problem.u_minus).max(initial= -1.0))'):
+        _ABS,
+    ("impactqp/model/admissible.py", "core/NumberReplacer",
+     'cn = float(np.abs(c).max(initial=0.0))',
+     'cn = float(np.abs(c).max(initial= -1.0))'):
+        _ABS,
+    ("impactqp/model/admissible.py", "core/NumberReplacer",
+     'lam.min() < -1e-12 * max(float(np.abs(lam).max(initial=0.0)), 1e-300):',
+     'lam.min() < -1e-12 * max(float(np.abs(lam).max(initial= -1.0)), 1e-300):'):
+        _ABS,
+    ("impactqp/model/admissible.py", "core/NumberReplacer",
+     'kinematic = float(max(0.0, -np.min(gamma / (s * V), initial=0.0)))',
+     'kinematic = float(max(0.0, -np.min(gamma / (s * V), initial= 1.0)))'):
+        "with every γᵢ > 0 both minima are positive and the penetration is 0 either way; with "
+        "one γᵢ ≤ 0 the minimum is that one",
+    ("impactqp/model/admissible.py", "core/NumberReplacer",
+     'lam.min() < -1e-12 * max(float(np.abs(lam).max(initial=0.0)), 1e-300):',
+     'lam.min() < -1e-12 * max(float(np.abs(lam).max(initial= 1.0)), 1e-300):'):
+        "not strictly equivalent: the sparse solve's Λ is accepted down to −1e-12 instead of "
+        "−1e-12·max|Λ| when max|Λ| < 1 (order-one units), and then clipped at 0; the "
+        "answer moves by < 1e-12 relative, below every certificate's tolerance",
 }
 """(module, operator, original line, mutated line) — lines stripped — → why no input can tell
 the mutant from the original. Keyed by text rather than line number, so that edits elsewhere

@@ -102,7 +102,9 @@ def test_a_body_at_rest_admits_only_rest() -> None:
     p = iq.newtons_cradle()
     q = p.with_u_minus(np.zeros(3))
     S = q.admissible_set()
-    assert S.contains(np.zeros(3))
+    rest = S.contains(np.zeros(3))
+    assert rest and (rest.kinetic, rest.kinematic, rest.energetic) == (0.0, 0.0, 0.0)
+    np.testing.assert_array_equal(rest.impulses, 0.0)
     assert S.contains(np.zeros(3), method="optimizer").distance == 0.0
     m = S.contains([0.0, 1e-300, 0.0])
     assert not m and m.kinetic == np.inf
@@ -142,6 +144,14 @@ def test_moreau_split_is_the_kinetic_projection(scale: float) -> None:
     assert abs(z @ M @ zp) <= 1e-9 * scale**2 * max(p.norm(p.u_minus / scale) ** 2, 1.0)
 
 
+def test_moreau_split_of_one_contact() -> None:
+    # two equal balls, one contact: z is the common velocity, z⊥ the rest
+    p = iq.newtons_cradle(2)
+    z, zp = p.admissible_set().moreau_split()
+    np.testing.assert_allclose(z, [0.5, 0.5], atol=1e-12)
+    np.testing.assert_allclose(zp, [0.5, -0.5], atol=1e-12)
+
+
 def test_support_and_projection_against_sampled_points() -> None:
     p = iq.newtons_cradle(4)
     S = p.admissible_set()
@@ -160,5 +170,6 @@ def test_support_and_projection_against_sampled_points() -> None:
     x = np.array([0.3, -1.0, 2.0, 0.1])
     y = S.project(x)
     assert S.contains(y, tol=1e-6)
-    far = p.with_u_minus(p.u_minus * 1e3).admissible_set().project(x * 1e3)
-    np.testing.assert_allclose(far, y * 1e3, rtol=1e-5, atol=1e-3)
+    for scale in (1e3, 1e-3):  # S and the projection scale with u⁻
+        far = p.with_u_minus(p.u_minus * scale).admissible_set().project(x * scale)
+        np.testing.assert_allclose(far, y * scale, rtol=1e-5, atol=1e-6 * scale)

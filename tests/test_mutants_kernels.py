@@ -276,6 +276,33 @@ def test_active_set_with_redundant_contacts(seed: int) -> None:
     _check_lcp(G, q, x, w, status)
 
 
+def _assert_kkt(G, q, x, w) -> None:
+    """0 ≤ x ⟂ w = Gx + q ≥ 0, to rounding relative to the sizes involved."""
+    size = 1.0 + np.abs(q).max() + np.abs(G).max() * np.abs(x).max()
+    np.testing.assert_allclose(w, G @ x + q, atol=1e-9 * size)
+    assert np.all(x >= 0.0) and np.all(w >= -1e-9 * size)
+    assert abs(x @ w) <= 1e-9 * size * (1.0 + np.abs(x).max())
+
+
+def test_active_set_on_many_small_lcps() -> None:
+    # a sweep over sizes, ranks and warm starts: every answer satisfies the LCP's conditions,
+    # and an LCP is declared without solution only when no support gives one
+    rng = np.random.default_rng(2024)
+    for _ in range(150):
+        m = int(rng.integers(2, 8))
+        A = rng.normal(size=(int(rng.integers(1, m + 2)), m))
+        G = A.T @ A
+        q = rng.normal(size=m) * rng.choice([0.1, 1.0, 10.0])
+        regular = bool(np.all(np.linalg.eigvalsh(G) > 1e-9))  # then solvable for every q
+        for passive in (None, rng.random(m) < 0.5):
+            x, w, status = solve_lcp_psd(G, q, passive)
+            if status == SOLVED:
+                _assert_kkt(G, q, x, w)
+            else:
+                assert not regular and status == NO_SOLUTION
+                assert lcp_brute_force(G, q) is None
+
+
 def test_active_set_reports_an_infeasible_lcp_and_the_step_limit() -> None:
     G = np.array([[1.0, -1.0], [-1.0, 1.0]])
     q = np.array([-1.0, -1.0])  # x₁ − x₂ ≥ 1 and x₂ − x₁ ≥ 1 cannot both hold
