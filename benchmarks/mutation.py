@@ -150,7 +150,6 @@ def run(modules: list[str], n: int | None, seed: int, out: Path, progress: bool 
     ``summary.md`` and ``results.json`` in ``out`` (with ``merge``, replacing only these
     modules' results in the ones already there); return the results."""
     *_, mutate_and_test, mutation_spec, test_outcome, _ = _cosmic_ray()
-    rng = random.Random(seed)
     start = time.perf_counter()
     scratch = _scratch_copy()
     here = Path.cwd()
@@ -162,7 +161,7 @@ def run(modules: list[str], n: int | None, seed: int, out: Path, progress: bool 
         for module in modules:
             tests = MODULES[module]
             every = enumerate_mutants(module, scratch)
-            chosen = sample(every, n, rng)
+            chosen = sample(every, n, random.Random(f"{seed}:{module}"))  # per module
             base = _baseline(tests)
             timeout = max(60.0, 4.0 * base)
             for k, mutant in enumerate(chosen, 1):

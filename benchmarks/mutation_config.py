@@ -80,6 +80,17 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ("impactqp/base/checks.py", "core/NumberReplacer",
      "UNIT_RANGE = (1e-100, 1e100)", "UNIT_RANGE = (1e-100, 1e+100)"):
         "1e100 ± 1 rounds to the float 1e100: the constant is unchanged",
+    ("impactqp/kernels/residuals.py", "core/NumberReplacer",
+     "SCALE_RANGE = (1e-60, 1e60)", "SCALE_RANGE = (1e-60, 1e+60)"):
+        "1e60 ± 1 rounds to the float 1e60: the constant is unchanged",
+    ("impactqp/kernels/residuals.py", "core/ReplaceComparisonOperator_Gt_GtE",
+     "return a if (a > b or a != a) else b", "return a if (a >= b or a != a) else b"):
+        "for a == b either argument is the same number (±0 compare equal and give the same "
+        "verdicts)",
+    ("impactqp/kernels/residuals.py", "core/ReplaceComparisonOperator_Lt_LtE",
+     "return a if (a < b or a != a) else b", "return a if (a <= b or a != a) else b"):
+        "for a == b either argument is the same number (±0 compare equal and give the same "
+        "verdicts)",
     ("impactqp/kernels/active_set.py", "core/ReplaceFalseWithTrue",
      "blocked[:] = False", "blocked[:] = True"):
         "after a ray step (the only place this line survives; at the other two every test "

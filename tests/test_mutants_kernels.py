@@ -199,6 +199,10 @@ def test_fold_contacts_and_finish_rows() -> None:
                                         10.5 / 4 + 0.0625])
     out = finish_rows(V, np.array([0.5]), lam[None], w[None], s, 0.25, False, np.array([1.0]))
     assert np.isnan(out[0, 4:]).all()
+    # no contacts: nothing violated, nothing to complement
+    out = finish_rows(V, np.array([0.5]), np.zeros((1, 0)), np.zeros((1, 0)), np.zeros(0), 0.25,
+                      True, np.array([0.0]))
+    np.testing.assert_array_equal(out[0], [0.25, 0.0, 0.0, 0.0, 0.0, 0.0625])
     nan = fold_contacts(np.array([1.0, np.nan]), np.array([1.0, 1.0]), np.ones(2))
     assert np.isnan([nan[0], nan[2], nan[3]]).all() and nan[1] == 1.0
 
