@@ -30,7 +30,7 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from .mutation_config import EQUIVALENT, FIRST, MODULES, OPERATORS
+from .mutation_config import EQUIVALENT, FIRST, MODULES, NOTES, OPERATORS
 from .mutation_report import summary_markdown
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -110,7 +110,7 @@ def _judge(mutant: Mutant, result, test_outcome) -> None:
     if result.test_outcome == test_outcome.SURVIVED:
         key = (mutant.module, mutant.operator, *_changed_lines(mutant.diff))
         mutant.status = "equivalent" if key in EQUIVALENT else "survived"
-        mutant.reason = EQUIVALENT.get(key, "")
+        mutant.reason = EQUIVALENT.get(key, NOTES.get(key, ""))
         return
     if result.output == "timeout":
         mutant.status = "timeout"

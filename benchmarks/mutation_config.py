@@ -135,3 +135,23 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
 """(module, operator, original line, mutated line) — lines stripped — → why no input can tell
 the mutant from the original. Keyed by text rather than line number, so that edits elsewhere
 in the module keep the entry."""
+
+_TIE = ("reached only when a variable of P has x = s = 0 exactly (a tie at a vertex), "
+        "which changes the path of the search and not its end: no test has such a tie")
+
+NOTES: dict[tuple[str, str, str, str], str] = {
+    ("impactqp/kernels/active_set.py", "core/NumberReplacer",
+     "step = x[i] / (x[i] - s[i]) if x[i] > s[i] else 0.0",
+     "step = x[i] / (x[i] - s[i]) if x[i] > s[i] else 1.0"): _TIE,
+    ("impactqp/kernels/active_set.py", "core/NumberReplacer",
+     "step = x[i] / (x[i] - s[i]) if x[i] > s[i] else 0.0",
+     "step = x[i] / (x[i] - s[i]) if x[i] > s[i] else -1.0"): _TIE,
+    ("impactqp/kernels/active_set.py", "core/ReplaceAndWithOr",
+     "if i != stop and (s[i] > 0.0 or x[i] > 0.0):",
+     "if i != stop or (s[i] > 0.0 or x[i] > 0.0):"):
+        "a variable of P other than the blocking one that reaches zero in the same step "
+        "stays in P at x = 0 and leaves at the next inner step (step 0): a tie again, one "
+        "more inner step, the same end",
+}
+"""Survivors that are not equivalent but not yet killed, keyed as :data:`EQUIVALENT`: what
+they change and why no test sees it. They count as survived."""

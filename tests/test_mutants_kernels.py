@@ -321,6 +321,16 @@ def test_active_set_reports_an_infeasible_lcp_and_the_step_limit() -> None:
     _check_lcp(G, q, x, w, SOLVED)
 
 
+def test_every_step_changes_the_passive_set() -> None:
+    # max_iter bounds the steps that change the passive set: a one-variable LCP whose
+    # variable is positive takes two (it joins; nothing more joins), cold or warm
+    for passive in (False, True):
+        x, w = np.zeros(1), np.zeros(1)
+        status = lcp_psd(np.array([[2.0]]), np.array([-1.0]), np.array([passive]), x, w, 2)
+        assert status == SOLVED
+        assert x[0] == 0.5 and w[0] == 0.0
+
+
 def test_active_set_rows_warm_start_each_other() -> None:
     rng = np.random.default_rng(9)
     A = rng.normal(size=(5, 4))
