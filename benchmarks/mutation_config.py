@@ -80,6 +80,14 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ("impactqp/base/checks.py", "core/NumberReplacer",
      "UNIT_RANGE = (1e-100, 1e100)", "UNIT_RANGE = (1e-100, 1e+100)"):
         "1e100 ± 1 rounds to the float 1e100: the constant is unchanged",
+    ("impactqp/kernels/impact.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "for i in range(j + 1, n):", "for i in range(j - 1, n):"):
+        "to one rounding: the extra row j − 1 writes L[j−1, j], above the diagonal and never "
+        "read (for j = 0, row −1 is row n − 1, rewritten with the same value later), and row "
+        "j rewrites L[j, j] as d/√d, which is √d to one rounding",
+    ("impactqp/kernels/residuals.py", "core/NumberReplacer",
+     "if 0 <= k + 1 < lam.size:", "if -1 <= k + 1 < lam.size:"):
+        "k = j − lo ≥ −1, so k + 1 ≥ 0 and the lower bound never decides",
     ("impactqp/kernels/residuals.py", "core/NumberReplacer",
      "SCALE_RANGE = (1e-60, 1e60)", "SCALE_RANGE = (1e-60, 1e+60)"):
         "1e60 ± 1 rounds to the float 1e60: the constant is unchanged",
@@ -152,6 +160,17 @@ NOTES: dict[tuple[str, str, str, str], str] = {
         "a variable of P other than the blocking one that reaches zero in the same step "
         "stays in P at x = 0 and leaves at the next inner step (step 0): a tie again, one "
         "more inner step, the same end",
+    ("impactqp/kernels/active_set.py", "core/ReplaceFalseWithTrue",
+     "first = False", "first = True"):
+        "a joining variable whose minimizer turns non-positive after the first inner step "
+        "leaves at once and is blocked instead of being stepped past; this could end a "
+        "search with that variable still descending, which no test (150 random LCPs, "
+        "redundant contacts, warm starts) has produced",
+    ("impactqp/kernels/impact.py", "core/NumberReplacer",
+     "sv = floats[2 * m:3 * m]", "sv = floats[ 1 * m:3 * m]"):
+        "γ⁻ and the search's scratch s then share w's cells; every use of one ends before the "
+        "other is written (γ⁻ is read into q before the search; s[i] = −w[i] reads the cell "
+        "it writes), so the answers agree",
 }
 """Survivors that are not equivalent but not yet killed, keyed as :data:`EQUIVALENT`: what
 they change and why no test sees it. They count as survived."""

@@ -278,6 +278,11 @@ def test_active_set_with_redundant_contacts(seed: int) -> None:
     _check_lcp(G, q, x, w, status)
     x, w, status = solve_lcp_psd(G, q, np.ones(6, dtype=bool))
     _check_lcp(G, q, x, w, status)
+    for scale in (1e-8, 1e8):  # dependence is judged relative to G's scale
+        xs, ws, status = solve_lcp_psd(scale * G, scale * q)
+        assert status == SOLVED
+        _assert_kkt(scale * G, scale * q, xs, ws)
+        np.testing.assert_allclose(ws, scale * w, rtol=1e-6, atol=1e-9 * scale)
 
 
 def _assert_kkt(G, q, x, w) -> None:
