@@ -1,5 +1,5 @@
 """``python -m benchmarks.mutation [--modules PATH ...] [--sample N] [--seed S] [--out DIR]
-[--merge] [--list]``: mutation checks of the modules holding formulas and verdicts.
+[--merge] [--rejudge] [--list]``: mutation checks of the modules holding formulas and verdicts.
 
 Each mutant is one small change made by cosmic-ray's operators (:data:`.mutation_config.
 OPERATORS`) to one module, in a scratch copy of the repository; the module's fast test files
@@ -99,6 +99,26 @@ def _changed_lines(diff: str) -> tuple[str, str]:
     return " / ".join(before), " / ".join(after)
 
 
+def _explain(record: dict) -> None:
+    """Mark a surviving record equivalent or noted by the tables (``record`` as in
+    results.json)."""
+    key = (record["module"], record["operator"], *_changed_lines(record["diff"]))
+    record["status"] = "equivalent" if key in EQUIVALENT else "survived"
+    record["reason"] = EQUIVALENT.get(key, NOTES.get(key, ""))
+
+
+def rejudge(out: Path) -> dict:
+    """Apply the current :data:`EQUIVALENT` and :data:`NOTES` to the survivors of the run in
+    ``out`` and rewrite its report, without running anything."""
+    results = json.loads((out / "results.json").read_text(encoding="utf-8"))
+    for record in (r for mod in results["modules"] for r in mod["results"]):
+        if record["status"] in ("survived", "equivalent"):
+            _explain(record)
+    (out / "results.json").write_text(json.dumps(results, indent=1) + "\n", encoding="utf-8")
+    (out / "summary.md").write_text(summary_markdown(results), encoding="utf-8")
+    return results
+
+
 def _judge(mutant: Mutant, result, test_outcome) -> None:
     mutant.diff = result.diff or ""
     if result.test_outcome is None:
@@ -108,9 +128,9 @@ def _judge(mutant: Mutant, result, test_outcome) -> None:
         mutant.status, mutant.killer = "error", (result.output or "").strip().splitlines()[-1:][0]
         return
     if result.test_outcome == test_outcome.SURVIVED:
-        key = (mutant.module, mutant.operator, *_changed_lines(mutant.diff))
-        mutant.status = "equivalent" if key in EQUIVALENT else "survived"
-        mutant.reason = EQUIVALENT.get(key, NOTES.get(key, ""))
+        record = asdict(mutant)
+        _explain(record)
+        mutant.status, mutant.reason = record["status"], record["reason"]
         return
     if result.output == "timeout":
         mutant.status = "timeout"
@@ -212,6 +232,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="output directory (default: benchmarks/results/mutation)")
     parser.add_argument("--merge", action="store_true",
                         help="replace only these modules' results in --out's results.json")
+    parser.add_argument("--rejudge", action="store_true",
+                        help="apply the current EQUIVALENT and NOTES tables to --out's "
+                             "results.json and rewrite its report, running nothing")
     parser.add_argument("--list", action="store_true",
                         help="print how many mutants each module has and stop")
     parser.add_argument("--no-progress", action="store_true", help="no line per mutant")
@@ -223,8 +246,11 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{module}: {len(enumerate_mutants(module))} mutants; tests: "
                   + " ".join(MODULES[module]))
         return 0
-    results = run(args.modules, args.sample, args.seed, args.out.resolve(),
-                  progress=not args.no_progress, merge=args.merge)
+    if args.rejudge:
+        results = rejudge(args.out)
+    else:
+        results = run(args.modules, args.sample, args.seed, args.out.resolve(),
+                      progress=not args.no_progress, merge=args.merge)
     print(f"wrote {args.out}/summary.md, results.json")
     survived = [m for mod in results["modules"] for m in mod["results"]
                 if m["status"] in ("survived", "error")]

@@ -85,6 +85,12 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "to one rounding: the extra row j − 1 writes L[j−1, j], above the diagonal and never "
         "read (for j = 0, row −1 is row n − 1, rewritten with the same value later), and row "
         "j rewrites L[j, j] as d/√d, which is √d to one rounding",
+    ("impactqp/kernels/impact.py", "core/NumberReplacer",
+     "w = floats[m:2 * m]", "w = floats[m: 3 * m]"):
+        "the search reads and writes w[:m] only, the same cells",
+    ("impactqp/kernels/impact.py", "core/NumberReplacer",
+     "sv = floats[2 * m:3 * m]", "sv = floats[2 * m: 4 * m]"):
+        "γ⁻ and the search's scratch use sv[:m] only, the same cells",
     ("impactqp/kernels/residuals.py", "core/NumberReplacer",
      "if 0 <= k + 1 < lam.size:", "if -1 <= k + 1 < lam.size:"):
         "k = j − lo ≥ −1, so k + 1 ≥ 0 and the lower bound never decides",
@@ -147,7 +153,26 @@ in the module keep the entry."""
 _TIE = ("reached only when a variable of P has x = s = 0 exactly (a tie at a vertex), "
         "which changes the path of the search and not its end: no test has such a tie")
 
+_BUDGET = ("the search's step budget 20m + 50 moved by m or 1: searches take m to 3m steps, "
+           "so only an LCP near the budget could tell")
+
 NOTES: dict[tuple[str, str, str, str], str] = {
+    ("impactqp/kernels/impact.py", "core/NumberReplacer",
+     "if lcp_psd_work(G, q, passive, lam, w, 20 * m + 50, L, idx, sv, blocked) != SOLVED:",
+     "if lcp_psd_work(G, q, passive, lam, w, 21 * m + 50, L, idx, sv, blocked) != SOLVED:"):
+        _BUDGET,
+    ("impactqp/kernels/impact.py", "core/NumberReplacer",
+     "if lcp_psd_work(G, q, passive, lam, w, 20 * m + 50, L, idx, sv, blocked) != SOLVED:",
+     "if lcp_psd_work(G, q, passive, lam, w, 19 * m + 50, L, idx, sv, blocked) != SOLVED:"):
+        _BUDGET,
+    ("impactqp/kernels/impact.py", "core/NumberReplacer",
+     "if lcp_psd_work(G, q, passive, lam, w, 20 * m + 50, L, idx, sv, blocked) != SOLVED:",
+     "if lcp_psd_work(G, q, passive, lam, w, 20 * m + 51, L, idx, sv, blocked) != SOLVED:"):
+        _BUDGET,
+    ("impactqp/kernels/impact.py", "core/NumberReplacer",
+     "if lcp_psd_work(G, q, passive, lam, w, 20 * m + 50, L, idx, sv, blocked) != SOLVED:",
+     "if lcp_psd_work(G, q, passive, lam, w, 20 * m + 49, L, idx, sv, blocked) != SOLVED:"):
+        _BUDGET,
     ("impactqp/kernels/active_set.py", "core/NumberReplacer",
      "step = x[i] / (x[i] - s[i]) if x[i] > s[i] else 0.0",
      "step = x[i] / (x[i] - s[i]) if x[i] > s[i] else 1.0"): _TIE,
