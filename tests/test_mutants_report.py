@@ -86,3 +86,24 @@ def test_mutants_of_the_verdict_module() -> None:
     # the verdict's comparison ``v <= self.tol`` is among the mutated lines
     text = (ROOT / "impactqp/base/checks.py").read_text(encoding="utf-8").splitlines()
     assert any("v <= self.tol" in text[m.line - 1] for m in mutants)
+
+
+def test_rejudge_applies_the_tables_to_a_finished_run(tmp_path: Path) -> None:
+    import json
+
+    from benchmarks.mutation import rejudge
+
+    (module, operator, before, after), reason = next(iter(EQUIVALENT.items()))
+    explained = _record("survived", 3) | {
+        "module": module, "operator": operator,
+        "diff": f"--- a\n+++ b\n@@ -3 +3 @@\n-{before}\n+{after}\n"}
+    results = {"operators": list(OPERATORS),
+               "modules": [{"module": module, "tests": [], "mutants": 2, "baseline_s": 1.0,
+                            "timeout_s": 60.0, "sample": None, "seed": 0, "run_s": 2.0,
+                            "results": [explained, _record("survived", 9)]}]}
+    (tmp_path / "results.json").write_text(json.dumps(results), encoding="utf-8")
+    records = rejudge(tmp_path)["modules"][0]["results"]
+    assert [r["status"] for r in records] == ["equivalent", "survived"]
+    assert records[0]["reason"] == reason
+    assert "1 of 1" not in (tmp_path / "summary.md").read_text(encoding="utf-8")
+    assert "0 of 1 non-equivalent" in (tmp_path / "summary.md").read_text(encoding="utf-8")
