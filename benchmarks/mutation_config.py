@@ -91,6 +91,11 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ("impactqp/kernels/impact.py", "core/NumberReplacer",
      "sv = floats[2 * m:3 * m]", "sv = floats[2 * m: 4 * m]"):
         "γ⁻ and the search's scratch use sv[:m] only, the same cells",
+    ("impactqp/kernels/active_set.py", "core/NumberReplacer", "leave = -1", "leave = - 2"):
+        "only leave < 0 is tested: −1 and −2 say the same",
+    ("impactqp/kernels/active_set.py", "core/NumberReplacer",
+     "if status == SOLVED and k > 0:", "if status == SOLVED and k > -1:"):
+        "with k = 0 the final solve sets x = 0, which it already is, and recomputes w",
     ("impactqp/kernels/residuals.py", "core/NumberReplacer",
      "if 0 <= k + 1 < lam.size:", "if -1 <= k + 1 < lam.size:"):
         "k = j − lo ≥ −1, so k + 1 ≥ 0 and the lower bound never decides",
@@ -157,6 +162,31 @@ _BUDGET = ("the search's step budget 20m + 50 moved by m or 1: searches take m t
            "so only an LCP near the budget could tell")
 
 NOTES: dict[tuple[str, str, str, str], str] = {
+    ("impactqp/kernels/active_set.py", "core/NumberReplacer",
+     "if i != stop and (s[i] > 0.0 or x[i] > 0.0):",
+     "if i != stop and (s[i] > 1.0 or x[i] > 0.0):"):
+        _TIE,
+    ("impactqp/kernels/active_set.py", "core/NumberReplacer",
+     "if i != stop and (s[i] > 0.0 or x[i] > 0.0):",
+     "if i != stop and (s[i] > -1.0 or x[i] > 0.0):"):
+        _TIE,
+    ("impactqp/kernels/active_set.py", "core/NumberReplacer",
+     "if i != stop and (s[i] > 0.0 or x[i] > 0.0):",
+     "if i != stop and (s[i] > 0.0 or x[i] > -1.0):"):
+        _TIE,
+    ("impactqp/kernels/active_set.py", "core/NumberReplacer",
+     "if i != stop and (s[i] > 0.0 or x[i] > 0.0):",
+     "if i != stop and (s[i] > 0.0 or x[i] > 1.0):"):
+        "drops variables still moving with 0 < x ≤ 1; they join again in later outer steps "
+        "and the answer is the minimizer on the final support: the path changes, not the end",
+    ("impactqp/kernels/active_set.py", "core/ReplaceBinaryOperator_Mul_Div",
+     "x[idx[a]] += t * s[idx[a]]", "x[idx[a]] += t / s[idx[a]]"):
+        "the point reached along a ray only starts the restoring inner steps, which end at the "
+        "minimizer on the new support: the path changes, not the end",
+    ("impactqp/kernels/active_set.py", "core/ReplaceAndWithOr",
+     "if status == SOLVED and k > 0:", "if status == SOLVED or k > 0:"):
+        "refines x after a failed search too; every caller refuses a failed search's answer "
+        "(no test reads x after NO_SOLUTION or ITERATION_LIMIT)",
     ("impactqp/kernels/impact.py", "core/NumberReplacer",
      "if lcp_psd_work(G, q, passive, lam, w, 20 * m + 50, L, idx, sv, blocked) != SOLVED:",
      "if lcp_psd_work(G, q, passive, lam, w, 21 * m + 50, L, idx, sv, blocked) != SOLVED:"):
