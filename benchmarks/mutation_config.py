@@ -97,6 +97,28 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
      "if status == SOLVED and k > 0:", "if status == SOLVED and k > -1:"):
         "with k = 0 the final solve sets x = 0, which it already is, and recomputes w",
     ("impactqp/kernels/residuals.py", "core/NumberReplacer",
+     "return _high(np.sqrt(_high(V2_plus, 0.0)), 1.0)",
+     "return _high(np.sqrt(_high(V2_plus, 1.0)), 1.0)"):
+        "max(√max(x, 1), 1) = max(√max(x, 0), 1) for every x, and NaN stays NaN in both",
+    ("impactqp/model/admissible.py", "core/NumberReplacer", "if st.m == 0:", "if st.m == -1:"):
+        "to rounding: without contacts the NNLS over no columns returns the same ‖du‖_M "
+        "(computed in order-one units and scaled back) and no impulses",
+    ("impactqp/model/admissible.py", "core/ReplaceComparisonOperator_LtE_Lt",
+     "if not UNIT_RANGE[0] <= scale <= UNIT_RANGE[1]:  # z scales with u⁻: order-one units",
+     "if not UNIT_RANGE[0] <= scale < UNIT_RANGE[1]:  # z scales with u⁻: order-one units"):
+        "to rounding: at a scale of exactly 1e100 z is computed in order-one units and "
+        "scaled back instead of as given; z is positively homogeneous in u⁻",
+    ("impactqp/model/admissible.py", "core/NumberReplacer",
+     "kinematic = float(max(0.0, -np.min(gamma / (s * V), initial=0.0)))",
+     "kinematic = float(max( -1.0, -np.min(gamma / (s * V), initial=0.0)))"):
+        "min(…, initial=0) ≤ 0, so −min ≥ 0 > −1 and the outer max never picks −1",
+    ("impactqp/kernels/impact.py", "core/NumberReplacer",
+     "sv = floats[2 * m:3 * m]", "sv = floats[ 1 * m:3 * m]"):
+        "γ⁻ and the search's scratch s then share w's cells, and no value is read after the "
+        "other array overwrote it: γ⁻ is read into q before the search; every pass that "
+        "writes s (the ray, the inner steps, the final solve) reads w before it or not at "
+        "all, s[i] = −w[i] negates a cell in place, and w is recomputed before it is read",
+    ("impactqp/kernels/residuals.py", "core/NumberReplacer",
      "if 0 <= k + 1 < lam.size:", "if -1 <= k + 1 < lam.size:"):
         "k = j − lo ≥ −1, so k + 1 ≥ 0 and the lower bound never decides",
     ("impactqp/kernels/residuals.py", "core/NumberReplacer",
@@ -162,6 +184,12 @@ _BUDGET = ("the search's step budget 20m + 50 moved by m or 1: searches take m t
            "so only an LCP near the budget could tell")
 
 NOTES: dict[tuple[str, str, str, str], str] = {
+    ("impactqp/model/admissible.py", "core/ReplaceUnaryOperator_Delete_Not",
+     "if lam is None or not np.all(np.isfinite(lam)) or \\",
+     "if lam is None or  np.all(np.isfinite(lam)) or \\"):
+        "sends every finite sparse Λ to the certified LCP instead (slower, the same answer); "
+        "differs only when the sparse LU of the Delassus matrix returns a non-finite Λ, "
+        "which no test's problem does",
     ("impactqp/kernels/active_set.py", "core/NumberReplacer",
      "if i != stop and (s[i] > 0.0 or x[i] > 0.0):",
      "if i != stop and (s[i] > 1.0 or x[i] > 0.0):"):
@@ -221,11 +249,6 @@ NOTES: dict[tuple[str, str, str, str], str] = {
         "leaves at once and is blocked instead of being stepped past; this could end a "
         "search with that variable still descending, which no test (150 random LCPs, "
         "redundant contacts, warm starts) has produced",
-    ("impactqp/kernels/impact.py", "core/NumberReplacer",
-     "sv = floats[2 * m:3 * m]", "sv = floats[ 1 * m:3 * m]"):
-        "γ⁻ and the search's scratch s then share w's cells; every use of one ends before the "
-        "other is written (γ⁻ is read into q before the search; s[i] = −w[i] reads the cell "
-        "it writes), so the answers agree",
 }
 """Survivors that are not equivalent but not yet killed, keyed as :data:`EQUIVALENT`: what
 they change and why no test sees it. They count as survived."""
