@@ -30,7 +30,8 @@ MODULES: dict[str, tuple[str, ...]] = {
         "tests/test_mutants_certificate.py", "tests/test_verify.py", "tests/test_small_path.py",
         "tests/test_reflection_law.py"),
     "impactqp/model/residuals.py": (
-        "tests/test_small_path.py", "tests/test_chain_certificate.py", "tests/test_verify.py"),
+        "tests/test_mutants_model_residuals.py", "tests/test_small_path.py",
+        "tests/test_verify.py"),
     # the chain's compiled pass
     "impactqp/kernels/chain.py": ("tests/test_chain_certificate.py", "tests/test_isotonic.py"),
     # LZB's compliant impact
