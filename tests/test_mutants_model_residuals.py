@@ -11,7 +11,12 @@ import scipy.sparse as sp
 from test_mutants_kernels import residuals_reference
 
 import impactqp as iq
-from impactqp.model.residuals import law_residuals, normalized_rows, restitution_matrix
+from impactqp.model.residuals import (
+    impact_residuals,
+    law_residuals,
+    normalized_rows,
+    restitution_matrix,
+)
 
 NAMES = ("momentum", "impulse_sign", "law_feasibility", "complementarity", "energy_balance",
          "duality_gap")
@@ -121,3 +126,29 @@ def test_restitution_matrix() -> None:
     np.testing.assert_array_equal(restitution_matrix([0.1, 0.2], 2), [[0.1, 0.0], [0.0, 0.2]])
     E = np.array([[0.1, 0.2], [0.3, 0.4]])
     np.testing.assert_array_equal(restitution_matrix(E, 2), E)
+
+
+@pytest.mark.parametrize("sparse", [False, True])
+def test_impact_residuals_are_the_formulas(sparse: bool) -> None:
+    # the residuals every law shares (the sector, reflection, LZB and Coulomb certificates
+    # read them): the momentum and the impulse sign, one impact and rows, u⁻ = 0 included
+    rng, M, W = _random(8)
+    n, m = W.shape
+    p = iq.ImpactProblem(sp.csc_matrix(M) if sparse else M, sp.csc_matrix(W) if sparse else W,
+                         rng.normal(size=n))
+    Um, Up, Lam = rng.normal(size=(3, n)), rng.normal(size=(3, n)), rng.normal(size=(3, m))
+    Um[2] = 0.0
+    Um, Up, Lam = normalized_rows(Um, Up, Lam)
+    V, rows = impact_residuals(p.structure, Um, Up, Lam)
+    for r in range(3):
+        ref = residuals_reference(M, W, Um[r], Up[r], Lam[r], np.eye(m), 0.0, False)
+        np.testing.assert_allclose([rows["momentum"][r], rows["impulse_sign"][r]], ref[:2],
+                                   rtol=1e-9, atol=1e-15)
+        Vr, one = impact_residuals(p.structure, Um[r], Up[r], Lam[r])
+        assert float(Vr) == pytest.approx(V[r], rel=1e-12)
+        assert float(one["momentum"]) == pytest.approx(rows["momentum"][r], rel=1e-12)
+    assert V[2] == pytest.approx(max(np.sqrt(Up[2] @ M @ Up[2]), 1.0), rel=1e-12)
+    q = iq.ImpactProblem(np.eye(2), np.zeros((2, 0)), np.array([1.0, 0.0]))  # no contacts
+    _, none = impact_residuals(q.structure, np.array([1.0, 0.0]), np.array([0.0, 1.0]),
+                               np.zeros(0))
+    assert none["impulse_sign"] == 0.0 and none["momentum"] == pytest.approx(np.sqrt(2.0))
