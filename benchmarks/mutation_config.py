@@ -74,6 +74,10 @@ in these modules), the arithmetic replacements beyond one per operator pair (the
 the kept ones find), ``AddNot`` (the comparison negations cover it) and the variable
 replacers (random, not reproducible from a seed)."""
 
+_ROUTE = ("to rounding: which of the two routes (the compiled dense kernel or numpy products) "
+          "computes the residuals; both compute the same formulas, each tested against the "
+          "same numpy reference")
+
 _ABS = ("max(|·|) is ≥ 0 > −1: ``initial`` decides only for an empty array, which this one "
         "never is")
 
@@ -119,6 +123,26 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "other array overwrote it: γ⁻ is read into q before the search; every pass that "
         "writes s (the ray, the inner steps, the final solve) reads w before it or not at "
         "all, s[i] = −w[i] negates a cell in place, and w is recomputed before it is read",
+    ("impactqp/model/residuals.py", "core/NumberReplacer",
+     "DENSE_CONTACTS = 2000", "DENSE_CONTACTS = 2001"):
+        _ROUTE,
+    ("impactqp/model/residuals.py", "core/NumberReplacer",
+     "DENSE_CONTACTS = 2000", "DENSE_CONTACTS = 1999"):
+        _ROUTE,
+    ("impactqp/model/residuals.py", "core/ReplaceUnaryOperator_Delete_Not",
+     "if not st.sparse and st.chain is None and st.m <= DENSE_CONTACTS:",
+     "if  st.sparse and st.chain is None and st.m <= DENSE_CONTACTS:"):
+        _ROUTE,
+    ("impactqp/model/residuals.py", "core/NumberReplacer",
+     "bool(c.left_wall), bool(c.right_wall), E, 0.0 if eps is None else float(eps),",
+     "bool(c.left_wall), bool(c.right_wall), E, -1.0 if eps is None else float(eps),"):
+        "without Moreau's ε the chain kernel never reads ε (energy balance and duality gap "
+        "are NaN then)",
+    ("impactqp/model/residuals.py", "core/NumberReplacer",
+     "bool(c.left_wall), bool(c.right_wall), E, 0.0 if eps is None else float(eps),",
+     "bool(c.left_wall), bool(c.right_wall), E, 1.0 if eps is None else float(eps),"):
+        "without Moreau's ε the chain kernel never reads ε (energy balance and duality gap "
+        "are NaN then)",
     ("impactqp/kernels/residuals.py", "core/NumberReplacer",
      "if 0 <= k + 1 < lam.size:", "if -1 <= k + 1 < lam.size:"):
         "k = j − lo ≥ −1, so k + 1 ≥ 0 and the lower bound never decides",
