@@ -1,0 +1,75 @@
+"""The shared verdict (impactqp/base/checks.py) judged at its edge, written to kill the
+mutants benchmarks/mutation.py makes of it: a residual exactly at the tolerance passes, one
+just above fails, a non-finite one fails, and the worst residual is the largest."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import impactqp as iq
+from impactqp.base.checks import DEFAULT_TOL, UNIT_RANGE, NamedChecks
+
+TOL = 1e-9
+
+
+@pytest.mark.parametrize("factor, ok", [(0.0, True), (0.5, True), (1.0, True),
+                                        (1.0 + 1e-12, False), (2.0, False)])
+def test_verdict_at_its_edge(factor: float, ok: bool) -> None:
+    # ≤ tol passes, including equality; anything above fails, however close
+    checks = NamedChecks({"a": 0.1 * TOL, "b": factor * TOL}, TOL)
+    assert checks.ok is ok
+    assert bool(checks) is ok
+    assert checks.summary().startswith("ok" if ok else "FAILED")
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_a_residual_that_cannot_be_evaluated_fails(bad: float) -> None:
+    checks = NamedChecks({"a": 0.0, "b": bad}, TOL)
+    assert not checks.ok
+    assert checks.worst[0] == "b"
+
+
+def test_a_negative_residual_is_within_tolerance() -> None:
+    # residuals are magnitudes; a finite value below tol passes whatever its sign
+    assert NamedChecks({"a": -1.0}, TOL).ok
+
+
+def test_every_residual_counts() -> None:
+    for k in range(3):
+        values = dict.fromkeys("xyz", 0.0)
+        values["xyz"[k]] = 3 * TOL
+        assert not NamedChecks(values, TOL).ok
+
+
+def test_worst_is_the_largest_and_none_when_empty() -> None:
+    values = {"a": 3e-12, "b": 7e-10, "c": 1e-11}
+    assert NamedChecks(values, TOL).worst == ("b", 7e-10)
+    assert NamedChecks({"a": 2.0, "b": math.nan, "c": 5.0}, TOL).worst[0] == "b"
+    empty = NamedChecks({}, TOL)
+    assert empty.worst == ("none", 0.0)
+    assert empty.ok
+
+
+def test_summary_names_every_residual_and_the_tolerance() -> None:
+    checks = NamedChecks({"gap": 2.5e-3, "energy": 1.25e-12}, 1e-6)
+    assert checks.summary() == "FAILED (tol 1e-06): gap=2.5e-03, energy=1.2e-12"
+
+
+def test_default_tolerance_rejects_a_visible_error_and_accepts_rounding() -> None:
+    # the certificates' default is a dimensionless tolerance near 1e-9: rounding of a few ulps
+    # of order-one numbers passes, an error of a millionth does not
+    assert NamedChecks({"r": 1e-6}, DEFAULT_TOL).ok is False
+    assert NamedChecks({"r": 50 * np.finfo(float).eps}, DEFAULT_TOL).ok is True
+    assert iq.moreau(iq.newtons_cradle(3), 1.0).certificate.tol == DEFAULT_TOL
+
+
+@pytest.mark.parametrize("scale", [1e-90, 1.0, 1e90])
+def test_unit_range_holds_the_velocities_worked_with_as_given(scale: float) -> None:
+    # the range spans order one and every scale whose squares stay far inside the float range
+    low, high = UNIT_RANGE
+    assert low <= scale <= high
+    assert 0.0 < low < 1.0 < high
+    assert high ** 2 < np.finfo(float).max and low ** 2 > np.finfo(float).tiny
