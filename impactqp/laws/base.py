@@ -113,11 +113,12 @@ class ImpactLaw(ABC):
         The compiled family of complementarity laws the law belongs to, whose fast paths
         take it (docs/theory.md §9): the compiled single impact, its rows in batches, the
         compiled Moreau–Jean loop and the collapse of parallel contacts.
-        ``"complementarity"`` (:data:`COMPLEMENTARITY_FAMILY`): the law is
+        ``"complementarity"`` (:data:`~impactqp.laws.base.COMPLEMENTARITY_FAMILY`): the law is
         ``0 ≤ Λ ⟂ GΛ + (I + E)γ⁻ ≥ 0`` with E = ``restitution(m)`` (an (m,) diagonal or an
         (m, m) matrix), has the step form E = :meth:`step_restitution` and, with
-        per-contact coefficients, :meth:`restrict`. ``"moreau"`` (:data:`MOREAU_FAMILY`):
-        the same with E = εI from the law's ``eps``, and the projection
+        per-contact coefficients, :meth:`restrict`. ``"moreau"``
+        (:data:`~impactqp.laws.base.MOREAU_FAMILY`): the same with E = εI from the law's
+        ``eps``, and the projection
         z = ``projection(problem, u⁺)``; short chains also take the column-wise isotonic
         path. The fast paths compute and certify the family's answer with the family's
         residuals (docs/theory.md §8), not the law's :meth:`program` and :meth:`residuals`:
@@ -125,12 +126,13 @@ class ImpactLaw(ABC):
         the impacts the fast paths decline. None (the default): the law's own programs or
         closed form answer. Declared per class: a subclass of a built-in law that does not
         declare it takes the general path; a class that declares a family without its
-        methods (:data:`FAMILY_METHODS`) is refused when it is defined.
+        methods (:data:`~impactqp.laws.base.FAMILY_METHODS`) is refused when it is defined.
     restitution_per_contact : bool
         E is diagonal (one coefficient per contact, or one ε for all): contacts whose columns
         of W are parallel, with equal coefficients, act as one and an impact with more
         contacts than degrees of freedom is solved collapsed (docs/theory.md §1). Read with
-        :attr:`family`, whose ``restitution(m)`` gives the coefficients. Declared per class.
+        :attr:`~impactqp.laws.base.ImpactLaw.family`, whose ``restitution(m)`` gives the
+        coefficients. Declared per class.
     compliant : bool
         The outcome depends on the contacts' compliance (stiffnesses, exponents), as for the
         LZB model (docs/theory.md §13), and not on the rigid geometry alone:

@@ -123,7 +123,8 @@ class FrictionContactProblem:
         """The problem posed in its contacts' units (docs/theory.md §15): W̃ = DWD,
         q̂ = 2⁻ᵏDq, D = diag(1/s), s = √W_nn of each contact
         (:func:`impactqp.kernels.units.contact_units`) and 2ᵏ = 1 unless max|Dq| lies
-        outside :data:`QUANTITY_RANGE`, where it is the power of two nearest it. Its
+        outside :data:`~impactqp.model.friction.QUANTITY_RANGE`, where it is the power of two
+        nearest it. Its
         reaction r̂ = 2⁻ᵏ s∘r and velocity û = 2⁻ᵏ u/s; the cones do not change (a positive
         factor per contact), so r solves this problem exactly when r̂ solves that one. The
         same object every time (it is computed once); a problem already in its units is
@@ -132,7 +133,7 @@ class FrictionContactProblem:
         Raises
         ------
         OutOfRangeError
-            W̃ is not finite (|W_ij| far beyond √(W_ii W_jj)): floats cannot pose it.
+            W̃ is not finite (``|W_ij|`` far beyond √(W_ii W_jj)): floats cannot pose it.
         """
         if self._units is None:
             s = contact_units(np.ascontiguousarray(_diagonal(self.W)), self.contact_dim)
@@ -163,7 +164,8 @@ class ContactUnits(NamedTuple):
     s : (d·m,) ndarray
         The unit s_c of the contact of each entry.
     k : int
-        The scale-first exponent (0 unless max|Dq| lies outside :data:`QUANTITY_RANGE`).
+        The scale-first exponent (0 unless max|Dq| lies outside
+        :data:`~impactqp.model.friction.QUANTITY_RANGE`).
     """
 
     problem: FrictionContactProblem
@@ -247,7 +249,7 @@ class FrictionCertificate(NamedChecks):
 
     - cone: r̂_c ∈ K_μc (‖r_T‖ ≤ μ r_n), over max(‖q̂‖, ‖r̂‖);
     - dual_cone: ũ_c = û_c + μ_c‖û_T,c‖e_n ∈ K_{1/μc} (μ‖ũ_T‖ ≤ ũ_n), over ‖q̂‖;
-    - complementarity: |r̂_c·ũ_c| / (‖r̂_c‖ + ‖ũ_c‖) contact by contact, over ‖q̂‖.
+    - complementarity: ``|r̂_c·ũ_c|`` / (‖r̂_c‖ + ‖ũ_c‖) contact by contact, over ‖q̂‖.
 
     Reported beside them (``reported``), not part of the verdict: ``siconos_error``
     ‖F‖/max(‖q̂‖, ‖r̂‖, ‖û‖) and ``penetration`` ‖(−û_n)₊‖/‖q̂‖.
