@@ -76,3 +76,14 @@ def test_an_unknown_name_is_an_attribute_error() -> None:
     with pytest.raises(AttributeError, match="no_such_name"):
         iq.no_such_name  # noqa: B018
     assert not hasattr(iq, "SectorTables")
+
+
+def test_a_name_off_the_top_level_has_one_home() -> None:
+    homes: dict[str, list[str]] = {}
+    for sub in iq.SUBMODULES:
+        for name in importlib.import_module(f"impactqp.{sub}").__all__:
+            if name not in iq.__all__:
+                homes.setdefault(name, []).append(sub)
+    assert {n: subs for n, subs in homes.items() if len(subs) > 1} == {}
+    # every name of the former top level has a place: the top level or its one submodule
+    assert {n for n in FORMER_TOP_LEVEL if n not in iq.__all__} <= set(homes)
