@@ -95,7 +95,7 @@ def _local(k, vf, gk, closed, contacts, friction, tol, events, vn, lam):
     """Step 3 on the closed contacts: the local problem solved and certified, v_{k+1} and
     the impulses written into ``vn`` and ``lam``, the step recorded; False hands the step
     back."""
-    d, units = contacts.d, contacts.units
+    ptr, idx, val, _, d, _, _, _, MinvH, G, units = contacts
     cons = np.flatnonzero(closed)
     closed_count = cons.size
     na = closed_count * d
@@ -104,10 +104,10 @@ def _local(k, vf, gk, closed, contacts, friction, tol, events, vn, lam):
         for i in range(d):
             cols[t * d + i] = cons[t] * d + i
     qa = np.empty(na)
-    if not step_q(rows_times(contacts, cons, vf, np.empty(na)), gk, friction.e,
+    if not step_q(rows_times(ptr, idx, val, d, cons, vf, np.empty(na)), gk, friction.e,
                   np.zeros((0, 0)), cons, d, qa):
         return True  # r = 0 solves the step exactly
-    W, qt = gather_local(contacts.G, units, cols, qa, np.empty((na, na)), np.empty(na))
+    W, qt = gather_local(G, units, cols, qa, np.empty((na, na)), np.empty(na))
     mu = friction.mu[cons]
     r = np.zeros(na)
     done, _ = nsgs(W, qt, mu, d, r, friction.target, friction.sweeps, LOCAL_ITERATIONS)
@@ -117,7 +117,7 @@ def _local(k, vf, gk, closed, contacts, friction, tol, events, vn, lam):
     for j in range(vf.size):
         w = vf[j]
         for t in range(na):
-            w += contacts.MinvH[j, cols[t]] * r[t] / units[cols[t]]
+            w += MinvH[j, cols[t]] * r[t] / units[cols[t]]
         vn[j] = w
     for t in range(na):
         lam[cols[t]] = r[t] / units[cols[t]]
@@ -157,21 +157,27 @@ def run(q, v, k_first, k_stop, row, contacts, force, scheme, friction, record, e
         Status (:data:`DONE`, :data:`FAILED`, :data:`FULL`), the first step not done, the
         next record row.
     """
-    n, m = v.size, contacts.b.size
+    ptr, idx, val, b, d = contacts.ptr, contacts.idx, contacts.val, contacts.b, contacts.d
+    chol, K, c, shift, linear = force
+    h, theta, tol = scheme
+    kept, Q, V, L = record
+    n, m = v.size, b.size
     vf, vn, y = np.empty(n), np.empty(n), np.empty(n)
     g, gk = np.empty(m), np.empty(m)
     closed = np.zeros(m, dtype=np.bool_)
-    lam = np.zeros(m * contacts.d)
+    lam = np.zeros(m * d)
     for k in range(k_first, k_stop):
         if full(events):
             return FULL, k, row
-        linear_gaps(contacts, q, v, g, gk)  # 1.
-        count = activation(g, gk, scheme.h, closed)
-        free_velocity(force, scheme, q, v, vf, y)  # 2.
-        vn[:] = vf
-        lam[:] = 0.0
-        if count > 0 and not _local(k, vf, gk, closed, contacts, friction, scheme.tol, events,
-                                    vn, lam):  # 3.
+        linear_gaps(ptr, idx, val, b, d, q, v, g, gk)  # 1.
+        count = activation(g, gk, h, closed)
+        free_velocity(chol, K, c, shift, linear, h, theta, q, v, vf, y)  # 2.
+        for j in range(n):
+            vn[j] = vf[j]
+        for j in range(m * d):
+            lam[j] = 0.0
+        if count > 0 and not _local(k, vf, gk, closed, contacts, friction, tol, events, vn,
+                                    lam):  # 3.
             return FAILED, k, row
-        row = end_step(q, v, vn, lam, scheme, k, row, record)  # 4.
+        row = end_step(q, v, vn, lam, h, theta, k, row, kept, Q, V, L)  # 4.
     return DONE, k_stop, row

@@ -123,6 +123,9 @@ def _solve_dense(cl, contacts, law, tol, dense_work, res, work):
     D, C, um, vp, up, lam, qc = cl
     nc, mc = D.size, C.size
     Mc, Wt, MW, Gc, Ec, sc, w, pas, Lf, idx, sv, blocked = dense_work
+    metric, MinvH, G, units = contacts.metric, contacts.MinvH, contacts.G, contacts.units
+    ptr, cidx, val = contacts.ptr, contacts.idx, contacts.val
+    e, E, passive = law
     Mv = Mc[:nc * nc].reshape((nc, nc))
     Wv = Wt[:mc * nc].reshape((mc, nc))
     Xv = MW[:nc * mc].reshape((nc, mc))
@@ -130,26 +133,26 @@ def _solve_dense(cl, contacts, law, tol, dense_work, res, work):
     Ev = Ec[:mc * mc].reshape((mc, mc))
     for x in range(nc):
         for y in range(nc):
-            Mv[x, y] = contacts.metric[D[x], D[y]]
+            Mv[x, y] = metric[D[x], D[y]]
         for y in range(mc):
-            Xv[x, y] = contacts.MinvH[D[x], C[y]]
+            Xv[x, y] = MinvH[D[x], C[y]]
     for x in range(mc):
         for y in range(nc):
             Wv[x, y] = 0.0
-        sc[x] = contacts.units[C[x]]
-        pas[x] = law.passive[C[x]]
+        sc[x] = units[C[x]]
+        pas[x] = passive[C[x]]
         for y in range(mc):
-            Gv[x, y] = contacts.G[C[x], C[y]]
-            if law.E.shape[0] > 0:
-                Ev[x, y] = law.E[C[x], C[y]]
+            Gv[x, y] = G[C[x], C[y]]
+            if E.shape[0] > 0:
+                Ev[x, y] = E[C[x], C[y]]
             else:
-                Ev[x, y] = law.e[C[x]] if x == y else 0.0
+                Ev[x, y] = e[C[x]] if x == y else 0.0
     for x in range(mc):
         i = C[x]
-        for p in range(contacts.ptr[i], contacts.ptr[i + 1]):
+        for p in range(ptr[i], ptr[i + 1]):
             for y in range(nc):
-                if D[y] == contacts.idx[p]:
-                    Wv[x, y] = contacts.val[p]
+                if D[y] == cidx[p]:
+                    Wv[x, y] = val[p]
     if lcp_psd_work(Gv, qc[:mc], pas[:mc], lam[:mc], w[:mc], 20 * mc + 50, Lf, idx, sv,
                     blocked) != SOLVED:
         return False
@@ -164,7 +167,7 @@ def _solve_dense(cl, contacts, law, tol, dense_work, res, work):
         if not res[x] <= tol:  # NaN fails
             return False
     for x in range(mc):
-        law.passive[C[x]] = pas[x]
+        passive[C[x]] = pas[x]
     return True
 
 
@@ -176,13 +179,13 @@ def _solve_chain(cl, units, chain, left, right, tol, chain_work, res):
     True when certified. ``left``/``right``: the run ends at the chain's wall."""
     D, C, um, vp, up, lam, _ = cl
     nc, mc = D.size, C.size
-    e = chain.e
+    _, masses, inverse, _, _, e = chain
     shifted, z, L, starts = chain_work
     first = D[0]
     for x in range(nc):
         shifted[x] = um[x] + e * vp[x]
     weight = up  # scratch until u⁺ is formed
-    project(chain.masses[first:first + nc], shifted[:nc], left, right, z[:nc], L[:nc + 1],
+    project(masses[first:first + nc], shifted[:nc], left, right, z[:nc], L[:nc + 1],
             starts[:nc + 1], weight[:nc])
     lo = 0 if left else 1
     for x in range(mc):
@@ -192,9 +195,8 @@ def _solve_chain(cl, units, chain, left, right, tol, chain_work, res):
     sc = shifted  # scratch again: the contact scales of the run
     for x in range(mc):
         sc[x] = units[C[x]]
-    chain_step_residuals(um[:nc], up[:nc], lam[:mc], vp[:nc], chain.masses[first:first + nc],
-                         chain.inverse[first:first + nc], sc[:mc], left, right, e, 0.0, False,
-                         res)
+    chain_step_residuals(um[:nc], up[:nc], lam[:mc], vp[:nc], masses[first:first + nc],
+                         inverse[first:first + nc], sc[:mc], left, right, e, 0.0, False, res)
     for x in range(CHECKED):
         if not res[x] <= tol:  # NaN fails
             return False
@@ -202,92 +204,76 @@ def _solve_chain(cl, units, chain, left, right, tol, chain_work, res):
 
 
 @kernel
-def _clusters(k, v, vf, gk, closed, contacts, law, chain, tol, events, work, vn, lam_all):
-    """Step 3 on the closed contacts: each cluster with an approaching contact solved,
-    v_{k+1} and Λ written into ``vn`` and ``lam_all``, each solved cluster recorded; False
-    (at the first cluster not certified) hands the step back."""
-    cluster_work, n_of, m_of, dofs, cons, um, up, vp, gf, qc, lam, dense_work, chain_work, \
-        res, rwork = work
-    m = gk.size
-    n_cl = group(closed, contacts.ptr, contacts.idx, contacts.couple_a, contacts.couple_b,
-                 cluster_work, dofs, cons, n_of, m_of)
-    for a in range(n_cl):
-        D = dofs[n_of[a]:n_of[a + 1]]
-        C = cons[m_of[a]:m_of[a + 1]]
-        nc, mc = D.size, C.size
-        for x in range(nc):
-            um[x] = vf[D[x]]
-            vp[x] = v[D[x]]
-        rows_times(contacts, C, vf, gf)
-        if not step_q(gf, gk, law.e, law.E, C, 1, qc):
-            continue
-        cl = (D, C, um, vp, up, lam, qc)
-        if chain.on:
-            ok = _solve_chain(cl, contacts.units, chain, chain.left_wall and C[0] == 0,
-                              chain.right_wall and C[mc - 1] == m - 1, tol, chain_work, res)
-        else:
-            ok = _solve_dense(cl, contacts, law, tol, dense_work, res, rwork)
-        if not ok:
-            return False
-        for x in range(mc):
-            lam_all[C[x]] = lam[x]
-        for x in range(nc):
-            vn[D[x]] = up[x]
-        if events.keep:
-            open_record(events, k + 1, mc, nc)
-            put_ints(events, D)
-            put_ints(events, C)
-            put_floats(events, res[:CHECKED])
-            put_floats(events, um[:nc])
-            put_floats(events, up[:nc])
-            put_floats(events, vp[:nc])
-            put_floats(events, lam[:mc])
-    return True
+def _record(events, k, D, C, res, um, up, vp, lam):
+    """Record a solved cluster (dofs D, contacts C) of step k."""
+    nc, mc = D.size, C.size
+    open_record(events, k + 1, mc, nc)
+    put_ints(events, D)
+    put_ints(events, C)
+    put_floats(events, res[:CHECKED])
+    put_floats(events, um[:nc])
+    put_floats(events, up[:nc])
+    put_floats(events, vp[:nc])
+    put_floats(events, lam[:mc])
 
 
 @kernel
 def run(q, v, k_first, k_stop, row, contacts, force, scheme, law, chain, record, events):
-    """Steps k_first … k_stop − 1 of a Moreau–Jean run (module docstring), in place.
-
-    Parameters
-    ----------
-    q, v : (n,) float arrays
-        The state at step k_first; on return, the state after the last completed step.
-    k_first, k_stop, row : int
-        First step, step to stop before, next record row.
-    contacts : impactqp.kernels.step.Contacts
-        H (d = 1), b, Ŵ, its couplings, Ŵ⁻¹H, HᵀŴ⁻¹H and the contact units.
-    force : impactqp.kernels.step.Force
-    scheme : impactqp.kernels.step.Scheme
-    law : Impacts
-    chain : Chain
-    record : impactqp.kernels.step.Record
-    events : impactqp.kernels.events.Events
-        With :func:`worst_step`.
-
-    Returns
-    -------
-    (int, int, int)
-        Status (:data:`DONE`, :data:`FAILED`, :data:`FULL`), the first step not done, the
-        next record row.
-    """
-    n, m = v.size, contacts.b.size
+    """Steps k_first … k_stop − 1 of a Moreau–Jean run (module docstring), in place: (q, v)
+    the state at step k_first, on return the state after the last completed step; ``row``
+    the next record row; ``contacts`` (d = 1), ``force``, ``scheme``, ``record``
+    (:mod:`impactqp.kernels.step`), ``law`` (:class:`Impacts`), ``chain`` (:class:`Chain`)
+    and ``events`` (:mod:`impactqp.kernels.events`, with :func:`worst_step`). Returns
+    (status :data:`DONE`, :data:`FAILED` or :data:`FULL`, the first step not done, the next
+    record row)."""
+    ptr, idx, val, b, _, _, couple_a, couple_b, _, _, units = contacts
+    chol, K, c, shift, linear = force
+    h, theta, tol = scheme
+    kept, Q, V, L = record
+    e, E, _ = law
+    n, m = v.size, b.size
     vf, vn, y = np.empty(n), np.empty(n), np.empty(n)
-    g, gk, lam = np.empty(m), np.empty(m), np.zeros(m)
+    g, gk, lam_all = np.empty(m), np.empty(m), np.zeros(m)
     closed = np.zeros(m, dtype=np.bool_)
-    work = _work(n, m, chain.on)
+    cluster_work, n_of, m_of, dofs, cons, um, up, vp, gf, qc, lam, dense_work, chain_work, \
+        res, rwork = _work(n, m, chain.on)
     for k in range(k_first, k_stop):
         if full(events):
             return FULL, k, row
         at = mark(events)
-        linear_gaps(contacts, q, v, g, gk)  # 1.
-        count = activation(g, gk, scheme.h, closed)
-        free_velocity(force, scheme, q, v, vf, y)  # 2.
-        vn[:] = vf
-        lam[:] = 0.0
-        if count > 0 and not _clusters(k, v, vf, gk, closed, contacts, law, chain, scheme.tol,
-                                       events, work, vn, lam):  # 3.
-            rollback(events, at)
-            return FAILED, k, row
-        row = end_step(q, v, vn, lam, scheme, k, row, record)  # 4.
+        linear_gaps(ptr, idx, val, b, 1, q, v, g, gk)  # 1.
+        count = activation(g, gk, h, closed)
+        free_velocity(chol, K, c, shift, linear, h, theta, q, v, vf, y)  # 2.
+        for i in range(n):
+            vn[i] = vf[i]
+        for i in range(m):
+            lam_all[i] = 0.0
+        n_cl = group(closed, ptr, idx, couple_a, couple_b, cluster_work, dofs, cons, n_of,
+                     m_of) if count > 0 else 0
+        for a in range(n_cl):  # 3. each cluster with an approaching contact
+            D = dofs[n_of[a]:n_of[a + 1]]
+            C = cons[m_of[a]:m_of[a + 1]]
+            nc, mc = D.size, C.size
+            for x in range(nc):
+                um[x] = vf[D[x]]
+                vp[x] = v[D[x]]
+            rows_times(ptr, idx, val, 1, C, vf, gf)
+            if not step_q(gf, gk, e, E, C, 1, qc):
+                continue
+            cl = (D, C, um, vp, up, lam, qc)
+            if chain.on:
+                ok = _solve_chain(cl, units, chain, chain.left_wall and C[0] == 0,
+                                  chain.right_wall and C[mc - 1] == m - 1, tol, chain_work, res)
+            else:
+                ok = _solve_dense(cl, contacts, law, tol, dense_work, res, rwork)
+            if not ok:
+                rollback(events, at)
+                return FAILED, k, row
+            for x in range(mc):
+                lam_all[C[x]] = lam[x]
+            for x in range(nc):
+                vn[D[x]] = up[x]
+            if events.keep:
+                _record(events, k, D, C, res, um, up, vp, lam)
+        row = end_step(q, v, vn, lam_all, h, theta, k, row, kept, Q, V, L)  # 4.
     return DONE, k_stop, row

@@ -12,6 +12,10 @@ the Python loop of :mod:`impactqp.simulation.time_stepping`):
    :func:`impactqp.kernels.units.contact_units`); the law's solve then gives v_{k+1};
 4. :func:`end_step`: q_{k+1} = q_k + h((1 − θ)v_k + θv_{k+1}) and the recorded row.
 
+The compiled loops take their arguments grouped (:class:`Contacts`, :class:`Force`,
+:class:`Scheme`, :class:`Record`, the event buffers) and unpack them once per call; the
+rules above take plain arrays, so a step touches no tuple.
+
 What the step needs from the system is handed to it, not built into it: the gaps g(q_k),
 the normal velocities γ_k = H_nᵀv_k, v_free and a :class:`Contacts` (H, Ŵ and the products
 Ŵ⁻¹H, HᵀŴ⁻¹H, the contact units). A linear system (constant M and H) forms its
@@ -109,10 +113,10 @@ class Record(NamedTuple):
 
 
 @inline_kernel
-def linear_gaps(contacts, q, v, g, gamma):
+def linear_gaps(ptr, idx, val, b, d, q, v, g, gamma):
     """The gaps g = H_nᵀq + b and normal velocities γ = H_nᵀv of a linear system (H_n: row
-    c·d of each contact c), into ``g`` and ``gamma``."""
-    d, ptr, idx, val = contacts.d, contacts.ptr, contacts.idx, contacts.val
+    c·d of each contact c of Hᵀ in compressed rows ``ptr``, ``idx``, ``val``; see
+    :class:`Contacts`), into ``g`` and ``gamma``."""
     for i in range(g.size):
         r = i * d
         gap = 0.0
@@ -120,7 +124,7 @@ def linear_gaps(contacts, q, v, g, gamma):
         for p in range(ptr[r], ptr[r + 1]):
             gap += val[p] * q[idx[p]]
             vel += val[p] * v[idx[p]]
-        g[i] = gap + contacts.b[i]
+        g[i] = gap + b[i]
         gamma[i] = vel
     return g, gamma
 
@@ -137,33 +141,33 @@ def activation(g, gamma, h, closed):
 
 
 @inline_kernel
-def free_velocity(force, scheme, q, v, out, y):
-    """v_free into ``out``: v − shift (a constant force: shift = Ŵ⁻¹r formed once) or, for
-    the force c − Kq, v − Ŵ⁻¹(hKq + h²θKv − hc), solved as LAPACK's potrs does (forward,
-    then backward substitution; ``y`` is scratch of n floats)."""
+def free_velocity(chol, K, c, shift, linear, h, theta, q, v, out, y):
+    """v_free into ``out`` for the force of :class:`Force` (its fields first): v − shift (a
+    constant force: shift = Ŵ⁻¹r formed once) or, for the force c − Kq,
+    v − Ŵ⁻¹(hKq + h²θKv − hc), solved as LAPACK's potrs does (forward, then backward
+    substitution; ``y`` is scratch of n floats)."""
     n = v.size
-    if not force.linear:
+    if not linear:
         for i in range(n):
-            out[i] = v[i] - force.shift[i]
+            out[i] = v[i] - shift[i]
         return out
-    h, theta, K = scheme.h, scheme.theta, force.K
     for i in range(n):
         kq = 0.0
         kv = 0.0
         for j in range(n):
             kq += K[i, j] * q[j]
             kv += K[i, j] * v[j]
-        y[i] = h * kq + (h * h * theta) * kv - h * force.c[i]
-    cholesky_solve(force.chol, n, y)
+        y[i] = h * kq + (h * h * theta) * kv - h * c[i]
+    cholesky_solve(chol, n, y)
     for i in range(n):
         out[i] = v[i] - y[i]
     return out
 
 
 @inline_kernel
-def rows_times(contacts, C, x, out):
-    """H_Cᵀx on the d rows of each contact in C (in order) into ``out``."""
-    d, ptr, idx, val = contacts.d, contacts.ptr, contacts.idx, contacts.val
+def rows_times(ptr, idx, val, d, C, x, out):
+    """H_Cᵀx on the d rows of each contact in C (in order) into ``out`` (Hᵀ in compressed
+    rows, as :class:`Contacts` holds it)."""
     for a in range(C.size):
         for j in range(d):
             r = C[a] * d + j
@@ -230,17 +234,18 @@ def gather_local(G, units, cols, q, W_out, q_out):
 
 
 @inline_kernel
-def end_step(q, v, vn, lam, scheme, k, row, record):
+def end_step(q, v, vn, lam, h, theta, k, row, kept, Q, V, L):
     """The end of step k: q_{k+1} = q_k + h((1 − θ)v_k + θv_{k+1}), v ← v_{k+1} (in place),
-    and the record row of step k + 1 (q, v and the impulses ``lam``) when it is kept;
-    returns the next record row."""
-    h, theta = scheme.h, scheme.theta
+    and the record row of step k + 1 (q, v and the impulses ``lam``) when it is kept (the
+    fields of :class:`Record` last); returns the next record row."""
     for i in range(q.size):
         q[i] = q[i] + h * ((1.0 - theta) * v[i] + theta * vn[i])
         v[i] = vn[i]
-    if row < record.kept.size and record.kept[row] == k + 1:
-        record.Q[row, :] = q
-        record.V[row, :] = v
-        record.L[row, :] = lam
+    if row < kept.size and kept[row] == k + 1:
+        for i in range(q.size):
+            Q[row, i] = q[i]
+            V[row, i] = v[i]
+        for i in range(lam.size):
+            L[row, i] = lam[i]
         row += 1
     return row

@@ -119,7 +119,7 @@ class CompiledDriver(ABC):
             if status == FAILED:  # the Python loop's step, whose solve raises what it raises
                 self._close(first)
                 v_next, lam, new = step(k, q, v)
-                row = end_step(q, v, v_next, lam, step.scheme, k, row, record)
+                row = end_step(q, v, v_next, lam, h, step.theta, k, row, *record)
                 if self.keep:
                     self.pieces.append(new)
                 first = int(self.events.counts[0])

@@ -208,7 +208,7 @@ def _python_loop(step: Step, steps: int, record: Record, keep: bool, report: int
     row = 1
     for k in range(steps):
         v_next, lam, new = step(k, q, v)
-        row = end_step(q, v, v_next, lam, step.scheme, k, row, record)
+        row = end_step(q, v, v_next, lam, step.h, step.theta, k, row, *record)
         if keep:
             events.extend(new)
         if progress is not None and (k + 1) % report == 0:
