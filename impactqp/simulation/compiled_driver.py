@@ -4,7 +4,8 @@ certificate failed) or after the event buffers were enlarged, the rows kept for 
 trajectory, and the pieces of the event list (kernel records or the Python step's events).
 
 The buffers have the one layout of :mod:`impactqp.kernels.events`: a loop says only how
-many entries one step may add (``worst``) and how one record reads back (:meth:`_event`).
+many entries one step may add (``worst``) and how one record reads back
+(:meth:`CompiledDriver._event`).
 """
 
 from __future__ import annotations
