@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..kernels.friction_loop import Friction, run, worst_step
-from ..kernels.step import Contacts
+from ..kernels.step import Contacts, gather_local
 from ..laws.friction import FrictionResult
 from ..model.friction import FrictionContactProblem, certify_friction
 from .compiled_driver import CompiledDriver, compressed_rows
@@ -67,7 +67,8 @@ class CompiledFriction(CompiledDriver):
         na = a * d
         cols = (closed[:, None] * d + np.arange(d)).ravel()
         s = self.contacts.units[cols]  # the kernel's problem, in contact units
-        W = self.contacts.G[np.ix_(cols, cols)] / np.outer(s, s)
+        W, _ = gather_local(self.contacts.G, self.contacts.units, cols, np.zeros(na),
+                            np.empty((na, na)), np.empty(na))
         problem = FrictionContactProblem(W, floats[:na].copy(), solver.mu[closed],
                                          contact_dim=d)
         r = floats[na:2 * na].copy()
