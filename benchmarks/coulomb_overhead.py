@@ -7,8 +7,9 @@ spheres in a row on a plane (five contacts,
 :func:`benchmarks.friction_impacts.spheres_in_a_row`). For each, the medians over repeated
 calls of ``iq.solve(problem, iq.Coulomb(μ))`` and of
 ``iq.solve_friction(local)`` on the law's own local problem in contact units
-(``law.local_problem(problem)[0]``, posed untimed), and of the law's certificate alone. The
-calls alternate, so that a machine shared with other work slows them alike. Run:
+(``law.local_problem(problem)[0]``, posed untimed), of the law's certificate alone (one
+compiled pass) and of its numpy reference (``law.reference_residuals``, the same residuals).
+The calls alternate, so that a machine shared with other work slows them alike. Run:
 ``python -m benchmarks.coulomb_overhead``.
 """
 
@@ -53,14 +54,17 @@ def main() -> None:
         local = law.local_problem(problem)[0]
         result = iq.solve(problem, law)
         answer = Answer(result.u_plus, result.impulses, None)
-        law_solve, friction, certificate = alternating_medians([
+        law_solve, friction, certificate, reference = alternating_medians([
             lambda p=problem, law=law: iq.solve(p, law),
             lambda local=local: iq.solve_friction(local),
             lambda p=problem, law=law, a=answer, tol=result.certificate.tol:
-                law.certificate(p, a, tol)])
+                law.certificate(p, a, tol),
+            lambda p=problem, law=law, a=answer:
+                law.reference_residuals(p.structure, p.u_minus, a.u_plus, a.impulses)])
         print(f"{label}: iq.solve(Coulomb) {law_solve:.1f} µs, solve_friction {friction:.1f} µs, "
               f"ratio {law_solve / friction:.2f}; the law's certificate alone "
-              f"{certificate:.1f} µs (backend {result.backend!r})")
+              f"{certificate:.1f} µs, its numpy reference {reference:.1f} µs "
+              f"(backend {result.backend!r})")
 
 
 if __name__ == "__main__":

@@ -136,6 +136,42 @@ def test_modules_stay_small() -> None:
     assert {m: n for m, n in sizes.items() if n > 360} == {}
 
 
+MAX_PARAMETERS = 15
+"""Most parameters of a function in impactqp/kernels: more travel grouped in named tuples
+(the system's contacts, the force, the scheme, the event buffers), not one by one."""
+
+MAX_LINES = 100
+"""Most lines of a kernel function."""
+
+LZB_UNGROUPED = {"lzb._root": 18, "lzb._rk_step": 18, "lzb._step_to_kink": 23,
+                 "lzb._piece": 24, "lzb.integrate_impact": 20}
+"""The LZB stepper's kernels, not yet grouped (integrate_impact's caller is
+laws/lzb/integration.py): the only ones over :data:`MAX_PARAMETERS`; the test fails when one
+of them changes, so that this list only shrinks."""
+
+
+def kernel_functions() -> dict[str, tuple[int, int]]:
+    """(parameters, lines) of every function in impactqp/kernels, by ``module.name``."""
+    out = {}
+    for path in sorted((PACKAGE / "kernels").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.FunctionDef):
+                a = node.args
+                count = len(a.posonlyargs) + len(a.args) + len(a.kwonlyargs) + \
+                    (a.vararg is not None) + (a.kwarg is not None)
+                out[f"{path.stem}.{node.name}"] = (count, node.end_lineno - node.lineno + 1)
+    return out
+
+
+def test_kernels_take_grouped_arguments() -> None:
+    functions = kernel_functions()
+    assert functions["moreau_jean.run"][0] <= MAX_PARAMETERS  # the check sees the loops
+    wide = {name: n for name, (n, _) in functions.items() if n > MAX_PARAMETERS}
+    assert wide == LZB_UNGROUPED
+    long = {name: lines for name, (_, lines) in functions.items() if lines > MAX_LINES}
+    assert set(long) <= {"lzb._piece"}
+
+
 def test_import_with_required_dependencies_only() -> None:
     # optional extras (matplotlib, piqp, daqp, ...) must not be needed to import impactqp
     code = ("import sys\n"

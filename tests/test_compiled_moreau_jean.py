@@ -125,21 +125,19 @@ def test_events_are_kept_or_not_without_changing_the_run():
     assert kept.event_arrays()["event_certified"].all()
 
 
-def _corrupt(monkeypatch, which: int) -> None:
+def _corrupt(monkeypatch, which: str) -> None:
     """Scale one of the kernel's formed impact arrays (Ŵ⁻¹H or HᵀŴ⁻¹H) by 2 after they are
     built: every answer computed from it is wrong."""
     original = time_stepping._CompiledLoop.__init__
 
     def corrupted(self, *args, **kwargs):
         original(self, *args, **kwargs)
-        impacts = list(self.impacts)
-        impacts[which] = 2.0 * impacts[which]
-        self.impacts = tuple(impacts)
+        self.contacts = self.contacts._replace(**{which: 2.0 * getattr(self.contacts, which)})
 
     monkeypatch.setattr(time_stepping._CompiledLoop, "__init__", corrupted)
 
 
-@pytest.mark.parametrize("which", [0, 1], ids=["Minv_H", "delassus"])
+@pytest.mark.parametrize("which", ["MinvH", "G"])
 def test_a_corrupted_compiled_step_is_solved_again_by_the_python_loop(monkeypatch, which):
     # one coefficient per contact: the LCP search path (one coefficient on a chain takes
     # the isotonic projection, which reads neither array)
@@ -281,3 +279,49 @@ def test_chain_step_residuals_are_the_step_law_certificate(walls):
         for i, name in enumerate(RESIDUALS[:4]):
             assert out[i] == pytest.approx(float(theirs[name]), rel=1e-9, abs=1e-15)
         assert (max(out[:4]) <= 1e-9) == ok
+
+
+def test_the_step_rules_are_written_once():
+    """The activation rule g + h/2 γ ≤ 0 and the step's q = γ(v_free) + Eγ_k live in
+    impactqp/kernels/step.py only; every loop calls them (docs/theory.md §17)."""
+    import re
+    from pathlib import Path
+
+    package = Path(iq.__file__).parent
+    activation = re.compile(r"0\.5 \* h\)?\s*\*")
+    found = sorted(str(p.relative_to(package)) for p in package.rglob("*.py")
+                   if activation.search(p.read_text(encoding="utf-8")))
+    assert found == ["kernels/step.py"]
+
+
+@pytest.mark.parametrize("d", [1, 3])
+def test_step_q_and_the_local_gather_against_numpy(d):
+    from impactqp.kernels.step import activation, gather_local, step_q
+    from impactqp.kernels.units import contact_units
+
+    rng = np.random.default_rng(d)
+    m, C = 5, np.array([0, 2, 3])
+    gamma_free, gamma_k = rng.normal(size=C.size * d), rng.normal(size=m)
+    e, E = rng.uniform(0, 1, m), _fremond(m)
+    for args, restitution in (((e, np.zeros((0, 0))), e[C] * gamma_k[C]),
+                              ((np.zeros(0), E), E[np.ix_(C, C)] @ gamma_k[C])):
+        q = np.empty(C.size * d)
+        approaching = step_q(gamma_free, gamma_k, *args, C, d, q)
+        expected = gamma_free.copy()
+        expected[::d] += restitution
+        np.testing.assert_allclose(q, expected, rtol=1e-15, atol=1e-15)
+        assert approaching == bool(np.any(expected[::d] < 0))
+    A = rng.normal(size=(m * d, m * d))
+    G = A @ A.T
+    units = contact_units(np.diag(G).copy(), d)
+    cols = (C[:, None] * d + np.arange(d)).ravel()
+    W, qt = gather_local(G, units, cols, q, np.empty((cols.size, cols.size)),
+                         np.empty(cols.size))
+    s = units[cols]
+    np.testing.assert_array_equal(W, G[np.ix_(cols, cols)] / np.outer(s, s))
+    np.testing.assert_array_equal(qt, q / s)
+    assert np.allclose(np.diag(W)[::d], 1.0)  # each contact's normal in its own unit
+    g, gamma = np.array([1e-3, -1e-9, 0.0]), np.array([-1.0, 0.0, 1e-3])
+    closed = np.empty(3, dtype=bool)
+    assert activation(g, gamma, 0.01, closed) == 2
+    np.testing.assert_array_equal(closed, g + 0.005 * gamma <= 0)

@@ -100,15 +100,21 @@ def test_coulomb_agrees_with_solve_friction_on_its_local_problem() -> None:
 
 
 def test_coulomb_is_certified_once(monkeypatch) -> None:
-    """The local problem is certified once per solve (by the law's certificate), not by
+    """The local problem is certified once per solve (by the law's certificate: its compiled
+    pass, or the reference's certify_friction where that does not apply), not by
     solve_friction and then again."""
     from impactqp.laws import coulomb
     calls = []
-    real = coulomb.certify_friction
-    monkeypatch.setattr(coulomb, "certify_friction",
-                        lambda *a, **k: calls.append(1) or real(*a, **k))
+    for name in ("certify_friction", "coulomb_residuals"):
+        real = getattr(coulomb, name)
+        monkeypatch.setattr(coulomb, name, lambda *a, real=real, name=name, **k:
+                            calls.append(name) or real(*a, **k))
     iq.solve(sphere(), iq.Coulomb(0.3))
-    assert len(calls) == 1
+    assert calls == ["coulomb_residuals"]
+    calls.clear()
+    big = sphere()
+    iq.solve(big.with_u_minus(big.u_minus * 1e200), iq.Coulomb(0.3))  # rescaled first
+    assert calls == ["coulomb_residuals"]
 
 
 def test_friction_result_is_of_the_result_family() -> None:

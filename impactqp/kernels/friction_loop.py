@@ -1,47 +1,138 @@
 """A whole frictional Moreau–Jean run in compiled code (docs/theory.md §17, "The compiled
 loop").
 
-:func:`run` integrates a dense linear system with a constant or linear force and Coulomb
-friction, step after step, as the Python loop's frictional step does:
+:func:`run` integrates a system with a constant or linear force and Coulomb friction, step
+after step, by the one step of :mod:`impactqp.kernels.step` (as the Python loop does):
 
-1. closed contacts: gᵢ(q_k) + ½h γ_{n,i}(v_k) ≤ 0 (normal rows of H);
-2. free velocity v_free, by :func:`impactqp.kernels.moreau_jean._free_velocity`;
-3. on the closed set A with some negative q_n, the local problem u = W r + q with
-   W = H_AᵀŴ⁻¹H_A gathered from the products of all contacts formed once and
-   q = H_Aᵀv_free + eγ_{n,k} on the normal rows, solved by the projected Gauss–Seidel
-   :func:`impactqp.kernels.friction.nsgs` from r = 0, projected onto the cones
+1. the closed contacts (:func:`~impactqp.kernels.step.activation` on the normal rows);
+2. v_free (:func:`~impactqp.kernels.step.free_velocity`);
+3. on the closed set A with some negative normal q (:func:`~impactqp.kernels.step.step_q`:
+   q = H_Aᵀv_free + eγ_{n,k} on the normal rows), the local problem u = W̃r + q̃ gathered in
+   contact units (:func:`~impactqp.kernels.step.gather_local`), solved by the projected
+   Gauss–Seidel :func:`impactqp.kernels.friction.nsgs` from r = 0, projected onto the cones
    (:func:`impactqp.kernels.friction.project_cones`) and accepted only when the figures of
    :func:`impactqp.model.friction.certify_friction` (from
    :func:`impactqp.kernels.friction.certificate_sums`) are within ``tol``;
    v_{k+1} = v_free + Ŵ⁻¹H_A r;
-4. q_{k+1} = q_k + h((1 − θ)v_k + θv_{k+1}), and the kept rows are recorded.
+4. :func:`~impactqp.kernels.step.end_step`.
 
 It stops early, with the state of the last completed step, when a step is not certified
 (:data:`FAILED`: the caller solves that step with :func:`impactqp.solve_friction` and
-resumes) or when the event buffers are full (:data:`FULL`).
+resumes) or when the event buffers might not hold the next step (:data:`FULL`). Each solved
+step is recorded (:mod:`impactqp.kernels.events`) with head integers (closed contacts,
+sweeps), the closed contacts and the floats q̃, r̃ (contact units), v_free and v_{k+1}.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
+from .events import full, open_record, put_floats, put_ints
 from .friction import certificate_sums, nsgs, project_cones
 from .jit import kernel
-from .moreau_jean import DONE, FAILED, FULL, _free_velocity, end_step
+from .moreau_jean import DONE, FAILED, FULL
+from .step import (
+    activation,
+    end_step,
+    free_velocity,
+    gather_local,
+    linear_gaps,
+    rows_times,
+    step_q,
+)
 
 LOCAL_ITERATIONS = 5
 """Most projected fixed-point iterations on one contact per Gauss–Seidel sweep (5: a few
 more sweeps on one contact, several times fewer operations on a box's four corners)."""
 
-HEAD = 6
-"""Columns of a recorded step's head: step k + 1, first contact, contacts, first local entry,
-first velocity entry, sweeps."""
+
+class Friction(NamedTuple):
+    """Coulomb's law in the compiled loop.
+
+    Attributes
+    ----------
+    mu, e : (m,) float arrays
+        Friction and restitution coefficients.
+    target : float
+        Error ‖F‖/‖q‖ the Gauss–Seidel sweeps aim at.
+    sweeps : int
+        Most sweeps per step.
+    """
+
+    mu: np.ndarray
+    e: np.ndarray
+    target: float
+    sweeps: int
+
+
+def worst_step(n: int, m: int, d: int) -> np.ndarray:
+    """Most (records, ints, floats) one step adds: one record, every contact closed."""
+    return np.array([1, m, 2 * m * d + 2 * n], dtype=np.int64)
 
 
 @kernel
-def run(q, v, k_first, k_stop, row, h, theta, Hn, b, Ht, chol, K, c, shift, linear, MinvH,
-        G, units, mu, e, d, tol, target, sweeps, kept, Q, V, L, keep, ev_head, ev_contacts,
-        ev_q, ev_r, ev_um, ev_up, counts):
+def _certified(W, q, r, mu, d, tol):
+    """The figures of :func:`impactqp.model.friction.certify_friction` of (W, q, μ, r)
+    within ``tol``: ‖F‖ ≤ tol·‖q‖ and the cone gap ≤ tol·‖r‖."""
+    na = q.size
+    u = np.empty(na)
+    for s in range(na):
+        w = q[s]
+        for t in range(na):
+            w += W[s, t] * r[t]
+        u[s] = w
+    f2, _, _, cone = certificate_sums(r, u, mu, d)
+    qn = np.sqrt(np.sum(q * q))
+    rn = np.sqrt(np.sum(r * r))
+    return (np.sqrt(f2) <= tol * (qn if qn > 0.0 else 1.0)
+            and (cone == 0.0 or np.sqrt(cone) <= tol * rn))
+
+
+@kernel
+def _local(k, vf, gk, closed, contacts, friction, tol, events, vn, lam):
+    """Step 3 on the closed contacts: the local problem solved and certified, v_{k+1} and
+    the impulses written into ``vn`` and ``lam``, the step recorded; False hands the step
+    back."""
+    ptr, idx, val, _, d, _, _, _, MinvH, G, units = contacts
+    cons = np.flatnonzero(closed)
+    closed_count = cons.size
+    na = closed_count * d
+    cols = np.empty(na, dtype=np.int64)
+    for t in range(closed_count):
+        for i in range(d):
+            cols[t * d + i] = cons[t] * d + i
+    qa = np.empty(na)
+    if not step_q(rows_times(ptr, idx, val, d, cons, vf, np.empty(na)), gk, friction.e,
+                  np.zeros((0, 0)), cons, d, qa):
+        return True  # r = 0 solves the step exactly
+    W, qt = gather_local(G, units, cols, qa, np.empty((na, na)), np.empty(na))
+    mu = friction.mu[cons]
+    r = np.zeros(na)
+    done, _ = nsgs(W, qt, mu, d, r, friction.target, friction.sweeps, LOCAL_ITERATIONS)
+    r = project_cones(r, mu, d)
+    if not _certified(W, qt, r, mu, d, tol):
+        return False
+    for j in range(vf.size):
+        w = vf[j]
+        for t in range(na):
+            w += MinvH[j, cols[t]] * r[t] / units[cols[t]]
+        vn[j] = w
+    for t in range(na):
+        lam[cols[t]] = r[t] / units[cols[t]]
+    if events.keep:
+        open_record(events, k + 1, closed_count, done)
+        put_ints(events, cons)
+        put_floats(events, qt)
+        put_floats(events, r)
+        put_floats(events, vf)
+        put_floats(events, vn)
+    return True
+
+
+@kernel
+def run(q, v, k_first, k_stop, row, contacts, force, scheme, friction, record, events):
     """Steps k_first … k_stop − 1 of a frictional Moreau–Jean run (module docstring), in place.
 
     Parameters
@@ -50,42 +141,15 @@ def run(q, v, k_first, k_stop, row, h, theta, Hn, b, Ht, chol, K, c, shift, line
         The state at step k_first; on return, the state after the last completed step.
     k_first, k_stop, row : int
         First step, step to stop before, next record row.
-    h, theta : float
-        Step and θ.
-    Hn : (m, n) float array
-        The normal rows of Hᵀ.
-    b : (m,) float array
-        Gap offsets.
-    Ht : (d·m, n) float array
-        Hᵀ, every row.
-    chol, K, c, shift, linear
-        The force, as :func:`impactqp.kernels.moreau_jean.run` takes it.
-    MinvH, G : (n, d·m), (d·m, d·m) float arrays
-        Ŵ⁻¹H and HᵀŴ⁻¹H of all contacts.
-    units : (d·m,) float array
-        s_c = √G_nn of each row's contact: the step's local problem is gathered, solved and
-        checked in contact units (W̃ = DWD, q̃ = Dq, D = diag(1/s); docs/theory.md §16, §17),
-        its reaction r̃ = s·r.
-    mu, e : (m,) float arrays
-        Friction and restitution coefficients.
-    d : int
-        Rows per contact.
-    tol, target : float
-        Tolerance of the certificate; error ‖F‖/‖q‖ the Gauss–Seidel sweeps aim at.
-    sweeps : int
-        Most sweeps per step.
-    kept : int array
-        Step numbers of the record rows; Q, V, L receive them.
-    keep : bool
-        Record every solved step in the ev_* buffers.
-    ev_head : (E, HEAD) int array
-        Per recorded step: step number k + 1, first entry in ``ev_contacts``, number of
-        contacts, first entry in ``ev_q``/``ev_r``, first entry in ``ev_um``/``ev_up``,
-        sweeps done.
-    ev_contacts, ev_q, ev_r, ev_um, ev_up : arrays
-        The closed contacts, q̃, r̃ (contact units), v_free and v_{k+1} of each recorded step.
-    counts : (4,) int array
-        Used entries of (ev_head, ev_contacts, ev_q, ev_um), updated.
+    contacts : impactqp.kernels.step.Contacts
+        H (d = 2 or 3 rows per contact), b, Ŵ⁻¹H, HᵀŴ⁻¹H and the contact units in which
+        each step's local problem is gathered, solved and checked (docs/theory.md §16, §17).
+    force : impactqp.kernels.step.Force
+    scheme : impactqp.kernels.step.Scheme
+    friction : Friction
+    record : impactqp.kernels.step.Record
+    events : impactqp.kernels.events.Events
+        With :func:`worst_step`.
 
     Returns
     -------
@@ -93,97 +157,27 @@ def run(q, v, k_first, k_stop, row, h, theta, Hn, b, Ht, chol, K, c, shift, line
         Status (:data:`DONE`, :data:`FAILED`, :data:`FULL`), the first step not done, the
         next record row.
     """
+    ptr, idx, val, b, d = contacts.ptr, contacts.idx, contacts.val, contacts.b, contacts.d
+    chol, K, c, shift, linear = force
+    h, theta, tol = scheme
+    kept, Q, V, L = record
     n, m = v.size, b.size
-    vf = np.empty(n)
-    vn = np.empty(n)
-    y = np.empty(n)
-    gam = np.empty(m)
-    cons = np.empty(m, dtype=np.int64)
-    cols = np.empty(m * d, dtype=np.int64)
+    vf, vn, y = np.empty(n), np.empty(n), np.empty(n)
+    g, gk = np.empty(m), np.empty(m)
+    closed = np.zeros(m, dtype=np.bool_)
     lam = np.zeros(m * d)
     for k in range(k_first, k_stop):
-        if keep and (counts[0] + 1 > ev_head.shape[0] or counts[1] + m > ev_contacts.size
-                     or counts[2] + m * d > ev_q.size or counts[3] + n > ev_um.size):
+        if full(events):
             return FULL, k, row
-        closed = 0
-        for i in range(m):
-            g = b[i]
-            gv = 0.0
-            for j in range(n):
-                g += Hn[i, j] * q[j]
-                gv += Hn[i, j] * v[j]
-            gam[i] = gv
-            if g + 0.5 * h * gv <= 0.0:
-                cons[closed] = i
-                closed += 1
-        _free_velocity(v, q, chol, K, c, shift, h, theta, linear, vf, y)
+        linear_gaps(ptr, idx, val, b, d, q, v, g, gk)  # 1.
+        count = activation(g, gk, h, closed)
+        free_velocity(chol, K, c, shift, linear, h, theta, q, v, vf, y)  # 2.
         for j in range(n):
             vn[j] = vf[j]
-        lam[:] = 0.0
-        na = closed * d
-        qa = np.empty(na)
-        approaching = False
-        for t in range(closed):
-            for i in range(d):
-                cols[t * d + i] = cons[t] * d + i
-        for t in range(na):
-            s = 0.0
-            for j in range(n):
-                s += Ht[cols[t], j] * vf[j]
-            qa[t] = s / units[cols[t]]
-        for t in range(closed):
-            qa[t * d] += e[cons[t]] * gam[cons[t]] / units[cols[t * d]]
-            if qa[t * d] < 0.0:
-                approaching = True
-        if approaching:  # else r = 0 solves the step exactly
-            Wa = np.empty((na, na))
-            for s_ in range(na):
-                for t in range(na):
-                    Wa[s_, t] = G[cols[s_], cols[t]] / (units[cols[s_]] * units[cols[t]])
-            mua = np.empty(closed)
-            for t in range(closed):
-                mua[t] = mu[cons[t]]
-            r = np.zeros(na)
-            done, _ = nsgs(Wa, qa, mua, d, r, target, sweeps, LOCAL_ITERATIONS)
-            r = project_cones(r, mua, d)
-            u = np.empty(na)
-            for s_ in range(na):
-                w = qa[s_]
-                for t in range(na):
-                    w += Wa[s_, t] * r[t]
-                u[s_] = w
-            f2, _, _, cone = certificate_sums(r, u, mua, d)
-            qn = np.sqrt(np.sum(qa * qa))
-            rn = np.sqrt(np.sum(r * r))
-            if not (np.sqrt(f2) <= tol * (qn if qn > 0.0 else 1.0)
-                    and (cone == 0.0 or np.sqrt(cone) <= tol * rn)):
-                return FAILED, k, row
-            for j in range(n):
-                w = vf[j]
-                for t in range(na):
-                    w += MinvH[j, cols[t]] * r[t] / units[cols[t]]
-                vn[j] = w
-            for t in range(na):
-                lam[cols[t]] = r[t] / units[cols[t]]
-            if keep:
-                e0, c0, q0, u0 = counts[0], counts[1], counts[2], counts[3]
-                ev_head[e0, 0] = k + 1
-                ev_head[e0, 1] = c0
-                ev_head[e0, 2] = closed
-                ev_head[e0, 3] = q0
-                ev_head[e0, 4] = u0
-                ev_head[e0, 5] = done
-                for t in range(closed):
-                    ev_contacts[c0 + t] = cons[t]
-                for t in range(na):
-                    ev_q[q0 + t] = qa[t]
-                    ev_r[q0 + t] = r[t]
-                for j in range(n):
-                    ev_um[u0 + j] = vf[j]
-                    ev_up[u0 + j] = vn[j]
-                counts[0] += 1
-                counts[1] += closed
-                counts[2] += na
-                counts[3] += n
-        row = end_step(q, v, vn, lam, h, theta, k, row, kept, Q, V, L)
+        for j in range(m * d):
+            lam[j] = 0.0
+        if count > 0 and not _local(k, vf, gk, closed, contacts, friction, tol, events, vn,
+                                    lam):  # 3.
+            return FAILED, k, row
+        row = end_step(q, v, vn, lam, h, theta, k, row, kept, Q, V, L)  # 4.
     return DONE, k_stop, row

@@ -125,6 +125,19 @@ def _scaled_quadratic(M, x, y, f):
     return total
 
 
+@inline_kernel
+def dense_momentum(M, MinvW, um, up, lam, f, d):
+    """(V, ‖u⁺ − u⁻ − M⁻¹WΛ‖) of the inputs multiplied by f, with dense M and M⁻¹W (the
+    momentum residual is their ratio, docs/theory.md §8); ``d`` is scratch of n floats."""
+    for i in range(um.size):  # u⁺ − u⁻ − M⁻¹WΛ
+        total = (up[i] - um[i]) * f
+        for j in range(lam.size):
+            total -= MinvW[i, j] * (lam[j] * f)
+        d[i] = total
+    V = velocity_unit(_scaled_quadratic(M, um, um, f), _scaled_quadratic(M, up, up, f))
+    return V, np.sqrt(_high(_scaled_quadratic(M, d, d, 1.0), 0.0))
+
+
 @kernel
 def dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, out, work):
     """The residuals of one impact with dense M (n × n), Wᵀ (m × n), M⁻¹W (n × m), the
@@ -141,17 +154,10 @@ def dense_step_residuals(M, Wt, MinvW, s, um, up, lam, ur, E, eps, moreau, out, 
     u⁻ = v_free and ur = v_k (``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k``, docs/theory.md §14)."""
     n, m = um.size, lam.size
     f = 1.0 / unit_of(um, up, lam)
-    d = work[:n]
     g = work[n:n + m]
     w = work[n + m:n + 2 * m]
     z = work[n + 2 * m:2 * n + 2 * m]
-    for i in range(n):  # u⁺ − u⁻ − M⁻¹WΛ
-        total = (up[i] - um[i]) * f
-        for j in range(m):
-            total -= MinvW[i, j] * (lam[j] * f)
-        d[i] = total
-    V = velocity_unit(_scaled_quadratic(M, um, um, f), _scaled_quadratic(M, up, up, f))
-    momentum = np.sqrt(_high(_scaled_quadratic(M, d, d, 1.0), 0.0))
+    V, momentum = dense_momentum(M, MinvW, um, up, lam, f, work[:n])
     for i in range(m):  # γ⁻ (of ur) and γ⁺
         gm = 0.0
         gp = 0.0

@@ -19,10 +19,22 @@ import numpy as np
 
 from ..base.arrays import as_array
 from ..errors import InputError, NonFiniteError, RestitutionError
+from ..kernels.coulomb_certificate import (
+    COULOMB_RESIDUALS,
+    FrictionalAnswer,
+    FrictionalSystem,
+    LocalFreeVelocity,
+    coulomb_residuals,
+)
 from ..model.admissible import AdmissibleSet
 from ..model.friction import FrictionContactProblem, certify_friction, friction_coefficients
 from ..model.problem import ImpactProblem
-from ..model.residuals import impact_residuals, normalized_rows
+from ..model.residuals import (
+    DENSE_CONTACTS,
+    certificate_operand,
+    impact_residuals,
+    normalized_rows,
+)
 from ..model.structure import ImpactStructure
 from ..qp.backends import FRICTION
 from ..qp.friction import FrictionSolution
@@ -133,6 +145,7 @@ class Coulomb(ImpactLaw):
                              f"{method!r}")
         self.method = method
         self._per_contact: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._operands: tuple[ImpactStructure, FrictionalSystem | None] | None = None
         self._posed: tuple[ImpactStructure, np.ndarray, FrictionContactProblem,
                            np.ndarray] | None = None
 
@@ -248,7 +261,22 @@ class Coulomb(ImpactLaw):
         contact) of the reduced problem in contact units
         (:func:`~impactqp.model.friction.certify_friction`), and
         ``non_penetration`` ‖(−U_n/s)₊‖/‖q̃‖ of the Newton-shifted normal velocity of u⁺
-        itself."""
+        itself.
+
+        One impact with dense M and W is judged in one compiled pass of the same formulas
+        (:func:`~impactqp.kernels.coulomb_certificate.coulomb_residuals`); rows, sparse
+        structures and velocities to be rescaled first by :meth:`reference_residuals`."""
+        if np.ndim(U_minus) == 1:
+            compiled = self._compiled_residuals(structure, U_minus, U_plus, impulses)
+            if compiled is not None:
+                return compiled
+        return self.reference_residuals(structure, U_minus, U_plus, impulses)
+
+    def reference_residuals(self, structure: ImpactStructure, U_minus: np.ndarray,
+                            U_plus: np.ndarray, impulses: np.ndarray) -> dict[str, Any]:
+        """:meth:`residuals` by numpy products and
+        :func:`~impactqp.model.friction.certify_friction` (the reference the compiled pass
+        is tested against), one impact (1-D arrays) or rows."""
         U_minus, U_plus, impulses = normalized_rows(U_minus, U_plus, impulses)
         momentum = impact_residuals(structure, U_minus, U_plus, impulses)[1]["momentum"]
         if np.ndim(U_minus) == 1:
@@ -258,6 +286,51 @@ class Coulomb(ImpactLaw):
                 for row in zip(U_minus, U_plus, impulses, strict=True)]
         return {"momentum": momentum,
                 **{k: np.array([r[k] for r in rows]) for k in FRICTION_RESIDUALS}}
+
+    def _compiled_residuals(self, structure: ImpactStructure, u_minus: np.ndarray,
+                            u_plus: np.ndarray, impulses: np.ndarray
+                            ) -> dict[str, float] | None:
+        """:meth:`residuals` of one impact with dense M and W in one compiled pass
+        (:func:`impactqp.kernels.coulomb_certificate.coulomb_residuals`, the same formulas);
+        None where it does not apply (sparse or large structures, answers not float vectors
+        of the problem's sizes, u⁻ to be rescaled first), and the reference computation
+        answers."""
+        system = self._system(structure)
+        if system is None:
+            return None
+        n, size = structure.n, structure.m
+        for x, length in ((u_minus, n), (u_plus, n), (impulses, size)):
+            if not (isinstance(x, np.ndarray) and x.dtype == np.float64
+                    and x.shape == (length,)):
+                return None
+        posed = self._local(structure, u_minus)[0]
+        unit = posed.in_contact_units()
+        local = LocalFreeVelocity(posed.q, unit.problem.q, unit.k)
+        out = np.empty(len(COULOMB_RESIDUALS))
+        answer = FrictionalAnswer(u_minus, u_plus, impulses, np.empty(n + 2 * size))
+        if not coulomb_residuals(system, local, answer, out):
+            return None
+        return dict(zip(COULOMB_RESIDUALS, out.tolist(), strict=True))
+
+    def _system(self, structure: ImpactStructure) -> FrictionalSystem | None:
+        """The compiled certificate's operands of ``structure``, kept for the last structure
+        (None for sparse, chain or very large structures)."""
+        kept = self._operands
+        if kept is not None and kept[0] is structure:
+            return kept[1]
+        system = None
+        if not structure.sparse and structure.chain is None and 0 < structure.m <= \
+                DENSE_CONTACTS:
+            G, s = structure.contact_delassus
+            mu, e = self.per_contact(structure.n_contacts)
+            system = FrictionalSystem(structure.dense_mass, structure.dense_Wt,
+                                      certificate_operand(structure),
+                                      np.ascontiguousarray(G, dtype=float), s,
+                                      np.ascontiguousarray(mu, dtype=float),
+                                      np.ascontiguousarray(e, dtype=float),
+                                      structure.contact_dim)
+        self._operands = structure, system
+        return system
 
     def _friction_residuals(self, structure: ImpactStructure, u_minus: np.ndarray,
                             u_plus: np.ndarray, impulses: np.ndarray) -> dict[str, float]:

@@ -1,7 +1,12 @@
 """What the two compiled Moreau–Jean loops share (docs/theory.md §14, §17): the calls of the
 kernel over a run, resumed after a step the kernel hands back to the Python loop's step (its
 certificate failed) or after the event buffers were enlarged, the rows kept for the
-trajectory, and the pieces of the event list (kernel records or the Python step's events)."""
+trajectory, and the pieces of the event list (kernel records or the Python step's events).
+
+The buffers have the one layout of :mod:`impactqp.kernels.events`: a loop says only how
+many entries one step may add (``worst``) and how one record reads back
+(:meth:`CompiledDriver._event`).
+"""
 
 from __future__ import annotations
 
@@ -10,69 +15,94 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
+from ..kernels.events import HEAD, Events
 from ..kernels.moreau_jean import DONE, FAILED
+from ..kernels.step import Record, end_step
+
+SLACK = 8
+"""Steps' worst case of room the event buffers get beyond twice what is in use."""
+
+
+def compressed_rows(H: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Hᵀ in compressed rows (ptr, idx, val), the indices of each row ascending: the form
+    :class:`impactqp.kernels.step.Contacts` holds H in."""
+    Ht = sp.csr_matrix(np.asarray(H, dtype=float).T)
+    Ht.sort_indices()
+    return Ht.indptr.astype(np.int64), Ht.indices.astype(np.int64), Ht.data.astype(float)
 
 
 class CompiledDriver(ABC):
-    """A run through a compiled loop ``kernel(q, v, k, stop, row, h, θ, *data, kept, Q, V, L,
-    keep, *buffers, counts) -> (status, k, row)``.
+    """A run through a compiled loop ``kernel(q, v, k, stop, row, *data, record, events)
+    -> (status, k, row)``.
 
-    A subclass sets ``kernel``, ``step`` (the Python loop's step: ``h``, ``theta``, ``t0`` and
-    ``step(k, q, v) -> (q, v, Λ, events)``), ``q0``, ``v0``, ``keep``, ``buffers``, ``counts``
-    and ``pieces`` (empty), and defines :meth:`kernel_data`, :meth:`_room`, :meth:`_used`
-    and :meth:`_event`.
+    Parameters
+    ----------
+    step : Step
+        The Python loop's step (:class:`impactqp.simulation.time_stepping.Step`): its system,
+        scheme and t0, and the step that solves what the kernel does not certify.
+    kernel : callable
+        The compiled loop.
+    keep : bool
+        Keep the events.
+    worst : (3,) int array
+        Most (records, ints, floats) one step adds.
+
+    A subclass defines :meth:`kernel_data` and :meth:`_event`.
     """
 
-    kernel: Callable[..., tuple[int, int, int]]
-    step: Any
-    q0: np.ndarray
-    v0: np.ndarray
-    keep: bool
-    buffers: tuple[np.ndarray, ...]
-    counts: np.ndarray
-    pieces: list
+    def __init__(self, step: Any, kernel: Callable[..., tuple[int, int, int]], keep: bool,
+                 worst: np.ndarray) -> None:
+        self.step, self.kernel, self.keep = step, kernel, keep
+        self.events = Events(np.empty((0, HEAD), dtype=np.int64), np.empty(0, dtype=np.int64),
+                             np.empty(0), np.zeros(3, dtype=np.int64), worst, bool(keep))
+        if keep:
+            self._grow()
+        self.pieces: list[tuple[int, int] | list] = []
 
     @abstractmethod
     def kernel_data(self) -> tuple:
-        """The kernel's arguments between θ and ``kept``."""
+        """The kernel's arguments between ``row`` and ``record``."""
 
     @abstractmethod
-    def _buffers(self, *sizes: int) -> tuple[np.ndarray, ...]:
-        """Empty event buffers of the given sizes."""
-
-    @abstractmethod
-    def _room(self, *counts: int) -> tuple[int, ...]:
-        """Buffer sizes for the recorded ``counts`` and what the next steps may add."""
-
-    @abstractmethod
-    def _used(self, *counts: int) -> tuple[int, ...]:
-        """The entries of each buffer in use for the recorded ``counts``."""
-
-    @abstractmethod
-    def _event(self, e: int) -> Any:
-        """The event of the kernel's record ``e``."""
+    def _event(self, step: int, a: int, b: int, ints: np.ndarray, floats: np.ndarray) -> Any:
+        """The event of a kernel record: step number k + 1, the loop's two head integers,
+        its integers and its floats."""
 
     def _grow(self) -> None:
-        """More room in every event buffer (:meth:`_room`), keeping what is recorded."""
-        counts = [int(x) for x in self.counts]
-        new = self._buffers(*self._room(*counts))
-        for old, fresh, used in zip(self.buffers, new, self._used(*counts), strict=True):
-            fresh[:used] = old[:used]
-        self.buffers = new
+        """More room in every event buffer (twice what is used plus :data:`SLACK` steps'
+        worst case), keeping what is recorded."""
+        old = self.events
+        used = [int(x) for x in old.counts]
+        size = [2 * u + SLACK * int(w) for u, w in zip(used, old.worst, strict=True)]
+        head = np.empty((size[0], HEAD), dtype=np.int64)
+        ints, floats = np.empty(size[1], dtype=np.int64), np.empty(size[2])
+        head[:used[0]], ints[:used[1]], floats[:used[2]] = \
+            old.head[:used[0]], old.ints[:used[1]], old.floats[:used[2]]
+        self.events = old._replace(head=head, ints=ints, floats=floats)
+
+    def _record(self, e: int) -> Any:
+        """The event of record ``e`` (its entries end where the next record's begin)."""
+        ev = self.events
+        step, i0, f0, a, b = (int(x) for x in ev.head[e])
+        last = e + 1 >= ev.counts[0]
+        i1 = int(ev.counts[1] if last else ev.head[e + 1, 1])
+        f1 = int(ev.counts[2] if last else ev.head[e + 1, 2])
+        return self._event(step, a, b, ev.ints[i0:i1], ev.floats[f0:f1])
 
     def _events(self) -> list:
         """The run's events, in order: the Python steps' as they are, the kernel's records
         built by :meth:`_event`."""
         out: list = []
         for piece in self.pieces:
-            out.extend(piece if isinstance(piece, list) else map(self._event, range(*piece)))
+            out.extend(piece if isinstance(piece, list) else map(self._record, range(*piece)))
         return out
 
     def _close(self, first: int) -> None:
         """Mark the kernel's events since ``first`` as the next piece of the list."""
-        if self.keep and self.counts[0] > first:
-            self.pieces.append((first, int(self.counts[0])))
+        if self.keep and self.events.counts[0] > first:
+            self.pieces.append((first, int(self.events.counts[0])))
 
     def run(self, steps: int, kept: np.ndarray, Q: np.ndarray, V: np.ndarray, L: np.ndarray,
             report: int, progress: Callable[[float], None] | None,
@@ -80,25 +110,21 @@ class CompiledDriver(ABC):
         """Fill Q, V, L (rows ``kept``) over ``steps`` steps; returns the events (a builder
         called on first read) or [] without ``keep``."""
         step, h, t0 = self.step, self.step.h, self.step.t0
-        q, v = self.q0.copy(), self.v0.copy()
+        q, v = step.system.q0.copy(), step.system.v0.copy()
+        record = Record(kept, Q, V, L)
         data = self.kernel_data()
         k, row, first, reported = 0, 1, 0, 0
         while k < steps:
             stop = steps if progress is None else min(steps, (k // report + 1) * report)
-            status, k, row = self.kernel(q, v, k, stop, row, h, step.theta, *data, kept,
-                                         Q, V, L, self.keep, *self.buffers, self.counts)
+            status, k, row = self.kernel(q, v, k, stop, row, *data, record, self.events)
             if status == FAILED:  # the Python loop's step, whose solve raises what it raises
                 self._close(first)
-                q_next, v_next, lam, new = step(k, q, v)
-                q[:], v[:] = q_next, v_next
+                v_next, lam, new = step(k, q, v)
+                row = end_step(q, v, v_next, lam, h, step.theta, k, row, *record)
                 if self.keep:
                     self.pieces.append(new)
-                first = int(self.counts[0])
+                first = int(self.events.counts[0])
                 k += 1
-                if row < kept.size and kept[row] == k:
-                    Q[row], V[row] = q, v
-                    L[row] = 0.0 if lam is None else lam
-                    row += 1
             elif status != DONE:  # the event buffers are full
                 self._grow()
             if progress is not None and k % report == 0 and k > reported:

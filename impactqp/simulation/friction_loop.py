@@ -1,21 +1,22 @@
 """The compiled frictional Moreau–Jean loop (docs/theory.md §17, "The compiled loop"): the
-arrays of :func:`impactqp.kernels.friction_loop.run`, formed once per run, the calls of the
-kernel (resumed after a step solved by the Python loop's
-:class:`~impactqp.simulation.friction_step.FrictionStep`, or after enlarging the event
-buffers) and the :class:`~impactqp.simulation.friction_step.FrictionEvent` s built from what
-the kernel recorded, on first read."""
+arrays of :func:`impactqp.kernels.friction_loop.run`, formed once per run, and the
+:class:`~impactqp.simulation.friction_step.FrictionEvent` s built from what the kernel
+recorded, on first read; the calls of the kernel (resumed after a step solved by the Python
+loop's step, or after enlarging the event buffers) are the shared driver's."""
 
 from __future__ import annotations
 
 from functools import partial
+from typing import Any
 
 import numpy as np
 
-from ..kernels.friction_loop import HEAD, run
+from ..kernels.friction_loop import Friction, run, worst_step
+from ..kernels.step import Contacts, gather_local
 from ..laws.friction import FrictionResult
 from ..model.friction import FrictionContactProblem, certify_friction
-from .compiled_driver import CompiledDriver
-from .friction_step import FrictionEvent, FrictionStep
+from .compiled_driver import CompiledDriver, compressed_rows
+from .friction_step import FrictionEvent
 
 LOOP_BACKEND = "compiled frictional loop"
 """What answered a step solved inside the compiled loop (its events' ``result.backend``)."""
@@ -33,66 +34,48 @@ class CompiledFriction(CompiledDriver):
 
     Parameters
     ----------
-    step : FrictionStep
-        The Python loop's step: its system, free velocity, coefficients and tolerance, and
-        the step that solves what the kernel does not certify.
+    step : Step
+        The Python loop's step (:class:`impactqp.simulation.time_stepping.Step`) with a
+        :class:`~impactqp.simulation.friction_step.FrictionSolver`: its system, free
+        velocity, coefficients and tolerance, and the step that solves what the kernel does
+        not certify.
     keep : bool
         Keep the events.
     """
 
-    def __init__(self, step: FrictionStep, keep: bool) -> None:
-        self.step, self.keep, self.kernel = step, keep, run
-        system, free = step.system, step.free
-        self.q0, self.v0 = system.q0, system.v0
-        d, m = step.d, system.n_contacts
-        _, H, MinvH, G, units = step.local(np.arange(m))
-        self.units = units
-        self.geometry = (np.ascontiguousarray(H[:, ::d].T), system.b, np.ascontiguousarray(H.T))
-        self.force = free.kernel_arrays(step.t0)
-        self.products = (MinvH, np.ascontiguousarray(G), units)
-        self.coefficients = (step.mu, step.e, d, step.tol, TARGET * step.tol, SWEEPS)
-        self.buffers = self._buffers(*(self._room(0, 0, 0, 0) if keep else (0, 0, 0, 0)))
-        self.counts = np.zeros(4, dtype=np.int64)
-        self.pieces: list[tuple[int, int] | list[FrictionEvent]] = []
-
-    @staticmethod
-    def _buffers(events: int, contacts: int, entries: int, dofs: int) -> tuple[np.ndarray, ...]:
-        """(head, contacts, q, r, u⁻, u⁺) for ``events`` recorded steps."""
-        return (np.empty((events, HEAD), dtype=np.int64), np.empty(contacts, dtype=np.int64),
-                np.empty(entries), np.empty(entries), np.empty(dofs), np.empty(dofs))
-
-    def _room(self, events: int, contacts: int, entries: int,
-              dofs: int) -> tuple[int, int, int, int]:
-        """Twice what is used plus 64 steps' worst case."""
-        n, m, d = self.step.system.n_dof, self.step.system.n_contacts, self.step.d
-        return (2 * events + 64, 2 * contacts + 64 * m, 2 * entries + 64 * m * d,
-                2 * dofs + 64 * n)
-
-    @staticmethod
-    def _used(events: int, contacts: int, entries: int, dofs: int) -> tuple[int, ...]:
-        """Entries in use of (head, contacts, q, r, u⁻, u⁺)."""
-        return events, contacts, entries, entries, dofs, dofs
+    def __init__(self, step: Any, keep: bool) -> None:
+        solver = self.solver = step.solver
+        system, d, m = step.system, solver.d, step.system.n_contacts
+        super().__init__(step, run, keep, worst_step(system.n_dof, m, d))
+        _, H, MinvH, G, units = solver.local(np.arange(m))
+        self.contacts = Contacts(*compressed_rows(H), system.b, d, np.zeros((0, 0)),
+                                 np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+                                 MinvH, np.ascontiguousarray(G), units)
+        self.force = step.free.kernel_force(step.t0)
+        self.friction = Friction(solver.mu, solver.e, TARGET * solver.tol, SWEEPS)
 
     def kernel_data(self) -> tuple:
-        return (*self.geometry, *self.force, *self.products, *self.coefficients)
+        return self.contacts, self.force, self.step.scheme, self.friction
 
-    def _event(self, e: int) -> FrictionEvent:
-        """The FrictionEvent of record ``e``, with the certificate of
-        :func:`impactqp.model.friction.certify_friction` recomputed from its (W, q, μ, r)."""
-        head, contacts, qs, rs, ums, ups = self.buffers
-        step, n, d = self.step, self.step.system.n_dof, self.step.d
-        k1, c0, a, r0, u0, sweeps = (int(x) for x in head[e])
-        closed = contacts[c0:c0 + a].copy()
+    def _event(self, step: int, a: int, b: int, ints: np.ndarray,
+               floats: np.ndarray) -> FrictionEvent:
+        """The FrictionEvent of a recorded step (``a`` closed contacts, ``b`` sweeps), with
+        the certificate of :func:`impactqp.model.friction.certify_friction` recomputed from
+        its (W, q, μ, r)."""
+        solver, n, d = self.solver, self.step.system.n_dof, self.solver.d
+        closed = ints[:a].copy()
+        na = a * d
         cols = (closed[:, None] * d + np.arange(d)).ravel()
-        s = self.units[cols]  # the kernel's problem, in contact units
-        W = self.products[1][np.ix_(cols, cols)] / np.outer(s, s)
-        problem = FrictionContactProblem(W, qs[r0:r0 + a * d].copy(), step.mu[closed],
+        s = self.contacts.units[cols]  # the kernel's problem, in contact units
+        W, _ = gather_local(self.contacts.G, self.contacts.units, cols, np.zeros(na),
+                            np.empty((na, na)), np.empty(na))
+        problem = FrictionContactProblem(W, floats[:na].copy(), solver.mu[closed],
                                          contact_dim=d)
-        r = rs[r0:r0 + a * d].copy()
+        r = floats[na:2 * na].copy()
         u = problem.velocity(r)
-        cert = certify_friction(problem, r, u, tol=step.tol)
-        result = FrictionResult(r, u, cert.error, cert, sweeps, 0.0, LOOP_BACKEND)
-        um, up = ums[u0:u0 + n].copy(), ups[u0:u0 + n].copy()
-        verdict = partial(step.membership, closed, um, up, r / s)
-        return FrictionEvent(step.t0 + k1 * step.h, closed, problem, result, s, um, up,
-                             verdict)
+        cert = certify_friction(problem, r, u, tol=solver.tol)
+        result = FrictionResult(r, u, cert.error, cert, b, 0.0, LOOP_BACKEND)
+        um, up = floats[2 * na:2 * na + n].copy(), floats[2 * na + n:2 * na + 2 * n].copy()
+        verdict = partial(solver.membership, closed, um, up, r / s)
+        return FrictionEvent(self.step.t0 + step * self.step.h, closed, problem, result, s, um,
+                             up, verdict)

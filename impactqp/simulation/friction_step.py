@@ -1,11 +1,13 @@
-"""One Moreau–Jean step with Coulomb friction (docs/theory.md §17).
+"""Coulomb friction in one Moreau–Jean step, in step form (docs/theory.md §17).
 
-On the contacts the step predicts closed (gᵢ(q_k) + ½hγᵢ(v_k) ≤ 0, the frictionless loop's
-rule), the local problem of docs/theory.md §15,
+On the contacts the step closes (:func:`impactqp.kernels.step.activation`, the rule of every
+loop), the local problem of docs/theory.md §15,
 
     u = W r + q,    W = H_AᵀŴ⁻¹H_A,    q = H_Aᵀv_free + e ∘ γ_k (on the normal rows),
 
-is solved and certified by :func:`impactqp.solve_friction`; then v_{k+1} = v_free + Ŵ⁻¹H_A r
+with the step's q of :func:`impactqp.kernels.step.step_q`, is gathered in contact units by
+:func:`impactqp.kernels.step.gather_local` and solved and certified by
+:func:`impactqp.solve_friction` (:class:`FrictionSolver`); then v_{k+1} = v_free + Ŵ⁻¹H_A r
 and u is the local velocity H_Aᵀv_{k+1} shifted by eγ_k on the normal rows, as Newton's law
 at velocity level reads it (Siconos' NewtonImpactFrictionNSL).
 """
@@ -22,6 +24,8 @@ import scipy.sparse as sp
 from ..base.checks import NamedChecks
 from ..errors import CertificateError, InputError, ShapeError
 from ..kernels.friction import project_cones
+from ..kernels.step import gather_local, step_q
+from ..kernels.units import contact_units
 from ..laws.coulomb import Coulomb
 from ..laws.friction import FRICTION_BACKENDS, FrictionResult, solve_friction
 from ..model.friction import FrictionCertificate, FrictionContactProblem
@@ -31,6 +35,10 @@ NEEDS_TANGENTS = ("Coulomb friction needs tangent columns: build the LinearSyste
                   "contact_dim=2 (plane) or 3 (space), H holding the normal and then the "
                   "tangents of each contact")
 """The refusal of Coulomb's law on a frictionless system."""
+
+_NO_MATRIX = np.zeros((0, 0))
+"""The restitution matrix of :func:`impactqp.kernels.step.step_q` for Coulomb's one
+coefficient per contact."""
 
 MAX_CACHED = 4096
 """Closed sets whose W and Ŵ⁻¹H_A are kept per run; the cache starts afresh when full."""
@@ -160,8 +168,16 @@ class FrictionEvent:
                 f"certificate={'ok' if self.certified else 'FAILED'})")
 
 
-class FrictionStep:
-    """One step of the frictional loop: (q_{k+1}, v_{k+1}, r or None, events) from (q_k, v_k).
+class FrictionSolver:
+    """The closed contacts' frictional problem of one Moreau–Jean step, in step form
+    (docs/theory.md §17): what :class:`~.impacts.ImpactSolver` is for the frictionless laws,
+    with the same :meth:`solve`.
+
+    The step's q = H_Aᵀv_free + eγ_k (normal rows; :func:`impactqp.kernels.step.step_q`)
+    and the local problem gathered in contact units
+    (:func:`impactqp.kernels.step.gather_local`, the units of
+    :func:`impactqp.kernels.units.contact_units`) are the compiled loop's; the problem is
+    solved and certified by :func:`impactqp.solve_friction`.
 
     Parameters
     ----------
@@ -169,19 +185,17 @@ class FrictionStep:
         With ``contact_dim`` 2 or 3.
     free : callable
         v_free(t, q, v) of the θ-method, with its iteration matrix ``metric`` and its
-        factorization ``solver`` (the frictionless loop's ``_FreeVelocity``).
+        factorization ``solver`` (the loop's ``_FreeVelocity``).
     law : Coulomb
-    h, theta, t0 : float
     backend : str
         Method of :func:`impactqp.solve_friction` (``"auto"``: the law's ``method``).
     tol : float
         Certificate tolerance of every local problem.
     """
 
-    def __init__(self, system: LinearSystem, free, law: Coulomb, h: float, theta: float,
-                 t0: float, *, backend: str = "auto", tol: float = 1e-8) -> None:
+    def __init__(self, system: LinearSystem, free, law: Coulomb, *, backend: str = "auto",
+                 tol: float = 1e-8) -> None:
         self.system, self.free = system, free
-        self.h, self.theta, self.t0 = h, theta, t0
         self.mu, self.e = coulomb_coefficients(law, system)
         self.backend, self.tol = check_friction_backend(step_backend(law, backend)), tol
         self.d = system.contact_dim
@@ -190,8 +204,9 @@ class FrictionStep:
 
     def local(self, contacts: np.ndarray) -> tuple[np.ndarray, ...]:
         """(columns, H_A, Ŵ⁻¹H_A, W = H_AᵀŴ⁻¹H_A, s) of a closed set (H_A dense), formed once
-        per set: s holds each row's contact unit s_c = √W_nn (1 where W_nn = 0), in which
-        the step's local problem is posed (docs/theory.md §16, §17)."""
+        per set: s holds each row's contact unit (:func:`impactqp.kernels.units.contact_units`
+        of W's diagonal), in which the step's local problem is posed (docs/theory.md §16,
+        §17)."""
         key = contacts.tobytes()
         hit = self._cache.get(key)
         if hit is None:
@@ -203,48 +218,52 @@ class FrictionStep:
             H = H.toarray() if sp.issparse(H) else np.asarray(H, dtype=float)
             MinvH = self.free.solver.solve_mass(H)
             W = H.T @ MinvH
-            W = 0.5 * (W + W.T)
-            units = np.sqrt(np.diag(W)[::d])
-            units = np.repeat(np.where(units > 0.0, units, 1.0), d)
-            hit = (cols, H, np.ascontiguousarray(MinvH), W, units)
+            W = np.ascontiguousarray(0.5 * (W + W.T))
+            hit = (cols, H, np.ascontiguousarray(MinvH), W, contact_units(np.diag(W).copy(), d))
             self._cache[key] = hit
         return hit
 
-    def __call__(self, k: int, q: np.ndarray, v: np.ndarray,
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, list[FrictionEvent]]:
-        h, theta, system, d = self.h, self.theta, self.system, self.d
-        gamma = system.contact_velocities(v)
-        closed = system.gaps(q) + (0.5 * h) * gamma <= 0.0
-        v_free = self.free(self.t0 + k * h, q, v)
-        v_next, lam, events = v_free, None, []
-        if closed.any():
-            contacts = np.flatnonzero(closed)
-            cols, H, MinvH, W, units = self.local(contacts)
-            q_loc = H.T @ v_free
-            q_loc[::d] += self.e[contacts] * gamma[contacts]
-            if np.any(q_loc[::d] < 0.0):  # else r = 0 is exact (docs/theory.md §17)
-                time = self.t0 + (k + 1) * h
-                problem = FrictionContactProblem(W / np.outer(units, units), q_loc / units,
-                                                 self.mu[contacts], contact_dim=d)
-                try:
-                    result = solve_friction(problem, backend=self.backend, tol=self.tol)
-                except CertificateError as exc:
-                    raise CertificateError(f"the frictional Moreau–Jean step ending at "
-                                           f"t = {time:.12g} (contacts "
-                                           f"{contacts.tolist()[:8]}): {exc}") from exc
-                r = result.r / units
-                v_next = v_free + MinvH @ r
-                lam = np.zeros(self.impulse_size)
-                lam[cols] = r
-                verdict = partial(self.membership, contacts, v_free, v_next, r)
-                events = [FrictionEvent(time, contacts, problem, result, units, v_free,
-                                        v_next, verdict)]
-        return q + h * ((1.0 - theta) * v + theta * v_next), v_next, lam, events
+    def solve(self, time: float, u_minus: np.ndarray, closed: np.ndarray, *,
+              v_previous: np.ndarray, gamma_previous: np.ndarray,
+              ) -> tuple[np.ndarray, np.ndarray, list[FrictionEvent]]:
+        """(v_{k+1}, impulses over every column of H, events) of the step ending at ``time``
+        from u⁻ = v_free, the closed contacts (boolean mask) and γ_k = H_nᵀv_k of all
+        contacts (``v_previous`` = v_k, unused beyond γ_k).
+
+        Raises
+        ------
+        CertificateError
+            No method of :func:`impactqp.solve_friction` certifies the step (with its time
+            and contacts).
+        """
+        d = self.d
+        contacts = np.flatnonzero(closed)
+        cols, H, MinvH, W, units = self.local(contacts)
+        q = np.empty(cols.size)
+        if not step_q(np.ascontiguousarray(H.T @ u_minus), gamma_previous, self.e, _NO_MATRIX,
+                      contacts, d, q):
+            return u_minus, np.zeros(self.impulse_size), []  # r = 0 is exact
+        W_local, q_local = gather_local(W, units, np.arange(cols.size), q,
+                                        np.empty((cols.size, cols.size)), np.empty(cols.size))
+        problem = FrictionContactProblem(W_local, q_local, self.mu[contacts], contact_dim=d)
+        try:
+            result = solve_friction(problem, backend=self.backend, tol=self.tol)
+        except CertificateError as exc:
+            raise CertificateError(f"the frictional Moreau–Jean step ending at "
+                                   f"t = {time:.12g} (contacts "
+                                   f"{contacts.tolist()[:8]}): {exc}") from exc
+        r = result.r / units
+        v_next = u_minus + MinvH @ r
+        lam = np.zeros(self.impulse_size)
+        lam[cols] = r
+        verdict = partial(self.membership, contacts, u_minus, v_next, r)
+        return v_next, lam, [FrictionEvent(time, contacts, problem, result, units, u_minus,
+                                           v_next, verdict)]
 
     def membership(self, contacts: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
                    r: np.ndarray) -> StepMembership:
         """The verdict of :class:`StepMembership` for one recorded step."""
-        _, H, _, W, _ = self.local(contacts)
+        _, H, _, _, units = self.local(contacts)
         d = self.d
         metric = self.free.metric
         impulse = H @ project_cones(r, self.mu[contacts], d)
@@ -254,7 +273,7 @@ class FrictionStep:
         norm_minus = float(u_minus @ np.asarray(metric @ u_minus).ravel())
         norm_plus = float(u_plus @ np.asarray(metric @ u_plus).ravel())
         gamma = H[:, ::d].T @ u_plus
-        s = np.sqrt(np.diag(W)[::d])
+        s = units[::d]
         ref = np.sqrt(norm_minus) if norm_minus > 0 else 1.0
         kinematic = max(0.0, float(np.max(-gamma / (s * ref))))
         energetic = max(0.0, norm_plus - norm_minus) / (norm_minus if norm_minus > 0 else 1.0)

@@ -96,20 +96,23 @@ class ImpactSolver:
         self.cache, self.law, self.backend, self.tol = cache, law, backend, tol
 
     def solve(self, time: float, u_minus: np.ndarray, closed: np.ndarray, *,
-              v_previous: np.ndarray | None = None,
+              v_previous: np.ndarray | None = None, gamma_previous: np.ndarray | None = None,
               ) -> tuple[np.ndarray, np.ndarray, list[ImpactEvent]]:
         """(u⁺, Λ over all contacts, events) for the closed contacts (boolean mask).
 
         Without ``v_previous`` (event-driven) a cluster is an impact when one of its
-        contacts approaches (γ⁻ᵢ < 0). With it (a Moreau–Jean step from v_k), complementarity
-        laws take the step form and a cluster is solved unless Λ = 0 already solves it.
+        contacts approaches (γ⁻ᵢ < 0). With it and the normal velocities
+        ``gamma_previous`` = Hᵀv_k of all contacts (a Moreau–Jean step from v_k),
+        complementarity laws take the step form and a cluster is solved unless its step q
+        (:func:`impactqp.kernels.step.step_q`) is ≥ 0, where Λ = 0 already solves it.
         """
         u_plus = u_minus.copy()
         impulses = np.zeros(self.cache.m)
         events: list[ImpactEvent] = []
         for cl in self.cache.clusters(closed):
             u_c = u_minus[cl.dofs]
-            law = self._law(cl, u_c, None if v_previous is None else v_previous[cl.dofs])
+            law = self._law(cl, u_c, None if v_previous is None else v_previous[cl.dofs],
+                            gamma_previous)
             if law is None:
                 continue
             result = self._solve(ImpactProblem.from_structure(cl.structure, u_c), law)
@@ -120,16 +123,15 @@ class ImpactSolver:
                                       result))
         return u_plus, impulses, events
 
-    def _law(self, cl: Cluster, u_c: np.ndarray,
-             v_prev: np.ndarray | None) -> ImpactLaw | None:
+    def _law(self, cl: Cluster, u_c: np.ndarray, v_prev: np.ndarray | None,
+             gamma_previous: np.ndarray | None) -> ImpactLaw | None:
         """The law for this cluster, or None when nothing happens (Λ = 0)."""
         gamma = cl.structure.Wt_times(u_c)
-        if v_prev is not None:
+        if v_prev is not None and gamma_previous is not None:
             E = self.law.step_restitution(cl.contacts)
             if E is not None:
-                g_prev = cl.structure.Wt_times(v_prev)
-                q = gamma + (E @ g_prev if np.ndim(E) == 2 else E * g_prev)
-                return MoreauJeanStep(E, v_prev) if np.any(q < 0) else None
+                law = MoreauJeanStep(E, v_prev)
+                return law if law.approaching(gamma, gamma_previous[cl.contacts]) else None
         if not np.any(gamma < 0):
             return None
         return self.law.restrict(cl.contacts)

@@ -17,12 +17,17 @@ import numpy as np
 from ..base.arrays import as_array
 from ..base.rowwise import row_max, row_min
 from ..errors import ShapeError
+from ..kernels.step import step_q
 from ..laws.base import Answer, ImpactLaw
 from ..model.problem import ImpactProblem
 from ..model.programs import impulse_program, velocity_program
 from ..model.residuals import impact_residuals, normalized_rows
 from ..model.structure import ChainInfo, ImpactStructure
 from ..qp.program import QPSolution, QuadraticProgram
+
+_NO_MATRIX = np.zeros((0, 0))
+"""The restitution matrix argument of :func:`impactqp.kernels.step.step_q` for one
+coefficient per contact."""
 
 
 class _Shifted(NamedTuple):
@@ -60,6 +65,26 @@ class MoreauJeanStep(ImpactLaw):
         self.v_previous = as_array("v_previous", v_previous, ndim=1)
         self.forms = ("velocity", "impulse") if self.E.ndim == 0 else ("impulse",)
 
+    def step_q(self, gamma_free: np.ndarray, gamma_previous: np.ndarray,
+               ) -> tuple[np.ndarray, bool]:
+        """(q, some qᵢ < 0): the step's q = γ(v_free) + Eγ_k of
+        :func:`impactqp.kernels.step.step_q` from γ(v_free) = Wᵀv_free and γ_k = Wᵀv_k on
+        this problem's contacts."""
+        m = gamma_free.size
+        if self.E.ndim == 2:
+            e, E = np.zeros(0), np.ascontiguousarray(self.E, dtype=float)
+        else:
+            e, E = np.ascontiguousarray(np.broadcast_to(self.E, (m,)), dtype=float), _NO_MATRIX
+        q = np.empty(m)
+        approaching = step_q(np.ascontiguousarray(gamma_free, dtype=float),
+                             np.ascontiguousarray(gamma_previous, dtype=float), e, E,
+                             np.arange(m), 1, q)
+        return q, bool(approaching)
+
+    def approaching(self, gamma_free: np.ndarray, gamma_previous: np.ndarray) -> bool:
+        """Some contact's step q is negative: Λ = 0 does not solve the step."""
+        return self.step_q(gamma_free, gamma_previous)[1]
+
     @property
     def coefficients(self) -> float | np.ndarray:
         return float(self.E) if self.E.ndim == 0 else self.E
@@ -73,7 +98,7 @@ class MoreauJeanStep(ImpactLaw):
         if form == "velocity":
             shifted = problem.u_minus + float(self.E) * self.v_previous
             return velocity_program(_Shifted(st, shifted, problem.chain))
-        q = problem.gamma_minus + self._restitution(st.Wt_times(self.v_previous))
+        q, _ = self.step_q(problem.gamma_minus, st.Wt_times(self.v_previous))
         return impulse_program(problem, q)
 
     def recover(self, problem: ImpactProblem, form: str, solution: QPSolution) -> Answer:

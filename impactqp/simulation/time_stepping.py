@@ -1,33 +1,36 @@
 """Moreau–Jean time-stepping with any impact law (docs/theory.md §14).
 
 One step from (q_k, v_k) at t_k to t_{k+1} = t₀ + (k+1)h, in the order Siconos' MoreauJeanOSI
-uses:
+uses, as :mod:`impactqp.kernels.step` specifies it for every loop:
 
 1. closed contacts: gᵢ(q_k) + ½h γᵢ(v_k) ≤ 0 (the gap predicted half a step ahead);
 2. free velocity: v_free = v_k + Ŵ⁻¹ h((1 − θ)f_k + θf_{k+1} − Kq_k − hθKv_k), with the
    iteration matrix Ŵ = M + h²θ²K of a :class:`~impactqp.simulation.system.LinearForce`
    (Ŵ = M and K = 0 otherwise; a callable force is evaluated at (t_k, q_k, v_k) and at
    (t_{k+1}, q_k + hv_k, v_k));
-3. the impact problem (Ŵ, H_closed, u⁻ = v_free) of each cluster, solved with the law through
+3. the closed contacts' problem in step form, with q = H_Cᵀv_free + Eγ_k: for the
+   frictionless laws each cluster (Ŵ, H_closed, u⁻ = v_free) solved through
    :func:`impactqp.solve` (complementarity laws in the step form
-   ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k``), giving v_{k+1} = u⁺;
+   ``0 ≤ Λ ⟂ γ_{k+1} + Eγ_k``, :class:`~.impacts.ImpactSolver`), for Coulomb's law the
+   local frictional problem of the closed set in contact units
+   (:class:`~.friction_step.FrictionSolver`), giving v_{k+1};
 4. q_{k+1} = q_k + h((1 − θ)v_k + θv_{k+1}).
 
-Four loops run these steps, chosen by :func:`route`. A
-:class:`~impactqp.laws.coulomb.Coulomb` law on a system with ``contact_dim`` 2 or 3 takes a
-frictional loop (docs/theory.md §17): the compiled one
-(:class:`~impactqp.simulation.friction_loop.CompiledFriction`) under the conditions of the
-compiled loop below, else the Python loop with
-:class:`~impactqp.simulation.friction_step.FrictionStep` as its step; a Coulomb law on a
+The Python loop runs :class:`Step` (1., 2., the solver's 3.) and
+:func:`impactqp.kernels.step.end_step` (4.) step after step; its two kinds differ only in
+the solver the step calls. Two compiled loops run the same steps, chosen by
+:func:`route`: a :class:`~impactqp.laws.coulomb.Coulomb` law on a system with
+``contact_dim`` 2 or 3 takes the compiled frictional loop
+(:class:`~impactqp.simulation.friction_loop.CompiledFriction`, docs/theory.md §17) under the
+conditions of the compiled loop below, else the Python loop; a Coulomb law on a
 frictionless system or another law on a frictional system are refused by name. The
 compiled loop (:func:`impactqp.kernels.moreau_jean.run`) takes a run when
 :func:`compiled_applies` says so: a built-in complementarity law (Moreau, Newton, Frémond,
 by exact type), a constant or linear force, ``backend="auto"`` and a system small enough to
 be held dense. Every other run — a callable force, any other law (the sector and reflection
-laws, LZB, a user's law), a named backend, a large system — takes the Python loop, which
-solves each cluster through :func:`impactqp.solve`. A step whose compiled certificate fails
-is solved again by the Python loop's step (which raises what it raises), and the compiled
-loop resumes after it.
+laws, LZB, a user's law), a named backend, a large system — takes the Python loop. A step
+whose compiled certificate fails is solved again by the Python loop's step (which raises
+what it raises), and the compiled loop resumes after it.
 """
 
 from __future__ import annotations
@@ -39,8 +42,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.checks import DEFAULT_TOL
-from ..kernels.moreau_jean import CHECKED, run
+from ..kernels.moreau_jean import CHECKED, Chain, Impacts, run, worst_step
 from ..kernels.residuals import RESIDUALS
+from ..kernels.step import Contacts, Force, Record, Scheme, activation, end_step
+from ..kernels.units import contact_units
 from ..laws.base import ImpactLaw
 from ..laws.certificate import Certificate
 from ..laws.result import ImpactResult
@@ -48,9 +53,9 @@ from ..model.problem import ImpactProblem
 from ..model.residuals import restitution_matrix
 from ..model.structure import ImpactStructure
 from .clusters import ClusterCache
-from .compiled_driver import CompiledDriver
+from .compiled_driver import CompiledDriver, compressed_rows
 from .friction_loop import CompiledFriction
-from .friction_step import FrictionEvent, FrictionStep
+from .friction_step import FrictionEvent, FrictionSolver
 from .impacts import ImpactEvent, ImpactSolver
 from .routing import compiled_applies as compiled_applies  # re-exported: imported from here
 from .routing import route
@@ -100,16 +105,16 @@ class _FreeVelocity:
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         return v - self.solver.solve_mass(self.residual(t, q, v))
 
-    def kernel_arrays(self, t0: float) -> tuple:
-        """(L of Ŵ = LLᵀ, K, c, Ŵ⁻¹r, linear): the force as the compiled loops take it, for
-        a linear force or (Ŵ⁻¹r formed once) a constant one."""
+    def kernel_force(self, t0: float) -> Force:
+        """The force as the compiled loops take it: a linear force, or a constant one with
+        Ŵ⁻¹r formed once."""
         n = self.system.n_dof
         if self.K is not None:
             K = self.K.toarray() if sp.issparse(self.K) else self.K
-            return (self.solver.cholesky_factor, np.ascontiguousarray(K, dtype=float),
-                    self.constant, np.zeros(n), True)
+            return Force(self.solver.cholesky_factor, np.ascontiguousarray(K, dtype=float),
+                         self.constant, np.zeros(n), True)
         shift = self.solver.solve_mass(self.residual(t0, self.system.q0, self.system.v0))
-        return np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0), shift, False
+        return Force(np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0), shift, False)
 
 
 def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
@@ -168,35 +173,23 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     L = np.zeros((kept.size, m))
     Q[0], V[0] = system.q0, system.v0
     report = max(1, steps // 200)
-    step: _Step | FrictionStep
+    solver: ImpactSolver | FrictionSolver
     if loop.startswith("friction"):
-        step = FrictionStep(system, free, law, h, theta, t0, backend=backend, tol=tol)
+        solver = FrictionSolver(system, free, law, backend=backend, tol=tol)
     else:
         cache = ClusterCache(free.metric, system.H, system.chain)
-        step = _Step(system, free, ImpactSolver(cache, law, backend=backend, tol=tol),
-                     h, theta, t0)
-    events: list[ImpactEvent | FrictionEvent] | Callable[[], list[ImpactEvent]]
+        solver = ImpactSolver(cache, law, backend=backend, tol=tol)
+    step = Step(system, free, solver, Scheme(float(h), float(theta), float(tol)), t0)
+    events: list[ImpactEvent | FrictionEvent] | Callable[[], list]
     if loop == "compiled":
-        events = _CompiledLoop(system, law, free, step, tol, keep_events).run(
-            steps, kept, Q, V, L, report, progress)
+        events = _CompiledLoop(step, law, keep_events).run(steps, kept, Q, V, L, report,
+                                                           progress)
     elif loop == "friction-compiled":
         events = CompiledFriction(step, keep_events).run(steps, kept, Q, V, L, report,
                                                          progress)
     else:
-        events = []
-        q, v = system.q0.copy(), system.v0.copy()
-        row = 1
-        for k in range(steps):
-            q, v, lam, new = step(k, q, v)
-            if keep_events:
-                events.extend(new)
-            if row < kept.size and kept[row] == k + 1:
-                Q[row], V[row] = q, v
-                if lam is not None:
-                    L[row] = lam
-                row += 1
-            if progress is not None and (k + 1) % report == 0:
-                progress(t0 + (k + 1) * h)
+        events = _python_loop(step, steps, Record(kept, Q, V, L), keep_events, report,
+                              progress)
     settings = {"h": h, "theta": theta, "t0": t0, "t_end": t_end, "steps": steps,
                 "backend": backend, "tol": tol, "record_every": record_every,
                 "keep_events": keep_events,
@@ -204,38 +197,72 @@ def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
     return Trajectory(system, law, "moreau-jean", T, Q, V, L, events, settings)
 
 
-class _Step:
-    """One step of the Python loop: (q_{k+1}, v_{k+1}, Λ or None, events) from (q_k, v_k)."""
 
-    def __init__(self, system: LinearSystem, free: _FreeVelocity, solver: ImpactSolver,
-                 h: float, theta: float, t0: float) -> None:
+
+def _python_loop(step: Step, steps: int, record: Record, keep: bool, report: int,
+                 progress: Callable[[float], None] | None) -> list:
+    """The Python loop: ``step`` and :func:`impactqp.kernels.step.end_step` step after step;
+    returns the events (none without ``keep``)."""
+    events: list = []
+    q, v = step.system.q0.copy(), step.system.v0.copy()
+    row = 1
+    for k in range(steps):
+        v_next, lam, new = step(k, q, v)
+        row = end_step(q, v, v_next, lam, step.h, step.theta, k, row, *record)
+        if keep:
+            events.extend(new)
+        if progress is not None and (k + 1) % report == 0:
+            progress(step.t0 + (k + 1) * step.h)
+    return events
+
+
+class Step:
+    """Steps 1–3 of the Python loop (docs/theory.md §14, §17): (v_{k+1}, impulses, events)
+    from (q_k, v_k), by the rules of :mod:`impactqp.kernels.step`.
+
+    Parameters
+    ----------
+    system : LinearSystem
+        It hands the step its gaps g(q_k), normal velocities γ_k and (through ``free``)
+        v_free.
+    free : _FreeVelocity
+        v_free of the θ-method, with Ŵ and its factorization.
+    solver : ImpactSolver or FrictionSolver
+        The closed contacts' problem in step form (q = H_Cᵀv_free + Eγ_k): the frictionless
+        laws cluster by cluster through :func:`impactqp.solve`, Coulomb's law as one local
+        problem in contact units; the only difference between the two kinds of run.
+    scheme : Scheme
+        h, θ and the tolerance.
+    t0 : float
+    """
+
+    def __init__(self, system: LinearSystem, free: _FreeVelocity,
+                 solver: ImpactSolver | FrictionSolver, scheme: Scheme, t0: float) -> None:
         self.system, self.free, self.solver = system, free, solver
-        self.h, self.theta, self.t0 = h, theta, t0
+        self.scheme, self.h, self.theta, self.t0 = scheme, scheme.h, scheme.theta, t0
 
     def __call__(self, k: int, q: np.ndarray, v: np.ndarray,
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, list[ImpactEvent]]:
-        h, theta, system = self.h, self.theta, self.system
-        closed = system.gaps(q) + (0.5 * h) * system.contact_velocities(v) <= 0.0
+                 ) -> tuple[np.ndarray, np.ndarray, list]:
+        system, h = self.system, self.h
+        gamma = np.ascontiguousarray(system.contact_velocities(v), dtype=float)
+        closed = np.empty(gamma.size, dtype=bool)
+        count = activation(np.ascontiguousarray(system.gaps(q), dtype=float), gamma, h, closed)
         v_free = self.free(self.t0 + k * h, q, v)
-        if closed.any():
-            v_next, lam, new = self.solver.solve(self.t0 + (k + 1) * h, v_free, closed,
-                                                 v_previous=v)
-        else:
-            v_next, lam, new = v_free, None, []
-        return q + h * ((1.0 - theta) * v + theta * v_next), v_next, lam, new
+        if count == 0:
+            return v_free, np.zeros(system.H.shape[1]), []
+        return self.solver.solve(self.t0 + (k + 1) * h, v_free, closed, v_previous=v,
+                                 gamma_previous=gamma)
 
 
 class _CompiledLoop(CompiledDriver):
-    """The arrays of :func:`impactqp.kernels.moreau_jean.run`, formed once per run, the calls
-    of the kernel (resumed after a step solved by the Python loop or after enlarging the
-    event buffers) and the events built from what the kernel recorded."""
+    """The arrays of :func:`impactqp.kernels.moreau_jean.run`, formed once per run, and the
+    events built from what the kernel recorded; the calls of the kernel are the driver's."""
 
-    def __init__(self, system: LinearSystem, law: ImpactLaw, free: _FreeVelocity,
-                 step: _Step, tol: float, keep: bool) -> None:
-        self.system, self.law, self.free, self.step = system, law, free, step
-        self.tol, self.keep, self.kernel = tol, keep, run
-        self.q0, self.v0 = system.q0, system.v0
-        m = system.n_contacts
+    def __init__(self, step: Step, law: ImpactLaw, keep: bool) -> None:
+        system, free = step.system, step.free
+        n, m = system.n_dof, system.n_contacts
+        super().__init__(step, run, keep, worst_step(n, m))
+        self.law = law
         Wh = np.ascontiguousarray(free.metric, dtype=float)
         H = np.ascontiguousarray(system.H, dtype=float)
         cache = step.solver.cache
@@ -246,68 +273,47 @@ class _CompiledLoop(CompiledDriver):
         else:
             full = ImpactStructure(Wh, H)
             MinvH, G = full.dense_Minv_W, np.asarray(full.delassus)
-        Ht = sp.csr_matrix(H.T)
-        Ht.sort_indices()
-        self.force = free.kernel_arrays(step.t0)
+        G = np.ascontiguousarray(G, dtype=float)
         pairs = np.argwhere(np.triu(Wh != 0.0, 1))
+        self.contacts = Contacts(*compressed_rows(H), system.b, 1, Wh,
+                                 np.ascontiguousarray(pairs[:, 0], dtype=np.int64),
+                                 np.ascontiguousarray(pairs[:, 1], dtype=np.int64),
+                                 np.ascontiguousarray(MinvH), G,
+                                 contact_units(np.diag(G).copy(), 1))
+        self.force = free.kernel_force(step.t0)
         E = law.step_restitution(np.arange(m))
-        self.geometry = (Ht.indptr.astype(np.int64), Ht.indices.astype(np.int64),
-                         Ht.data.astype(float), system.b, Wh)
-        self.impacts = (np.ascontiguousarray(MinvH), np.ascontiguousarray(G, dtype=float),
-                        np.sqrt(np.diag(G)),
-                        restitution_matrix(E, m), np.ndim(E) < 2,
-                        np.ascontiguousarray(pairs[:, 0], dtype=np.int64),
-                        np.ascontiguousarray(pairs[:, 1], dtype=np.int64))
-        self.passive = np.zeros(m, dtype=bool)
+        if np.ndim(E) < 2:
+            e, matrix = np.ascontiguousarray(np.broadcast_to(E, (m,)), dtype=float), \
+                np.zeros((0, 0))
+        else:
+            e, matrix = np.zeros(0), np.ascontiguousarray(restitution_matrix(E, m))
+        self.impacts = Impacts(e, matrix, np.zeros(m, dtype=bool))
         if cache.chain is not None and np.ndim(E) == 0:  # runs of balls: isotonic
             chain = cache.chain
-            self.chain = (True, cache.diagonal, 1.0 / cache.diagonal, bool(chain.left_wall),
-                          bool(chain.right_wall), float(E))
+            self.chain = Chain(True, cache.diagonal, 1.0 / cache.diagonal,
+                               bool(chain.left_wall), bool(chain.right_wall), float(E))
         else:
-            self.chain = (False, np.zeros(0), np.zeros(0), False, False, 0.0)
-        self.buffers = self._buffers(*(self._room(0, 0, 0) if keep else (0, 0, 0)))
-        self.counts = np.zeros(3, dtype=np.int64)
-        self.pieces: list[tuple[int, int] | list[ImpactEvent]] = []
-
-    @staticmethod
-    def _buffers(events: int, dofs: int, contacts: int) -> tuple[np.ndarray, ...]:
-        """(head, residuals, dofs, contacts, u⁻, u⁺, v_k, Λ) of ``events`` recorded clusters
-        on ``dofs`` degrees of freedom and ``contacts`` contacts in all."""
-        return (np.empty((events, 4), dtype=np.int64), np.empty((events, CHECKED)),
-                np.empty(dofs, dtype=np.int64), np.empty(contacts, dtype=np.int64),
-                np.empty(dofs), np.empty(dofs), np.empty(dofs), np.empty(contacts))
-
-    def _room(self, events: int, dofs: int, contacts: int) -> tuple[int, int, int]:
-        """Buffer sizes for twice what is used plus one step's worst case (a cluster per
-        degree of freedom, every dof and contact in some cluster) and some slack."""
-        n, m = self.system.n_dof, self.system.n_contacts
-        return 2 * events + n + 64, 2 * dofs + n + 256, 2 * contacts + m + 256
-
-    @staticmethod
-    def _used(events: int, dofs: int, contacts: int) -> tuple[int, ...]:
-        """Entries in use of (head, residuals, dofs, contacts, u⁻, u⁺, v_k, Λ)."""
-        return events, events, dofs, contacts, dofs, dofs, dofs, contacts
+            self.chain = Chain(False, np.zeros(0), np.zeros(0), False, False, 0.0)
 
     def kernel_data(self) -> tuple:
-        return (*self.geometry, *self.force, *self.impacts, self.passive, *self.chain,
-                self.tol)
+        return self.contacts, self.force, self.step.scheme, self.impacts, self.chain
 
-    def _event(self, e: int) -> ImpactEvent:
-        """The ImpactEvent of record ``e``: the recorded cluster with its problem, the step
-        law on it and the certificate of the residuals the kernel checked."""
-        head, res, dofs, contacts, um, up, vp, lam = self.buffers
-        step, d0, c0, mc = (int(x) for x in head[e])
-        end = head[e + 1, 1] if e + 1 < self.counts[0] else self.counts[1]
-        d = slice(d0, int(end))
-        c = contacts[c0:c0 + mc].copy()
-        closed = np.zeros(self.system.n_contacts, dtype=bool)
+    def _event(self, step: int, a: int, b: int, ints: np.ndarray,
+               floats: np.ndarray) -> ImpactEvent:
+        """The ImpactEvent of a recorded cluster (``a`` contacts, ``b`` dofs): its problem,
+        the step law on it and the certificate of the residuals the kernel checked."""
+        mc, nc = a, b
+        dofs, c = ints[:nc].copy(), ints[nc:nc + mc].copy()
+        res = floats[:CHECKED]
+        um, up, vp = (floats[CHECKED + i * nc:CHECKED + (i + 1) * nc].copy() for i in range(3))
+        lam = floats[CHECKED + 3 * nc:CHECKED + 3 * nc + mc].copy()
+        closed = np.zeros(self.step.system.n_contacts, dtype=bool)
         closed[c] = True
         (cl,) = self.step.solver.cache.clusters(closed)  # the Python loop's structures
-        problem = ImpactProblem.from_structure(cl.structure, um[d].copy())
-        law = MoreauJeanStep(self.law.step_restitution(c), vp[d].copy())
-        cert = Certificate(dict(zip(RESIDUALS[:CHECKED], res[e].tolist())), self.tol)
-        result = ImpactResult(problem, law.name, law.coefficients_for(problem), up[d].copy(),
-                              lam[c0:c0 + mc].copy(), LOOP_BACKEND, cert, form="impulse",
-                              impact_law=law, attempts=[f"{LOOP_BACKEND}: certified"])
-        return ImpactEvent(self.step.t0 + step * self.step.h, "step", dofs[d].copy(), c,
-                           result)
+        problem = ImpactProblem.from_structure(cl.structure, um)
+        law = MoreauJeanStep(self.law.step_restitution(c), vp)
+        cert = Certificate(dict(zip(RESIDUALS[:CHECKED], res.tolist())), self.step.scheme.tol)
+        result = ImpactResult(problem, law.name, law.coefficients_for(problem), up, lam,
+                              LOOP_BACKEND, cert, form="impulse", impact_law=law,
+                              attempts=[f"{LOOP_BACKEND}: certified"])
+        return ImpactEvent(self.step.t0 + step * self.step.h, "step", dofs, c, result)
