@@ -111,7 +111,7 @@ def test_compiled_and_reference_residuals_agree_on_random_impacts(d: int) -> Non
 
 def test_the_solve_is_judged_by_the_compiled_pass() -> None:
     """iq.solve's certificate holds the compiled pass's values (the reference agrees)."""
-    problem = iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
+    problem = iq.friction.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
     law = iq.Coulomb(0.3, 0.5)
     result = iq.solve(problem, law)
     answer = Answer(result.u_plus, result.impulses, None)
@@ -131,7 +131,7 @@ def test_the_reference_answers_where_the_compiled_pass_does_not_apply() -> None:
     assert law._compiled_residuals(st, problem.u_minus, result.u_plus, result.impulses) is None
     assert result.ok
 
-    sphere = iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
+    sphere = iq.friction.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
     huge = sphere.with_u_minus(sphere.u_minus * 1e200)
     law = iq.Coulomb(0.3)
     result = iq.solve(huge, law)
@@ -142,7 +142,7 @@ def test_the_reference_answers_where_the_compiled_pass_does_not_apply() -> None:
     wrong[1] = 10.0 * abs(wrong[0]) + 1e200
     assert not law.certificate(huge, Answer(result.u_plus, wrong, None), TOL).ok
 
-    small = iq.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
+    small = iq.friction.sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
     result = iq.solve(small, law)
     single = result.impulses.astype(np.float32)  # not float64: the reference judges it
     assert law._compiled_residuals(small.structure, small.u_minus, result.u_plus,
