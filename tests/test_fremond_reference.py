@@ -1,5 +1,5 @@
 """Frémond's law with an asymmetric matrix E in motion, against references written here from
-docs/theory.md §14 (Moreau–Jean) and §3 (one impact), with numpy and a brute-force LCP.
+docs/theory.md §14 and §3 (Moreau–Jean; one impact), with numpy and a brute-force LCP.
 
 Every other simulation test uses a symmetric E, for which E and Eᵀ give the same motion; a
 transposed E (Eᵢⱼ for Eⱼᵢ) anywhere on the way from the law to a step or an impact changes
@@ -109,7 +109,8 @@ def test_event_driven_impacts_with_an_asymmetric_fremond_matrix():
         Minv_W = np.linalg.solve(Md, W)
         g = W.T @ ev.u_minus
         E_c = E[np.ix_(ev.contacts, ev.contacts)]
-        lam = lcp(W.T @ Minv_W, g + E_c @ g)  # §3: 0 ≤ Λ ⟂ γ⁺ + Eγ⁻ ≥ 0, γ⁺ = γ⁻ + GΛ
+        # docs/theory.md §3: 0 ≤ Λ ⟂ γ⁺ + Eγ⁻ ≥ 0, γ⁺ = γ⁻ + GΛ
+        lam = lcp(W.T @ Minv_W, g + E_c @ g)
         u_plus = ev.u_minus + Minv_W @ lam
         scale = np.abs(ev.u_minus).max()
         np.testing.assert_allclose(ev.u_plus, u_plus, rtol=0, atol=1e-10 * scale)
