@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -38,7 +38,7 @@ def _size(value: float) -> float:
     return value if math.isfinite(value) else math.inf
 
 
-@dataclass(frozen=True, eq=False, repr=False)
+@dataclass(frozen=True, eq=False, repr=False, init=False)
 class Certificate:
     """The recomputed residuals of one answer and the one verdict on them
     (docs/theory.md §8): accepted (``ok``, ``bool(cert)``) when every residual is finite
@@ -69,13 +69,26 @@ class Certificate:
 
     values: Mapping[str, float]
     tol: float
-    reported: Mapping[str, float] = field(default_factory=dict, kw_only=True)
-    extras: Mapping[str, Any] = field(default_factory=dict, kw_only=True)
-    tols: Mapping[str, float] = field(default_factory=dict, kw_only=True)
-    names: tuple[str, ...] = field(default=(), kw_only=True)
+    reported: Mapping[str, float]
+    extras: Mapping[str, Any]
+    tols: Mapping[str, float]
+    names: tuple[str, ...]
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "values", {k: as_residual(v) for k, v in self.values.items()})
+    def __init__(self, values: Mapping[str, Any], tol: float, *,
+                 reported: Mapping[str, float] | None = None,
+                 extras: Mapping[str, Any] | None = None,
+                 tols: Mapping[str, float] | None = None, names: tuple[str, ...] = ()) -> None:
+        # written out (not the dataclass's): a certificate is made for every answer, and the
+        # generated one with its default factories and a __post_init__ costs more
+        self.__dict__.update(values=self.stored(values), tol=tol,
+                             reported={} if reported is None else reported,
+                             extras={} if extras is None else extras,
+                             tols={} if tols is None else tols, names=names)
+
+    @staticmethod
+    def stored(values: Mapping[str, Any]) -> dict:
+        """The residuals as stored: floats, NaN as +inf (:func:`as_residual`, inlined)."""
+        return {k: f if (f := float(v)) == f else math.inf for k, v in values.items()}
 
     def __getattr__(self, name: str) -> Any:
         state = self.__dict__
@@ -99,7 +112,12 @@ class Certificate:
     @property
     def ok(self) -> bool:
         """True when every residual is finite and within its tolerance."""
-        return all(math.isfinite(v) and v <= self.tol_of(k) for k, v in self.values.items())
+        if self.tols:
+            return all(math.isfinite(v) and v <= self.tol_of(k) for k, v in self.values.items())
+        for v in self.values.values():  # a loop: read for every answer, all() costs twice
+            if not (math.isfinite(v) and v <= self.tol):
+                return False
+        return True
 
     def peaks(self) -> dict[str, float]:
         """Each residual's value as ``worst`` and ``summary`` rank it."""
@@ -128,7 +146,7 @@ class Certificate:
     def summary(self) -> str:
         """One line: the verdict, the tolerances, every residual and the reported figures."""
         parts = ", ".join(f"{k}={v:.1e}" for k, v in self.peaks().items())
-        own = "".join(f", {k} {t:.0e}" for k, t in self.tols.items())
+        own = "".join(f", {k} {t:.0e}" for k, t in self.tols.items() if t != self.tol)
         line = f"{'ok' if self.ok else 'FAILED'} (tol {self.tol:.0e}{own}): {parts}"
         if self.reported:
             line += "; reported: " + ", ".join(f"{k}={v:.1e}" for k, v in self.reported.items())
@@ -139,7 +157,7 @@ class Certificate:
 
 
 
-@dataclass(frozen=True, eq=False, repr=False)
+@dataclass(frozen=True, eq=False, repr=False, init=False)
 class BatchCertificate(Certificate):
     """The residuals of k impacts, each a (k,) array, with a verdict per row.
 
@@ -151,9 +169,10 @@ class BatchCertificate(Certificate):
     the rows.
     """
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "values", {k: np.asarray(v, dtype=float)
-                                            for k, v in self.values.items()})
+    @staticmethod
+    def stored(values: Mapping[str, Any]) -> dict:
+        """The residuals as stored: one float array per residual."""
+        return {k: np.asarray(v, dtype=float) for k, v in values.items()}
 
     @property
     def ok(self) -> np.ndarray:

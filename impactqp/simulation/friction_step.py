@@ -151,7 +151,7 @@ class FrictionEvent:
 
     @cached_property
     def admissible(self) -> Certificate:
-        """u⁺ ∈ S of the step, with r as witness (:meth:`FrictionSolver.membership`)."""
+        """u⁺ ∈ S of the step, with r as witness (:meth:`!FrictionSolver.membership`)."""
         return self._verdict()
 
     def __repr__(self) -> str:

@@ -120,7 +120,7 @@ class LZB(ImpactLaw):
     Notes
     -----
     Solved by :func:`impactqp.solve` in closed form (backend ``"lzb"``). The result's
-    certificate (:func:`~impactqp.laws.lzb.certificate.lzb_certificate`) carries the
+    certificate (:func:`!impactqp.laws.lzb.certificate.lzb_certificate`) carries the
     integration's record (its extra ``record``): potential energy left per contact,
     dissipated energy, primary-contact switches, steps.
     """
