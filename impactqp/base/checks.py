@@ -87,7 +87,7 @@ class Certificate:
 
     @staticmethod
     def stored(values: Mapping[str, Any]) -> dict:
-        """The residuals as stored: floats, NaN as +inf (:func:`as_residual`, inlined)."""
+        """The residuals as stored: floats, NaN as +inf (:func:`!as_residual`, inlined)."""
         return {k: f if (f := float(v)) == f else math.inf for k, v in values.items()}
 
     def __getattr__(self, name: str) -> Any:
