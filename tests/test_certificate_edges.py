@@ -23,7 +23,7 @@ import scipy.sparse as sp
 import impactqp as iq
 from impactqp.base.checks import NamedChecks
 from impactqp.laws.batch import BatchCertificate
-from impactqp.laws.lzb.certificate import LZBCertificate, lzb_residuals
+from impactqp.laws.lzb.certificate import lzb_certificate, lzb_residuals
 from impactqp.model.residuals import law_residuals
 from impactqp.qp.cones import ConeProgram
 from impactqp.qp.lcp import _residuals as lcp_residuals
@@ -180,8 +180,7 @@ def test_lzb_certificate_at_its_edge(target, factor, verdict):
     # the others, each against its own tolerance, stay below: the target decides
     assert max(v / (tol if k in ("momentum", "impulse_sign") else itol)
                for k, v in res.items() if k != target) <= 0.7 * factor
-    cert = LZBCertificate(**{k: float(v) for k, v in res.items()}, tol=tol,
-                          integration_tol=itol)
+    cert = lzb_certificate({k: float(v) for k, v in res.items()}, tol, itol)
     assert cert.ok is verdict, cert.summary()
 
 

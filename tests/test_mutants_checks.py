@@ -73,3 +73,43 @@ def test_unit_range_holds_the_velocities_worked_with_as_given(scale: float) -> N
     assert low <= scale <= high
     assert 0.0 < low < 1.0 < high
     assert high ** 2 < np.finfo(float).max and low ** 2 > np.finfo(float).tiny
+
+
+@pytest.mark.parametrize("factor, ok", [(0.5, True), (1.0, True), (2.0, False)])
+def test_a_residual_with_its_own_tolerance_is_judged_by_it(factor: float, ok: bool) -> None:
+    # LZB's integration-decided residuals: their own tolerance, the others keep ``tol``
+    own = 1e3 * TOL
+    cert = iq.results.Certificate({"exact": 0.5 * TOL, "integrated": factor * own}, TOL,
+                          tols={"integrated": own})
+    assert cert.ok is ok and cert.tol_of("integrated") == own and cert.tol_of("exact") == TOL
+    assert not iq.results.Certificate({"exact": 2 * TOL}, TOL, tols={"integrated": own}).ok
+    assert f"integrated {own:.0e}" in cert.summary()
+
+
+def test_reported_figures_and_extras_are_shown_not_judged() -> None:
+    cert = iq.results.Certificate({"a": 0.5 * TOL}, TOL, reported={"siconos": 1.0},
+                          extras={"record": "r"}, names=("a", "b"))
+    assert cert.ok and cert.worst == ("a", 0.5 * TOL)
+    assert cert.summary() == "ok (tol 1e-09): a=5.0e-10; reported: siconos=1.0e+00"
+    assert cert.a == 0.5 * TOL and cert.siconos == 1.0 and cert.record == "r"
+    assert cert.b is None  # declared, not held
+    with pytest.raises(AttributeError):
+        cert.c  # noqa: B018
+
+
+def test_the_velocity_error_bound_is_the_root_of_twice_the_gap() -> None:
+    assert iq.results.Certificate({"duality_gap": 8e-12}, TOL).velocity_error_bound == \
+        pytest.approx(4e-6, rel=1e-12)
+    assert iq.results.Certificate({"momentum": 0.0}, TOL).velocity_error_bound is None
+
+
+def test_a_batch_verdict_per_row_at_its_edge() -> None:
+    from impactqp.base.checks import BatchCertificate
+
+    cert = BatchCertificate({"a": [0.5 * TOL, TOL, 2 * TOL, math.nan],
+                             "b": [0.0, 0.0, 0.0, 0.0]}, TOL)
+    assert cert.ok.tolist() == [True, True, False, False] and not cert
+    assert cert.worst == ("a", math.inf)
+    assert bool(BatchCertificate({"a": [0.0, TOL]}, TOL))
+    empty = BatchCertificate({"a": []}, TOL)
+    assert empty.worst == ("none", 0.0) and empty.ok.tolist() == []

@@ -127,6 +127,10 @@ class ImpactLaw(ABC):
         closed form answer. Declared per class: a subclass of a built-in law that does not
         declare it takes the general path; a class that declares a family without its
         methods (:data:`~impactqp.laws.base.FAMILY_METHODS`) is refused when it is defined.
+    residual_names : tuple of str
+        The residuals of the law's certificate (:meth:`residuals`, docs/theory.md §8),
+        readable as its attributes; by default the two every impact law shares,
+        ``("momentum", "impulse_sign")``. A law that checks more declares them.
     restitution_per_contact : bool
         E is diagonal (one coefficient per contact, or one ε for all): contacts whose columns
         of W are parallel, with equal coefficients, act as one and an impact with more
@@ -175,6 +179,7 @@ class ImpactLaw(ABC):
     frictional: ClassVar[bool] = False
     family: ClassVar[str | None] = None
     restitution_per_contact: ClassVar[bool] = False
+    residual_names: ClassVar[tuple[str, ...]] = ("momentum", "impulse_sign")
     compliant: ClassVar[bool] = False
 
     @classmethod
@@ -300,7 +305,7 @@ class ImpactLaw(ABC):
         :meth:`residuals`, each within ``tol`` (docs/theory.md §8). A law whose checks need
         more than the structure (an independent evaluation on the problem) overrides it."""
         return Certificate(self.residuals(problem.structure, problem.u_minus, answer.u_plus,
-                                          answer.impulses), tol)
+                                          answer.impulses), tol, names=self.residual_names)
 
     def __repr__(self) -> str:
         coef = self.coefficients

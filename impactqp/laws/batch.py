@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..base.arrays import as_array, as_count
-from ..base.checks import DEFAULT_TOL
+from ..base.checks import DEFAULT_TOL, BatchCertificate, certified_rows
 from ..errors import BackendUnsuitableError, CertificateError, ShapeError
 from ..kernels.impact import solve_impact_rows
 from ..kernels.residuals import RESIDUALS
@@ -78,33 +78,6 @@ class BatchResult:
         name, value = self.certificate.worst
         return (f"{len(self.u_plus)} impacts by {self.backend} ({self.resolved} re-solved one "
                 f"by one); worst {name} = {value:.1e}")
-
-
-@dataclass(frozen=True)
-class BatchCertificate:
-    """Residuals of k impacts: each a (k,) array; ``ok`` is the per-row verdict."""
-
-    residuals: dict
-    tol: float
-
-    @property
-    def ok(self) -> np.ndarray:
-        return certified_rows(self.residuals, self.tol)
-
-    @property
-    def worst(self) -> tuple[str, float]:
-        """The largest residual over all rows and its name."""
-        if not self.residuals or not len(next(iter(self.residuals.values()))):
-            return "none", 0.0
-        peaks = {k: float(np.max(np.where(np.isfinite(v), v, np.inf))) for k, v in
-                 self.residuals.items()}
-        name = max(peaks, key=peaks.get)
-        return name, peaks[name]
-
-
-def certified_rows(residuals: dict, tol: float) -> np.ndarray:
-    """Rows whose every residual is within ``tol`` (NaN fails)."""
-    return np.all([v <= tol for v in residuals.values()], axis=0)
 
 
 def as_rows(problem: ImpactProblem, U_minus: Any) -> np.ndarray:

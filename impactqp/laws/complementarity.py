@@ -14,6 +14,7 @@ import numpy as np
 
 from ..base.arrays import as_array
 from ..errors import RestitutionError, ShapeError
+from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
 from ..model.programs import impulse_program
 from ..model.structure import ImpactStructure
@@ -44,6 +45,7 @@ class _ComplementarityLaw(ImpactLaw):
 
     forms = ("impulse",)
     homogeneous = True
+    residual_names = RESIDUALS[:4]
 
     @abstractmethod
     def restitution(self, m: int) -> np.ndarray:

@@ -132,6 +132,7 @@ class Coulomb(ImpactLaw):
     always_solvable = False  # μ = 0 with unequal eᵢ is local Newton, which may have none
     homogeneous = True
     frictional = True
+    residual_names = ("momentum", "natural_map", "cone", "complementarity", "non_penetration")
 
     def __init__(self, mu: Any, restitution: Any = 0.0, *, method: str = "auto") -> None:
         self.mu = _coefficient("mu", mu)

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..base.arrays import as_real
 from ..errors import RestitutionError
+from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
 from ..model.programs import impulse_program, velocity_program
 from ..model.structure import ImpactStructure
@@ -64,6 +65,7 @@ class Moreau(ImpactLaw):
     coefficient_symbol = "ε"
     family = MOREAU_FAMILY
     restitution_per_contact = True
+    residual_names = RESIDUALS
 
     def __init__(self, eps: float = 0.0) -> None:
         self.eps = check_eps(eps)

@@ -25,7 +25,7 @@ from ..tables.reflection_group import (
 from ..tables.reflection_table import reflection_law_table
 from .base import Answer, ImpactLaw
 from .certificate import Certificate
-from .sector import sector_residuals
+from .sector import SECTOR_RESIDUALS, sector_residuals
 
 
 @lru_cache(maxsize=32)
@@ -59,6 +59,7 @@ class ReflectionLaw(ImpactLaw):
     closed_form_backend = "reflections"
     always_solvable = True
     homogeneous = True
+    residual_names = SECTOR_RESIDUALS
 
     def check(self, problem: ImpactProblem) -> None:
         check_reflection_problem(problem)
@@ -77,4 +78,4 @@ class ReflectionLaw(ImpactLaw):
         expected = _reference_gamma(problem, group) if problem.n_contacts else None
         res = sector_residuals(problem.structure, problem.u_minus, answer.u_plus,
                                answer.impulses, expected=expected)
-        return Certificate(res, tol)
+        return Certificate(res, tol, names=self.residual_names)

@@ -24,6 +24,9 @@ from .certificate import Certificate
 MASS_RTOL = 1e-12
 """Relative spread of the ball masses below which they count as equal."""
 
+SECTOR_RESIDUALS = ("momentum", "impulse_sign", "energy_balance", "kinematic", "law_residual")
+"""The residuals of :func:`sector_residuals` (the sector and reflection laws)."""
+
 
 def sector_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
                      Lam: np.ndarray, expected: np.ndarray | None = None,
@@ -55,7 +58,7 @@ def certify_sector(problem: ImpactProblem, u_plus: np.ndarray, impulses: np.ndar
                    *, tol: float = DEFAULT_TOL) -> Certificate:
     """Recompute the checks of a sector-law answer (u⁺, Λ) on a chain problem."""
     return Certificate(sector_residuals(problem.structure, problem.u_minus, u_plus, impulses),
-                       tol)
+                       tol, names=SECTOR_RESIDUALS)
 
 
 
@@ -127,6 +130,7 @@ class SectorLaw(ImpactLaw):
     closed_form_backend = "sort"
     always_solvable = True
     homogeneous = True
+    residual_names = SECTOR_RESIDUALS
 
     def check(self, problem: ImpactProblem) -> None:
         check_sector_problem(problem)

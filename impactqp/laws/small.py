@@ -62,8 +62,9 @@ def applies(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str) -> 
 
 
 def _certificate(names: tuple[str, ...], values: np.ndarray, tol: float) -> Certificate:
-    """The certificate of residuals the kernel already checked, built when first read."""
-    return Certificate(dict(zip(names, values.tolist())), tol)
+    """The certificate of residuals the kernel already checked, built when first read; it
+    declares the compiled family's residuals (Moreau's two more read as None otherwise)."""
+    return Certificate(dict(zip(names, values.tolist())), tol, names=RESIDUALS)
 
 
 def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float,

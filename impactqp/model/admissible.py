@@ -20,7 +20,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import as_vector, check_tol
-from ..base.checks import DEFAULT_TOL, UNIT_RANGE, NamedChecks
+from ..base.checks import DEFAULT_TOL, UNIT_RANGE, Certificate
 from ..errors import InputError
 from ..kernels.nnls import solve_nnls
 from ..qp.certified import solve_in_forms
@@ -139,7 +139,7 @@ class AdmissibleSet:
                 else:
                     z, lam = u + st.impulse_velocity(sol.x), sol.x
                 res = law_residuals(st, u, z, lam, 0.0, eps=0.0)
-                return z, NamedChecks({k: float(v) for k, v in res.items()}, tol)
+                return z, Certificate({k: float(v) for k, v in res.items()}, tol)
             return finish
 
         out = solve_in_forms([(f, build[f], finish_for(f)) for f in preferred_forms(p)],

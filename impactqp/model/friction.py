@@ -12,14 +12,13 @@ natural map of :mod:`impactqp.kernels.friction` (docs/theory.md §15).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import as_array, as_count, as_matrix, check_tol
-from ..base.checks import NamedChecks
+from ..base.checks import Certificate
 from ..errors import InputError, OutOfRangeError, ShapeError
 from ..kernels.coulomb_conditions import coulomb_violation_sums
 from ..kernels.friction import natural_map
@@ -231,53 +230,29 @@ def _units_of(problem: FrictionContactProblem, s: np.ndarray) -> ContactUnits:
     return ContactUnits(unit, s, k)
 
 
-@dataclass(frozen=True)
-class FrictionCertificate(NamedChecks):
-    """The recomputed checks of one candidate answer (r, u) of a
-    :class:`FrictionContactProblem`, in its contacts' units: r̂, û and q̂ of
-    :meth:`FrictionContactProblem.in_contact_units`, û = W̃ r̂ + q̂ recomputed (docs/theory.md
-    §15).
+FRICTION_CHECKS = ("natural_map", "velocity", "cone", "dual_cone", "complementarity")
+"""The residuals of a certificate of :func:`certify_friction`."""
 
-    Accepted when each of its ``residuals`` is within ``tol``:
+FrictionCertificate = Certificate
+"""The certificate of a frictional contact problem is a :class:`~impactqp.results.Certificate`
+made by :func:`certify_friction` (the name is kept for code written before there was one
+type). Accepted when each of its residuals is within ``tol``, all in contact units:
 
-    - natural_map: ‖r̂ − P_K(r̂ − ũ)‖ / ‖q̂‖ (Acary–Brémond–Huber's error, the acceptance
-      figure, :func:`impactqp.kernels.friction.natural_map`);
-    - velocity: ‖û − (W̃ r̂ + q̂)‖ / ‖q̂‖ of the u given with r;
+- natural_map: ‖r̂ − P_K(r̂ − ũ)‖ / ‖q̂‖ (Acary–Brémond–Huber's error, the acceptance
+  figure, :func:`impactqp.kernels.friction.natural_map`);
+- velocity: ‖û − (W̃ r̂ + q̂)‖ / ‖q̂‖ of the u given with r;
 
-    and the defining conditions, by the formulas of
-    :func:`impactqp.kernels.coulomb_conditions.coulomb_violation_sums`, which no solver calls:
+and the defining conditions, by the formulas of
+:func:`impactqp.kernels.coulomb_conditions.coulomb_violation_sums`, which no solver calls:
 
-    - cone: r̂_c ∈ K_μc (‖r_T‖ ≤ μ r_n), over max(‖q̂‖, ‖r̂‖);
-    - dual_cone: ũ_c = û_c + μ_c‖û_T,c‖e_n ∈ K_{1/μc} (μ‖ũ_T‖ ≤ ũ_n), over ‖q̂‖;
-    - complementarity: ``|r̂_c·ũ_c|`` / (‖r̂_c‖ + ‖ũ_c‖) contact by contact, over ‖q̂‖.
+- cone: r̂_c ∈ K_μc (‖r_T‖ ≤ μ r_n), over max(‖q̂‖, ‖r̂‖);
+- dual_cone: ũ_c = û_c + μ_c‖û_T,c‖e_n ∈ K_{1/μc} (μ‖ũ_T‖ ≤ ũ_n), over ‖q̂‖;
+- complementarity: ``|r̂_c·ũ_c|`` / (‖r̂_c‖ + ‖ũ_c‖) contact by contact, over ‖q̂‖.
 
-    Reported beside them (``reported``), not part of the verdict: ``siconos_error``
-    ‖F‖/max(‖q̂‖, ‖r̂‖, ‖û‖) and ``penetration`` ‖(−û_n)₊‖/‖q̂‖.
-
-    Parameters
-    ----------
-    values : dict
-        The accepted residuals by name.
-    tol : float
-        Tolerance every accepted residual must meet.
-    reported : dict
-        The figures reported beside them.
-    extras : dict, optional
-        Anything a solver reports beside the residuals.
-    """
-
-    reported: dict = field(default_factory=dict)
-    extras: dict = field(default_factory=dict)
-
-    @property
-    def error(self) -> float:
-        """The acceptance figure ‖F‖/‖q‖ (ABH), in contact units."""
-        return self.values["natural_map"]
-
-    def summary(self) -> str:
-        """One line: the verdict, the tolerance, the residuals and the reported figures."""
-        extra = ", ".join(f"{k}={v:.1e}" for k, v in self.reported.items())
-        return f"{super().summary()}; reported: {extra}"
+Reported beside them (``reported``), not part of the verdict: ``siconos_error``
+‖F‖/max(‖q̂‖, ‖r̂‖, ‖û‖) and ``penetration`` ‖(−û_n)₊‖/‖q̂‖; ``extras["error"]`` is the
+acceptance figure.
+"""
 
 
 def _ratio(num: float, den: float) -> float:
@@ -304,9 +279,26 @@ def _candidate(name: str, value, n: int) -> np.ndarray:
 
 
 def certify_friction(problem: FrictionContactProblem, r, u=None, *,
-                     tol: float = 1e-8) -> FrictionCertificate:
+                     tol: float = 1e-8) -> Certificate:
     """Recompute the certificate of a candidate reaction ``r`` (and velocity ``u``) in the
-    problem's contacts' units (:class:`FrictionCertificate`, docs/theory.md §15).
+    problem's contacts' units (docs/theory.md §15): r̂, û and q̂ of
+    :meth:`FrictionContactProblem.in_contact_units`, û = W̃ r̂ + q̂ recomputed.
+
+    Accepted when each of its residuals is within ``tol``:
+
+    - natural_map: ‖r̂ − P_K(r̂ − ũ)‖ / ‖q̂‖ (Acary–Brémond–Huber's error, the acceptance
+      figure, :func:`impactqp.kernels.friction.natural_map`; also the extra ``error``);
+    - velocity: ‖û − (W̃ r̂ + q̂)‖ / ‖q̂‖ of the u given with r;
+
+    and the defining conditions, by the formulas of
+    :func:`impactqp.kernels.coulomb_conditions.coulomb_violation_sums`, which no solver calls:
+
+    - cone: r̂_c ∈ K_μc (‖r_T‖ ≤ μ r_n), over max(‖q̂‖, ‖r̂‖);
+    - dual_cone: ũ_c = û_c + μ_c‖û_T,c‖e_n ∈ K_{1/μc} (μ‖ũ_T‖ ≤ ũ_n), over ‖q̂‖;
+    - complementarity: |r̂_c·ũ_c| / (‖r̂_c‖ + ‖ũ_c‖) contact by contact, over ‖q̂‖.
+
+    Reported beside them (``reported``), not part of the verdict: ``siconos_error``
+    ‖F‖/max(‖q̂‖, ‖r̂‖, ‖û‖) and ``penetration`` ‖(−û_n)₊‖/‖q̂‖.
 
     Parameters
     ----------
@@ -353,4 +345,5 @@ def certify_friction(problem: FrictionContactProblem, r, u=None, *,
         penetration = _norm(np.maximum(-u_w[::unit.contact_dim], 0.0))
     reported = {"siconos_error": _ratio(fn, max(qn, rn, un)),
                 "penetration": _ratio(penetration, q_scale)}
-    return FrictionCertificate(values, tol, reported)
+    return Certificate(values, tol, reported=reported, names=FRICTION_CHECKS,
+                       extras={"error": values["natural_map"]})

@@ -27,7 +27,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import as_array, as_count, as_matrix
-from ..base.checks import NamedChecks
+from ..base.checks import Certificate
 from ..errors import InputError, ShapeError
 from ..kernels.friction import project_cones
 
@@ -213,7 +213,7 @@ class ConeProgram:
         quad = 0.0 if self.P is None else 0.5 * float(x @ (self.P @ x))
         return quad + float(self.c @ x)
 
-    def certificate(self, x: np.ndarray, z: np.ndarray, tol: float) -> NamedChecks:
+    def certificate(self, x: np.ndarray, z: np.ndarray, tol: float) -> Certificate:
         """The residuals of a primal-dual pair, recomputed from the program (docs/theory.md
         §9), each relative to one plus the size of what it compares:
 
@@ -245,7 +245,7 @@ class ConeProgram:
         def inf(v: np.ndarray) -> float:
             return float(np.abs(v).max()) if v.size else 0.0
 
-        return NamedChecks({
+        return Certificate({
             "primal": inf(s - self.project(s)) / (1.0 + max(inf(self.b), inf(Ax))),
             "dual": inf(z - self.project(z, dual=True)) / (1.0 + inf(z)),
             "stationarity": inf(Px + self.c + Atz) / (1.0 + max(inf(Px), inf(self.c),
@@ -272,7 +272,7 @@ class ConeSolution:
     backend : str
         Who solved it (``"clarabel"``, ``"cvxpy:ECOS"``, ...).
     iterations : int or None
-    checks : NamedChecks or None
+    checks : Certificate or None
         The certificate recomputed by :meth:`ConeProgram.certificate`; set by
         :func:`impactqp.qp.cone_solve.solve_cone`, None straight from a backend.
     """
@@ -283,4 +283,4 @@ class ConeSolution:
     status: str
     backend: str
     iterations: int | None = None
-    checks: NamedChecks | None = None
+    checks: Certificate | None = None

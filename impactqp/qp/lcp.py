@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..base.arrays import as_array, check_tol
-from ..base.checks import DEFAULT_TOL, NamedChecks, ResidualChecks
+from ..base.checks import DEFAULT_TOL, Certificate
 from ..errors import (
     NonConvexLCPError,
     NonSymmetricLCPError,
@@ -58,9 +58,9 @@ class LCPResult:
     solve_time: float = 0.0
 
     @property
-    def certificate(self) -> ResidualChecks:
+    def certificate(self) -> Certificate:
         """The recomputed residuals as a certificate (the same idiom as impact results)."""
-        return NamedChecks(self.residuals, self.tol)
+        return Certificate(self.residuals, self.tol)
 
     @property
     def ok(self) -> bool:
@@ -190,7 +190,7 @@ def solve_psd_lcp(G: Any, q: np.ndarray, backend: str = "auto", *,
     def finish(sol: QPSolution):
         z = np.maximum(sol.x, 0.0)
         w, res = _residuals(Gn, qn, z)
-        return (z, w, res), NamedChecks(res, tol)
+        return (z, w, res), Certificate(res, tol)
 
     out = solve_in_forms([("impulse", lambda: qp, finish)], backend)
     z, w, res = out.answer

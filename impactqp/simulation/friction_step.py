@@ -15,20 +15,19 @@ at velocity level reads it (Siconos' NewtonImpactFrictionNSL).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from functools import cached_property, partial
 
 import numpy as np
 import scipy.sparse as sp
 
-from ..base.checks import NamedChecks
+from ..base.checks import Certificate
 from ..errors import CertificateError, InputError, ShapeError
 from ..kernels.friction import project_cones
 from ..kernels.step import gather_local, step_q
 from ..kernels.units import contact_units
 from ..laws.coulomb import Coulomb
 from ..laws.friction import FRICTION_BACKENDS, FrictionResult, solve_friction
-from ..model.friction import FrictionCertificate, FrictionContactProblem
+from ..model.friction import FrictionContactProblem
 from .system import LinearSystem
 
 NEEDS_TANGENTS = ("Coulomb friction needs tangent columns: build the LinearSystem with "
@@ -81,21 +80,13 @@ def check_friction_backend(backend: str) -> str:
     return backend
 
 
-@dataclass(frozen=True)
-class StepMembership(NamedChecks):
-    """u⁺ ∈ S of a frictional step, proven by the reaction r as witness (docs/theory.md §17):
+STEP_CHECKS = ("kinetic", "kinematic", "energetic")
+"""The residuals of a frictional step's u⁺ ∈ S (:meth:`FrictionSolver.membership`)."""
 
-    - kinetic: ‖Ŵ(u⁺ − u⁻) − H_A P_K(r)‖ / ‖H_A P_K(r)‖ (u⁺ − u⁻ is an impulse from the
-      friction cones, P_K the projection onto them);
-    - kinematic: largest −γ⁺ᵢ/(sᵢ‖u⁻‖) on the closed contacts, or 0 (no penetrating normal
-      velocity; sᵢ² = Wᵢᵢ of the normal row, ‖·‖ the Ŵ-norm);
-    - energetic: (‖u⁺‖² − ‖u⁻‖²)₊ / ‖u⁻‖² in the Ŵ-norm (no kinetic energy gained).
-
-    Truthy when each is within ``tol``.
-    """
-
-    def __bool__(self) -> bool:
-        return self.ok
+StepMembership = Certificate
+"""The verdict u⁺ ∈ S of a frictional step is a :class:`~impactqp.results.Certificate` (made by
+:meth:`FrictionSolver.membership`); the name is kept for code written before there was one
+type."""
 
 
 class FrictionEvent:
@@ -119,7 +110,7 @@ class FrictionEvent:
     u_minus, u_plus : ndarray
         v_free and v_{k+1}.
     verdict : callable
-        Computes the ``StepMembership`` of the step (called on first read of
+        Computes the u⁺ ∈ S certificate of the step (called on first read of
         :attr:`admissible`).
 
     Attributes
@@ -137,7 +128,7 @@ class FrictionEvent:
 
     def __init__(self, time: float, contacts: np.ndarray, problem: FrictionContactProblem,
                  result: FrictionResult, units: np.ndarray, u_minus: np.ndarray,
-                 u_plus: np.ndarray, verdict: Callable[[], StepMembership]) -> None:
+                 u_plus: np.ndarray, verdict: Callable[[], Certificate]) -> None:
         self.time, self.contacts, self.problem, self.result = time, contacts, problem, result
         self.units = units
         self.u_minus, self.u_plus = u_minus, u_plus
@@ -149,7 +140,7 @@ class FrictionEvent:
                         doc="The impulses on the closed contacts' components.")
 
     @property
-    def certificate(self) -> FrictionCertificate:
+    def certificate(self) -> Certificate:
         """The recomputed certificate of the local problem."""
         return self.result.certificate
 
@@ -159,8 +150,8 @@ class FrictionEvent:
         return bool(self.result.certificate.ok)
 
     @cached_property
-    def admissible(self) -> StepMembership:
-        """u⁺ ∈ S of the step, with r as witness (a ``StepMembership``)."""
+    def admissible(self) -> Certificate:
+        """u⁺ ∈ S of the step, with r as witness (:meth:`!FrictionSolver.membership`)."""
         return self._verdict()
 
     def __repr__(self) -> str:
@@ -261,8 +252,17 @@ class FrictionSolver:
                                            v_next, verdict)]
 
     def membership(self, contacts: np.ndarray, u_minus: np.ndarray, u_plus: np.ndarray,
-                   r: np.ndarray) -> StepMembership:
-        """The verdict of :class:`StepMembership` for one recorded step."""
+                   r: np.ndarray) -> Certificate:
+        """u⁺ ∈ S of one recorded step, proven by the reaction r as witness
+        (docs/theory.md §17): a :class:`~impactqp.results.Certificate` of
+
+        - kinetic: ‖Ŵ(u⁺ − u⁻) − H_A P_K(r)‖ / ‖H_A P_K(r)‖ (u⁺ − u⁻ is an impulse from the
+          friction cones, P_K the projection onto them);
+        - kinematic: largest −γ⁺ᵢ/(sᵢ‖u⁻‖) on the closed contacts, or 0 (no penetrating
+          normal velocity; sᵢ² = Wᵢᵢ of the normal row, ‖·‖ the Ŵ-norm);
+        - energetic: (‖u⁺‖² − ‖u⁻‖²)₊ / ‖u⁻‖² in the Ŵ-norm (no kinetic energy gained),
+
+        each within the step's ``tol``."""
         _, H, _, _, units = self.local(contacts)
         d = self.d
         metric = self.free.metric
@@ -277,5 +277,5 @@ class FrictionSolver:
         ref = np.sqrt(norm_minus) if norm_minus > 0 else 1.0
         kinematic = max(0.0, float(np.max(-gamma / (s * ref))))
         energetic = max(0.0, norm_plus - norm_minus) / (norm_minus if norm_minus > 0 else 1.0)
-        return StepMembership({"kinetic": kinetic, "kinematic": kinematic,
-                               "energetic": energetic}, self.tol)
+        return Certificate({"kinetic": kinetic, "kinematic": kinematic,
+                            "energetic": energetic}, self.tol, names=STEP_CHECKS)

@@ -28,6 +28,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..base.checks import Certificate
+
 FloatArray = NDArray[np.float64]
 
 TOL = 1e-12
@@ -69,67 +71,27 @@ class CheckResult:
                 f"  (worst: {self.worst})")
 
 
-@dataclass(frozen=True)
-class TableCertificate:
-    """Exact docs/theory.md §7 certificate of a sector table.
+TABLE_CHECKS = {"kinematic": "kinematic_cones", "kinetic": "kinetic_cones",
+                "energetic": "energetic_cones", "continuity": "discontinuous_pairs",
+                "non_expansive": "expanding_cones",
+                "velocity_non_expansive": "velocity_expanding_cones"}
+"""Each global check of a table (its extra, a :class:`CheckResult`) and the residual that
+counts where it fails: cones (or, for continuity, neighbour pairs) that fail it."""
 
-    ``maximal_monotone`` is True iff the law is continuous across every pair of
-    neighbouring cones and every piece is non-expansive in ``G⁻¹`` and in ``M``;
-    ``reason`` names the failed check and cone, or says why the property holds.
+TableCertificate = Certificate
+"""The exact certificate of a table is a :class:`~impactqp.results.Certificate` (made by
+:func:`certify_sector_table`); the name is kept for code written before there was one
+type."""
 
-    Attributes
-    ----------
-    n_balls : int
-        Number of balls of the chain.
-    n_cones : int
-        Number of cones of the table.
-    n_neighbour_pairs : int
-        Pairs of cones sharing a facet (n−2 rays), checked for continuity.
-    cones : tuple of ConeCheck
-        The per-cone margins and verdicts.
-    kinematic, kinetic, energetic : CheckResult
-        u⁺ ∈ S on every cone: γ⁺ ≥ 0, Λ ≥ 0, and no energy gain (docs/theory.md §2).
-    continuity : CheckResult
-        Neighbouring cones agree on their shared rays.
-    non_expansive, velocity_non_expansive : CheckResult
-        Every piece is non-expansive in G⁻¹ (contact velocities) and in M (velocities).
-    maximal_monotone : bool
-        Continuity and non-expansiveness together (docs/theory.md §6).
-    reason : str
-        The failed check and cone, or why the property holds.
-    """
 
-    n_balls: int
-    n_cones: int
-    n_neighbour_pairs: int
-    cones: tuple[ConeCheck, ...]
-    kinematic: CheckResult
-    kinetic: CheckResult
-    energetic: CheckResult
-    continuity: CheckResult
-    non_expansive: CheckResult
-    velocity_non_expansive: CheckResult
-    maximal_monotone: bool
-    reason: str
-
-    @property
-    def admissible(self) -> bool:
-        """Kinematically, kinetically and energetically consistent on every cone (docs/theory.md
-        §2)."""
-        return self.kinematic.passed and self.kinetic.passed and self.energetic.passed
-
-    @property
-    def checks(self) -> tuple[CheckResult, ...]:
-        """All six global checks, in summary order."""
-        return (self.kinematic, self.kinetic, self.energetic, self.continuity,
-                self.non_expansive, self.velocity_non_expansive)
-
-    def summary(self) -> str:
-        """Plain-text summary, one line per check."""
-        head = (f"Exact certificate of the piecewise-linear law, {self.n_balls} balls, "
-                f"{self.n_cones} cones, {self.n_neighbour_pairs} neighbour pairs:")
-        verdict = f"  maximal monotone: {self.maximal_monotone} — {self.reason}"
-        return "\n".join([head, *(c.line() for c in self.checks), verdict])
+def table_report(cert: Certificate) -> str:
+    """Plain-text report of a table's certificate, one line per check and the verdict on
+    maximal monotonicity."""
+    x = cert.extras
+    head = (f"Exact certificate of the piecewise-linear law, {x['n_balls']} balls, "
+            f"{x['n_cones']} cones, {x['n_neighbour_pairs']} neighbour pairs:")
+    verdict = f"  maximal monotone: {x['maximal_monotone']} — {x['reason']}"
+    return "\n".join([head, *(c.line() for c in x["checks"]), verdict])
 
 
 # --------------------------------------------------------------------------- copositivity
@@ -237,8 +199,25 @@ SectorCertificate = TableCertificate
 """Another name of :class:`TableCertificate`, kept for code written before the rename."""
 
 
-def certify_sector_table(table: Any, exact_energy: bool | None = None) -> TableCertificate:
+def certify_sector_table(table: Any, exact_energy: bool | None = None) -> Certificate:
     """Run every docs/theory.md §7 check on ``table`` (a :class:`~impactqp.tables.SectorTable`).
+
+    The certificate's residuals count, for each check of :data:`TABLE_CHECKS`, the cones
+    (neighbour pairs for continuity) that fail it, with tolerance 0: it is ``ok`` when the
+    law is admissible on every cone and maximal monotone. Its extras:
+
+    - ``n_balls``, ``n_cones``, ``n_neighbour_pairs``: the table's size (pairs of cones
+      sharing a facet, n−2 rays, are checked for continuity);
+    - ``cones``: the per-cone margins and verdicts (:class:`ConeCheck`);
+    - ``kinematic``, ``kinetic``, ``energetic`` (:class:`CheckResult`): u⁺ ∈ S on every
+      cone, γ⁺ ≥ 0, Λ ≥ 0 and no energy gain (docs/theory.md §2); ``admissible``: all
+      three;
+    - ``continuity``: neighbouring cones agree on their shared rays;
+    - ``non_expansive``, ``velocity_non_expansive``: every piece is non-expansive in G⁻¹
+      (contact velocities) and in M (velocities);
+    - ``checks``: the six, in report order (:func:`table_report`);
+    - ``maximal_monotone``: continuity and non-expansiveness together (docs/theory.md §6);
+      ``reason``: the failed check and cone, or why the property holds.
 
     Parameters
     ----------
@@ -337,5 +316,17 @@ def certify_sector_table(table: Any, exact_energy: bool | None = None) -> TableC
     for c in (kinematic, kinetic, energetic):
         if not c.passed:
             reason += f"; note: {c.name} consistency fails on cone '{c.worst}'"
-    return TableCertificate(int(table.n_balls), len(cones), len(pairs), tuple(checks),
-                             kinematic, kinetic, energetic, continuity, non_exp, vel, mm, reason)
+    passing = {"kinematic": kin >= -TOL, "kinetic": lam >= -gscale, "energetic": ener_ok,
+               "continuity": jump <= qscale, "non_expansive": expa <= 1 + TOL,
+               "velocity_non_expansive": vnorm <= 1 + TOL}  # NaN fails each
+    failing = {k: int(np.sum(~np.asarray(v, dtype=bool))) for k, v in passing.items()}
+    results = {"kinematic": kinematic, "kinetic": kinetic, "energetic": energetic,
+               "continuity": continuity, "non_expansive": non_exp,
+               "velocity_non_expansive": vel}
+    extras = {"n_balls": int(table.n_balls), "n_cones": len(cones),
+              "n_neighbour_pairs": len(pairs), "cones": tuple(checks), **results,
+              "checks": tuple(results.values()),
+              "admissible": kinematic.passed and kinetic.passed and energetic.passed,
+              "maximal_monotone": mm, "reason": reason}
+    return Certificate({TABLE_CHECKS[k]: v for k, v in failing.items()}, 0.0,
+                       names=tuple(TABLE_CHECKS.values()), extras=extras)

@@ -12,7 +12,8 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .certificate import TableCertificate, certify_sector_table
+from ..base.checks import Certificate
+from .certificate import certify_sector_table
 
 FloatArray = NDArray[np.float64]
 
@@ -27,7 +28,7 @@ class PiecewiseLinearTable:
         raise TypeError(f"{type(self).__name__} must define find_cones")
 
     @cached_property
-    def certificate(self) -> TableCertificate:
+    def certificate(self) -> Certificate:
         """The exact docs/theory.md §7 certificate of this table (computed once, on first use)."""
         return certify_sector_table(self)
 

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import SectorInputError, SectorTableTooLarge
+from .certificate import table_report
 from .piecewise_table import PiecewiseLinearTable
 
 MAX_TABLE_BALLS = 8
@@ -309,7 +310,7 @@ def format_sector_table(table: SectorTable, include_certificate: bool = True) ->
         *(line.format(*r).rstrip() for r in rows),
     ]
     if include_certificate:
-        out += ["", table.certificate.summary()]
+        out += ["", table_report(table.certificate)]
     return "\n".join(out)
 
 

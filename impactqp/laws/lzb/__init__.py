@@ -3,11 +3,11 @@
 compiled stepper of :mod:`impactqp.kernels.lzb` or scipy's reference (:mod:`.integration`)
 and its certificate (:mod:`.certificate`)."""
 
-from .certificate import LZBCertificate, lzb_residuals
+from .certificate import LZBCertificate, lzb_certificate, lzb_residuals
 from .dynamics import LZBDynamics, Scales, log_force_coefficient
 from .integration import LZBRecord, integrate
 from .law import DEFAULT_RTOL, ENERGY_TARGET, LZB, MIN_RTOL, LZBAnswer
 
 __all__ = ["DEFAULT_RTOL", "ENERGY_TARGET", "LZB", "MIN_RTOL", "LZBAnswer", "LZBCertificate",
            "LZBDynamics", "LZBRecord", "Scales", "integrate", "log_force_coefficient",
-           "lzb_residuals"]
+           "lzb_certificate", "lzb_residuals"]

@@ -4,73 +4,60 @@ and its energy balance, recomputed from u⁻, u⁺, Λ and the integration's rec
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
+from collections.abc import Mapping
 
 import numpy as np
 
-from ...base.checks import ResidualChecks
+from ...base.checks import Certificate
 from ...model.residuals import impact_residuals, kinetic_norms, normalized_rows
 from ...model.structure import ImpactStructure
 from .integration import LZBRecord
 
+LZB_RESIDUALS = ("momentum", "impulse_sign", "kinematic", "energy_balance", "potential_left")
+"""The residuals of an LZB certificate (:func:`lzb_residuals`)."""
 
-@dataclass(frozen=True)
-class LZBCertificate(ResidualChecks):
-    """Recomputed checks of one LZB result (docs/theory.md §8, §13), dimensionless.
+EXACT = ("momentum", "impulse_sign")
+"""The residuals that hold to rounding; the integration's accuracy decides the others."""
 
-    Attributes
+LZBCertificate = Certificate
+"""The certificate of the LZB model is a :class:`~impactqp.results.Certificate` (made by
+:func:`lzb_certificate`); the name is kept for code written before there was one type."""
+
+
+def lzb_certificate(residuals: Mapping[str, float], tol: float, integration_tol: float,
+                    record: LZBRecord | None = None) -> Certificate:
+    """The certificate of one LZB result (docs/theory.md §8, §13), dimensionless.
+
+    Its residuals (:func:`lzb_residuals`):
+
+    - momentum: ‖u⁺ − u⁻ − M⁻¹WΛ‖ / V, the impact equation;
+    - impulse_sign: the largest violation of Λ ≥ 0 (scaled);
+    - kinematic: the largest violation of γ⁺ = Wᵀu⁺ ≥ 0 (scaled): every contact
+      separates or rests;
+    - energy_balance: the size of ‖u⁺‖² + 2ΣEᵢ + 2ΣDᵢ − ‖u⁻‖² over V²: kinetic energy
+      after, plus the potential energy Eᵢ left in the contacts, plus the energy Dᵢ
+      dissipated by restitution, equals the kinetic energy before, to the integration's
+      accuracy;
+    - potential_left: 2ΣEᵢ / V², the integration ended with no compression left.
+
+    Parameters
     ----------
-    momentum : float
-        ‖u⁺ − u⁻ − M⁻¹WΛ‖ / V: the impact equation.
-    impulse_sign : float
-        Largest violation of Λ ≥ 0 (scaled).
-    kinematic : float
-        Largest violation of γ⁺ = Wᵀu⁺ ≥ 0 (scaled): every contact separates or rests.
-    energy_balance : float
-        The size of ‖u⁺‖² + 2ΣEᵢ + 2ΣDᵢ − ‖u⁻‖² over V²: kinetic energy after, plus the
-        potential energy Eᵢ left in the contacts, plus the energy Dᵢ dissipated by
-        restitution, equals the kinetic energy before, to the integration's accuracy.
-    potential_left : float
-        2ΣEᵢ / V²: the integration ended with no compression left.
+    residuals : mapping
+        The five residuals by name.
     tol : float
-        Tolerance of the momentum and impulse-sign residuals (they hold to rounding).
+        Tolerance of momentum and impulse_sign (they hold to rounding).
     integration_tol : float
         Tolerance of the residuals the integration's accuracy decides (energy_balance,
         kinematic, potential_left): ``tol``, or more where the integration's own error
-        estimate is larger (:func:`!integration_tolerance`, docs/theory.md §13).
-    record : LZBRecord or None
-        The integration (primary switches, steps, energies); None when nothing was integrated.
+        estimate is larger (:func:`integration_tolerance`, docs/theory.md §13); the
+        certificate's ``tols`` and its extra ``integration_tol``.
+    record : LZBRecord, optional
+        The integration (primary switches, steps, energies), the extra ``record``; None
+        when nothing was integrated.
     """
-
-    momentum: float
-    impulse_sign: float
-    kinematic: float
-    energy_balance: float
-    potential_left: float
-    tol: float
-    integration_tol: float
-    record: LZBRecord | None = field(default=None, repr=False, compare=False)
-
-    @property
-    def ok(self) -> bool:
-        """Every residual finite and within its tolerance."""
-        res = self.residuals
-        exact = ("momentum", "impulse_sign")
-        return all(math.isfinite(v) and v <= (self.tol if k in exact else self.integration_tol)
-                   for k, v in res.items())
-
-    def summary(self) -> str:
-        """One line: the verdict, both tolerances and every residual."""
-        parts = ", ".join(f"{k}={v:.1e}" for k, v in self.residuals.items())
-        return (f"{'ok' if self.ok else 'FAILED'} (tol {self.tol:.0e}, integration "
-                f"{self.integration_tol:.0e}): {parts}")
-
-    @property
-    def residuals(self) -> dict[str, float]:
-        return {"momentum": self.momentum, "impulse_sign": self.impulse_sign,
-                "kinematic": self.kinematic, "energy_balance": self.energy_balance,
-                "potential_left": self.potential_left}
+    tols = {k: integration_tol for k in residuals if k not in EXACT}
+    return Certificate(residuals, tol, tols=tols, names=LZB_RESIDUALS,
+                       extras={"integration_tol": integration_tol, "record": record})
 
 
 ERROR_FACTOR = 10.0
@@ -90,7 +77,7 @@ def lzb_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
                   Lam: np.ndarray, *, stored: np.ndarray | float = 0.0,
                   left: np.ndarray | float = 0.0, energy_unit: tuple = (1.0, 1.0),
                   elastic: bool = True) -> dict[str, np.ndarray]:
-    """Residuals of :class:`LZBCertificate` for one impact or rows of impacts.
+    """Residuals of :func:`lzb_certificate` for one impact or rows of impacts.
 
     Parameters
     ----------

@@ -16,13 +16,12 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ...base.arrays import as_array, as_real, as_vector
-from ...base.checks import DEFAULT_TOL
+from ...base.checks import DEFAULT_TOL, Certificate
 from ...errors import InputError, RestitutionError, ShapeError
 from ...model.problem import ImpactProblem
 from ...model.structure import ImpactStructure
 from ..base import ImpactLaw
-from ..certificate import as_residual
-from .certificate import LZBCertificate, integration_tolerance, lzb_residuals
+from .certificate import LZB_RESIDUALS, integration_tolerance, lzb_certificate, lzb_residuals
 from .dynamics import LZBDynamics
 from .integration import LZBRecord, integrate
 
@@ -121,8 +120,9 @@ class LZB(ImpactLaw):
     Notes
     -----
     Solved by :func:`impactqp.solve` in closed form (backend ``"lzb"``). The result's
-    certificate (:class:`LZBCertificate`) carries the integration's record: potential energy
-    left per contact, dissipated energy, primary-contact switches, steps.
+    certificate (:func:`!impactqp.laws.lzb.certificate.lzb_certificate`) carries the
+    integration's record (its extra ``record``): potential energy left per contact,
+    dissipated energy, primary-contact switches, steps.
     """
 
     name = "lzb"
@@ -130,6 +130,7 @@ class LZB(ImpactLaw):
     closed_form_backend = "lzb"
     always_solvable = True
     compliant = True
+    residual_names = LZB_RESIDUALS
 
     def __init__(self, stiffness: Any, exponent: Any = 1.5, restitution: Any = 1.0,
                  step: float | None = None, *, rtol: float = DEFAULT_RTOL,
@@ -255,19 +256,16 @@ class LZB(ImpactLaw):
         return lzb_residuals(structure, U_minus, U_plus, impulses, elastic=self.elastic)
 
     def certificate(self, problem: ImpactProblem, answer: Any,
-                    tol: float = DEFAULT_TOL) -> LZBCertificate:
+                    tol: float = DEFAULT_TOL) -> Certificate:
         record = getattr(answer, "record", None)
         if record is None:
             res = lzb_residuals(problem.structure, problem.u_minus, answer.u_plus,
                                 answer.impulses)
-            return LZBCertificate(**{k: as_residual(v) for k, v in res.items()}, tol=tol,
-                                  integration_tol=tol)
+            return lzb_certificate(res, tol, tol)
         res = lzb_residuals(problem.structure, problem.u_minus, answer.u_plus,
                             answer.impulses, stored=record.stored_dimensionless,
                             left=record.left_dimensionless, energy_unit=record.energy_unit)
-        return LZBCertificate(**{k: as_residual(v) for k, v in res.items()}, tol=tol,
-                              integration_tol=integration_tolerance(tol, record),
-                              record=record)
+        return lzb_certificate(res, tol, integration_tolerance(tol, record), record)
 
     def __repr__(self) -> str:
         step = "" if self.step is None else f", step={self.step:g}"
