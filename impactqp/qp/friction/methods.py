@@ -156,9 +156,10 @@ def short_nsgs_route(data: FrictionData, tol: float) -> tuple[np.ndarray, int, b
     """:data:`NSGS_SHORT` sweeps from r = 0, then Newton from there: :data:`QUICK_POLISH`
     steps when the sweeps' rate predicts they reach the tolerance within :data:`NSGS_MORE`
     more, else up to ``POLISH_STEPS``. When Newton has not succeeded, the sweeps go on from
-    their r, in rounds of the predicted number, for as long as
-    each round gains a factor ten in ‖F‖ (else their r is returned, to the next method) and
-    up to :data:`NSGS_MORE` sweeps, after which Newton is tried again (docs/theory.md §15).
+    their r, in rounds of the predicted number, for as long as each round gains a factor
+    ten in ‖F‖ and its rate predicts the tolerance within what is left of
+    :data:`NSGS_MORE` sweeps (else their r is returned, to the next method), after which
+    Newton is tried again (docs/theory.md §15).
     Returns r, the sweeps and steps done, and whether Newton was run last."""
     r, its, left = nsgs_route(data, np.zeros_like(data.q), tol, NSGS_SHORT)
     if left == 0.0 and data.error(r) <= 0.5 * tol:
@@ -178,6 +179,8 @@ def short_nsgs_route(data: FrictionData, tol: float) -> tuple[np.ndarray, int, b
         if err_round <= 0.5 * tol:
             return r, its + more, False
         if not err_round <= 0.1 * err:  # stalling: NSGS will not get there soon
+            return r, its + more, False
+        if left > NSGS_MORE - more:  # its rate says the rest of the budget falls short
             return r, its + more, False
         err = err_round
     r, steps, _ = newton(data, r, tol, max_steps=POLISH_STEPS)
