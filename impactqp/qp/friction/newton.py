@@ -190,11 +190,13 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
     (J + λI)Δ = −Φ with J = A + B W (A, B block-diagonal, from
     :func:`impactqp.kernels.friction.alart_curnier`) and λ = κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²) (J is
     singular where W is; the shift vanishes with Φ), by sparse LU, then backtracking on ‖Φ‖.
+    A step the line search rejects outright is solved again with the shift grown by
+    :data:`SHIFT_GROWTH` (up to :data:`SHIFT_MAX`); each full step shrinks it back.
 
     Stops when the projected r is within tol/2 in ‖F‖/‖q‖ (projecting moves r by up to ‖F‖,
-    hence u by up to ‖W‖‖F‖), after ``max_steps`` steps, or when the line search fails.
-    Returns r projected onto the cones, the steps done, and whether that r is within tol/2
-    (the certificate's figure)."""
+    hence u by up to ‖W‖‖F‖), after ``max_steps`` steps (a rejected step counts), or when
+    the line search fails at the largest shift. Returns r projected onto the cones, the steps
+    done, and whether that r is within tol/2 (the certificate's figure)."""
     q, mu, d, rho = data.q, data.mu, data.d, data.rho
     n, m = data.n, mu.size
     A = np.empty((m, d, d))
