@@ -83,7 +83,9 @@ class ContactBlocks(NamedTuple):
         data = np.matmul(B[self.rows], self.data)
         data[self.diagonal] += A + shift * np.eye(A.shape[1])
         n = A.shape[0] * A.shape[1]
-        return sp.bsr_matrix((data, self.indices, self.indptr), shape=(n, n)).tocsc()
+        J = sp.bsr_matrix((data, self.indices, self.indptr), shape=(n, n)).tocsc()
+        J.eliminate_zeros()  # rows B_c = 0 (a contact coming apart) add no work to the LU
+        return J
 
 
 class FrictionData:
