@@ -7,6 +7,7 @@ with :class:`FrictionData`, the problem's arrays as every friction method uses t
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg as sla
@@ -26,10 +27,65 @@ from . import FrictionProgram
 
 NEWTON_STEPS = 50
 """Most steps of one run of Newton (those that converge here take 5 to 35)."""
+SHIFT_GROWTH = 10.0
+"""Factor by which Newton's shift grows after a step the line search rejects outright (and
+shrinks, back to κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²), after each full step)."""
+SHIFT_MAX = 1.0
+"""Largest shift Newton grows to: the order of J = A + B W itself (ρ_c W_cc has mean diagonal
+one), beyond which the step is a gradient-like one the line search would have accepted."""
 LSTSQ_STEPS = 60
 """Most steps of the least-squares Newton."""
 LSTSQ_MAX = 600
 """Most unknowns d·m for the least-squares Newton (a dense QR per step: 0.1 s at 858)."""
+
+
+class ContactBlocks(NamedTuple):
+    """W stored in d×d blocks, contact by contact (block compressed rows), every diagonal
+    block present: the pattern of Newton's J = A + λI + B W, whose block-diagonal A and B
+    scale W's block rows, so J is assembled from it with one product per stored block.
+
+    Attributes
+    ----------
+    data : (k, d, d) ndarray
+        The stored blocks of W.
+    indices, indptr : ndarray
+        Their block columns and each block row's span, as in scipy's BSR format.
+    rows : (k,) ndarray
+        The block row (contact) of each stored block.
+    diagonal : (m,) ndarray
+        Where the diagonal block of each contact is stored.
+    """
+
+    data: np.ndarray
+    indices: np.ndarray
+    indptr: np.ndarray
+    rows: np.ndarray
+    diagonal: np.ndarray
+
+    @classmethod
+    def of(cls, W: sp.csr_matrix, d: int) -> ContactBlocks:
+        """The blocks of W (explicit zeros added where a diagonal block is not stored)."""
+        n = W.shape[0]
+        coo = W.tocoo()
+        eye = np.repeat(np.arange(n), d)  # every entry of each diagonal block, as zeros
+        cols = (eye // d) * d + np.tile(np.arange(d), n)
+        pattern = sp.coo_matrix((np.concatenate([coo.data, np.zeros(eye.size)]),
+                                 (np.concatenate([coo.row, eye]),
+                                  np.concatenate([coo.col, cols]))),
+                                shape=(n, n)).tobsr(blocksize=(d, d))
+        pattern.sort_indices()
+        rows = np.repeat(np.arange(n // d), np.diff(pattern.indptr))
+        diagonal = np.flatnonzero(pattern.indices == rows)
+        return cls(pattern.data, pattern.indices, pattern.indptr, rows, diagonal)
+
+    def jacobian(self, A: np.ndarray, B: np.ndarray, shift: float) -> sp.csc_matrix:
+        """J = A + shift·I + B W (A, B: one d×d block per contact), for a sparse LU."""
+        data = np.matmul(B[self.rows], self.data)
+        data[self.diagonal] += A + shift * np.eye(A.shape[1])
+        n = A.shape[0] * A.shape[1]
+        J = sp.bsr_matrix((data, self.indices, self.indptr), shape=(n, n)).tocsc()
+        J.eliminate_zeros()  # rows B_c = 0 (a contact coming apart) add no work to the LU
+        return J
 
 
 class FrictionData:
@@ -48,6 +104,7 @@ class FrictionData:
         self._dense: np.ndarray | None = None
         self._qn: float | None = None
         self._rho: np.ndarray | None = None
+        self._blocks: ContactBlocks | None = None
 
     @property
     def W(self) -> sp.csr_matrix:
@@ -86,6 +143,13 @@ class FrictionData:
         if self._rho is None:
             self._rho = scales(self.W.diagonal(), self.d)
         return self._rho
+
+    @property
+    def blocks(self) -> ContactBlocks:
+        """W in blocks of one contact by another (:class:`ContactBlocks`)."""
+        if self._blocks is None:
+            self._blocks = ContactBlocks.of(self.W, self.d)
+        return self._blocks
 
     def velocity(self, r: np.ndarray) -> np.ndarray:
         """u = W r + q."""
@@ -128,21 +192,23 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
     (J + λI)Δ = −Φ with J = A + B W (A, B block-diagonal, from
     :func:`impactqp.kernels.friction.alart_curnier`) and λ = κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²) (J is
     singular where W is; the shift vanishes with Φ), by sparse LU, then backtracking on ‖Φ‖.
+    A step the line search rejects outright is solved again with the shift grown by
+    :data:`SHIFT_GROWTH` (up to :data:`SHIFT_MAX`); each full step shrinks it back.
 
     Stops when the projected r is within tol/2 in ‖F‖/‖q‖ (projecting moves r by up to ‖F‖,
-    hence u by up to ‖W‖‖F‖), after ``max_steps`` steps, or when the line search fails.
-    Returns r projected onto the cones, the steps done, and whether that r is within tol/2
-    (the certificate's figure)."""
-    W, q, mu, d, rho = data.W, data.q, data.mu, data.d, data.rho
+    hence u by up to ‖W‖‖F‖), after ``max_steps`` steps (a rejected step counts), or when
+    the line search fails at the largest shift. Returns r projected onto the cones, the steps
+    done, and whether that r is within tol/2 (the certificate's figure)."""
+    q, mu, d, rho = data.q, data.mu, data.d, data.rho
     n, m = data.n, mu.size
     A = np.empty((m, d, d))
     B = np.empty((m, d, d))
-    blocks = (np.arange(m), np.arange(m + 1))
     scale = float(np.linalg.norm(alart_curnier(np.zeros(n), q, mu, rho, d, False, A, B)))
     u = data.velocity(r)
     phi = alart_curnier(r, u, mu, rho, d, True, A, B)
     f = float(np.linalg.norm(phi))
     steps = 0
+    boost = 1.0
     while True:
         rp = data.finished(r, float(np.linalg.norm(natural_map(r, u, mu, d))), tol)
         if rp is not None:
@@ -150,17 +216,20 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
         if steps == max_steps:
             break
         steps += 1
-        shift = kappa * min(f / (scale or 1.0), 1e-2)
-        J = (sp.bsr_matrix((A, *blocks), shape=(n, n)) + shift * sp.identity(n)
-             + sp.bsr_matrix((B, *blocks), shape=(n, n)) @ W)
+        shift = boost * kappa * min(f / (scale or 1.0), 1e-2)
         try:
-            step = spla.splu(sp.csc_matrix(J)).solve(-phi)
+            step = spla.splu(data.blocks.jacobian(A, B, shift)).solve(-phi)
         except RuntimeError:  # an exactly singular J
             break
         found = backtrack(r, step, f, lambda x: alart_curnier(x, data.velocity(x), mu, rho,
                                                               d, False, A, B))
         if found is None:
-            break  # no descent: stalled
+            if shift >= SHIFT_MAX:
+                break  # no descent even with a shift of J's own scale: stalled
+            boost *= SHIFT_GROWTH  # a step too long along J's near-null directions
+            continue
+        if np.array_equal(found[0], r + step):
+            boost = max(1.0, boost / SHIFT_GROWTH)  # a full step: back towards Newton's
         r = found[0]
         u = data.velocity(r)
         phi = alart_curnier(r, u, mu, rho, d, True, A, B)
