@@ -80,53 +80,66 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     if units.problem is not problem:
         return _rescaled(problem, units, backend, tol)
     start = time.perf_counter()
-    out = solve_local(problem, backend, tol)
-    return _result(out, time.perf_counter() - start)
+    return _result(solve_local(problem, backend, tol), time.perf_counter() - start)
 
 
-def solve_local(problem: FrictionContactProblem, backend: str, tol: float) -> Outcome:
-    """The certified loop on ``problem``; its answer is the method's
-    :class:`~impactqp.qp.friction.FrictionSolution` and u = W r + q."""
+def solve_local(problem: FrictionContactProblem, backend: str, tol: float,
+                units: ContactUnits | None = None) -> Outcome:
+    """The certified loop on ``problem`` or, with ``units``, on ``units.problem`` (the same
+    problem in its contacts' units), each answer then scaled back and certified once, on the
+    problem as given (:func:`_scaled_back`). Its answer is the method's
+    :class:`~impactqp.qp.friction.FrictionSolution` with r and u = W r + q as given."""
+    posed = problem if units is None else units.problem
 
-    def finish(sol: FrictionSolution) -> tuple[tuple[FrictionSolution, np.ndarray],
-                                               FrictionCertificate]:
-        u = problem.velocity(sol.r)
-        return (sol, u), certify_friction(problem, sol.r, u, tol=tol)
+    def finish(sol: FrictionSolution) -> tuple[tuple[FrictionSolution, np.ndarray,
+                                                     np.ndarray], FrictionCertificate]:
+        u = posed.velocity(sol.r)
+        if units is None:
+            return (sol, sol.r, u), certify_friction(problem, sol.r, u, tol=tol)
+        r_given, u_given, cert = _scaled_back(problem, units, sol.r, u, tol)
+        return (sol, r_given, u_given), cert
 
-    planned = plan(backends.FRICTION, problem, finish, backend)
+    planned = plan(backends.FRICTION, posed, finish, backend)
     return solve_certified(planned, named=backend != "auto", tol=tol)
 
 
-def _result(out: Outcome, seconds: float) -> FrictionResult:
-    (sol, u), cert = out.answer, out.checks
-    return FrictionResult(sol.r, u, cert.error, cert, sol.iterations, seconds, out.backend,
-                          out.attempts)
+def _result(out: Outcome, seconds: float, note: tuple[str, ...] = ()) -> FrictionResult:
+    (sol, r, u), cert = out.answer, out.checks
+    return FrictionResult(r, u, cert.error, cert, sol.iterations, seconds, out.backend,
+                          [*note, *out.attempts])
 
 
 def _rescaled(problem: FrictionContactProblem, units: ContactUnits, backend: str,
               tol: float) -> FrictionResult:
     """The problem solved in its contacts' units (W̃ = DWD, q̂ = 2⁻ᵏDq: the normal diagonal
-    one and max|q̂ᵢ| within :data:`~impactqp.model.friction.QUANTITY_RANGE`), the answer
+    one and max|q̂ᵢ| within :data:`~impactqp.model.friction.QUANTITY_RANGE`), each answer
     scaled back (r = 2ᵏ r̂/s, u = 2ᵏ s∘û) and certified on the problem as given
-    (docs/theory.md §15).
+    (docs/theory.md §15)."""
+    start = time.perf_counter()
+    out = solve_local(problem, backend, tol, units)
+    return _result(out, time.perf_counter() - start,
+                   (f"solved in its contacts' units (2^{units.k})",))
+
+
+def _scaled_back(problem: FrictionContactProblem, units: ContactUnits, r_unit: np.ndarray,
+                 u_unit: np.ndarray,
+                 tol: float) -> tuple[np.ndarray, np.ndarray, FrictionCertificate]:
+    """r and u of the problem as given from an answer in contact units, with the certificate
+    on the problem as given: the one certificate of the answer.
 
     Raises
     ------
     OutOfRangeError
-        r or u is beyond the floats, or lands where floats hold it too coarsely for the
-        certificate (the answer in contact units was certified).
+        r or u is beyond the floats, or lands where floats hold it too coarsely for its
+        certificate although the answer in contact units passes its own.
     """
-    start = time.perf_counter()
-    found = solve_friction(units.problem, backend=backend, tol=tol)
-    r, u = units.reaction(found.r), units.velocity(found.u)
+    r, u = units.reaction(r_unit), units.velocity(u_unit)
     if not (np.isfinite(r).all() and np.isfinite(u).all()):
         raise OutOfRangeError("the reaction or velocity of this problem is beyond the floats "
                               f"(2^{units.k} times its answer in contact units)")
     cert = certify_friction(problem, r, u, tol=tol)
-    if not cert.ok:  # certified in contact units: only the floats' range can lose it here
+    if not cert.ok and certify_friction(units.problem, r_unit, u_unit, tol=tol).ok:
         raise OutOfRangeError("floats hold the reaction or velocity of this problem too "
                               f"coarsely for its certificate (2^{units.k} times its answer "
                               f"in contact units): {cert.summary()}")
-    return FrictionResult(r, u, cert.error, cert, found.iterations,
-                          time.perf_counter() - start, found.backend,
-                          [f"solved in its contacts' units (2^{units.k})", *found.attempts])
+    return r, u, cert
