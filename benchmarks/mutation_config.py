@@ -34,7 +34,9 @@ MODULES: dict[str, tuple[str, ...]] = {
         "tests/test_mutants_model_residuals.py", "tests/test_small_path.py",
         "tests/test_verify.py"),
     # the chain's compiled pass
-    "impactqp/kernels/chain.py": ("tests/test_isotonic.py", "tests/test_chain_certificate.py"),
+    "impactqp/kernels/chain.py": (
+        "tests/test_mutants_chain.py", "tests/test_isotonic.py",
+        "tests/test_chain_certificate.py"),
     # the friction certificate's own formulas (r ∈ K_μ, ũ ∈ K*_μ, r·ũ = 0)
     "impactqp/kernels/coulomb_conditions.py": (
         "tests/test_mutants_coulomb_conditions.py", "tests/test_friction_certificate.py",
@@ -224,6 +226,18 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "together with another +∞ term (μr_n overflowing, μ ≈ 1e300), and then the "
         "original's sums are +∞ where the mutant's are NaN, which every verdict refuses alike "
         "(v ≤ tol is false for both)",
+    ("impactqp/kernels/units.py", "core/ReplaceComparisonOperator_Gt_GtE",
+     "if x > w and x < np.inf:", "if x >= w and x < np.inf:"):
+        "where x == w the block's largest entry w is replaced by the same number (±0 only "
+        "while w ≤ 0, which is no unit either way)",
+    ("impactqp/kernels/units.py", "core/NumberReplacer", "w = 0.0", "w = -1.0"):
+        "the search of the block's largest entry starting at −1 instead of 0 may pick an "
+        "entry in (−1, 0], which is no unit either (w > 0 decides), and any positive finite "
+        "entry beats both starts: w ends the same positive number or non-positive",
+    ("impactqp/kernels/units.py", "core/NumberReplacer",
+     "for k in range(1, d):", "for k in range( 0, d):"):
+        "the search of the tangential entries runs only when the normal one is not positive "
+        "and finite, so adding it to the search adds an entry that is never picked",
 }
 """(module, operator, original line, mutated line) — lines stripped — → why no input can tell
 the mutant from the original. Keyed by text rather than line number, so that edits elsewhere

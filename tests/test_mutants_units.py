@@ -78,3 +78,11 @@ def test_the_fallback_is_scale_free():
         np.testing.assert_allclose(contact_units(c * diagonal, 2),
                                    math.sqrt(c) * np.repeat([2.0, math.sqrt(6.0), 3.0], 2),
                                    rtol=1e-14)
+
+
+@pytest.mark.parametrize("d", [1, 3])
+def test_one_contact_with_a_unit_lends_it_to_the_others(d):
+    """The geometric mean of one unit is that unit."""
+    diagonal = np.zeros(3 * d)
+    diagonal[d] = 9.0
+    np.testing.assert_allclose(contact_units(diagonal, d), np.full(3 * d, 3.0), rtol=1e-15)
