@@ -97,6 +97,19 @@ _ROUTE = ("to rounding: which of the two routes (the compiled dense kernel or nu
 _ABS = ("max(|·|) is ≥ 0 > −1: ``initial`` decides only for an empty array, which this one "
         "never is")
 
+_INF_ENTRY = ("an infinite entry of r or u makes the contact's size ‖r‖ + ‖ũ‖ infinite and r·ũ "
+              "infinite or NaN, so e is NaN and both sums are NaN")
+
+_NAN_TERM = ("the test only asks whether the sum is NaN: " + _INF_ENTRY + "; with finite "
+             "entries r_n and u_n are finite, so the sign of either changes nothing")
+
+_NAN_SIGN = ("to the verdict: the test only asks whether the sum is NaN, and turning the sign "
+             "of one non-negative term changes that only where two terms are +∞: "
+             + _INF_ENTRY + "; with finite entries that needs two of a, b, e, ‖r_T‖², ‖u_T‖² "
+             "overflowing (μ ≈ 1e300 or entries ≈ 1e154), and then one of the three figures is "
+             "+∞ or NaN in the original too, which every verdict refuses as it refuses NaN "
+             "(v ≤ tol is false for both)")
+
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ("impactqp/base/checks.py", "core/NumberReplacer",
      "UNIT_RANGE = (1e-100, 1e100)", "UNIT_RANGE = (1e-100, 1e+100)"):
@@ -220,12 +233,28 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "either way the next sweep (done + 1) is not below it and evaluates ‖F‖",
     ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
      "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
+     "if np.isnan(a - b + e + r[k] + u[k] + r_t2 + u_t2):"):
+        _NAN_SIGN,
+    ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
      "if np.isnan(a + b - e + r[k] + u[k] + r_t2 + u_t2):"):
-        "to the verdict: e = |r·ũ|/(‖r‖ + ‖ũ‖) is never −∞, and with e finite or NaN both sums "
-        "are NaN for the same inputs; they differ only where an overflow makes e = +∞ "
-        "together with another +∞ term (μr_n overflowing, μ ≈ 1e300), and then the "
-        "original's sums are +∞ where the mutant's are NaN, which every verdict refuses alike "
-        "(v ≤ tol is false for both)",
+        _NAN_SIGN,
+    ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
+     "if np.isnan(a + b + e - r[k] + u[k] + r_t2 + u_t2):"):
+        _NAN_TERM,
+    ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
+     "if np.isnan(a + b + e + r[k] - u[k] + r_t2 + u_t2):"):
+        _NAN_TERM,
+    ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
+     "if np.isnan(a + b + e + r[k] + u[k] - r_t2 + u_t2):"):
+        _NAN_SIGN,
+    ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 - u_t2):"):
+        _NAN_SIGN,
     ("impactqp/kernels/units.py", "core/ReplaceComparisonOperator_Gt_GtE",
      "if x > w and x < np.inf:", "if x >= w and x < np.inf:"):
         "where x == w the block's largest entry w is replaced by the same number (±0 only "
