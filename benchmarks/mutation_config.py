@@ -17,7 +17,8 @@ MODULES: dict[str, tuple[str, ...]] = {
         "tests/test_mutants_kernels.py", "tests/test_kernels.py", "tests/test_small_path.py"),
     # the active-set LCP solver every compiled impact calls
     "impactqp/kernels/active_set.py": (
-        "tests/test_mutants_kernels.py", "tests/test_kernels.py", "tests/test_small_path.py"),
+        "tests/test_mutants_kernels.py", "tests/test_mutants_active_set.py",
+        "tests/test_kernels.py", "tests/test_small_path.py"),
     # the certificate's residuals, dense and chain
     "impactqp/kernels/residuals.py": (
         "tests/test_mutants_kernels.py", "tests/test_kernels.py", "tests/test_small_path.py",
@@ -33,12 +34,27 @@ MODULES: dict[str, tuple[str, ...]] = {
         "tests/test_mutants_model_residuals.py", "tests/test_small_path.py",
         "tests/test_verify.py"),
     # the chain's compiled pass
-    "impactqp/kernels/chain.py": ("tests/test_chain_certificate.py", "tests/test_isotonic.py"),
+    "impactqp/kernels/chain.py": (
+        "tests/test_mutants_chain.py", "tests/test_isotonic.py",
+        "tests/test_chain_certificate.py"),
+    # the friction certificate's own formulas (r ∈ K_μ, ũ ∈ K*_μ, r·ũ = 0)
+    "impactqp/kernels/coulomb_conditions.py": (
+        "tests/test_mutants_coulomb_conditions.py", "tests/test_friction_certificate.py",
+        "tests/test_friction.py"),
+    # the unit of each contact every frictional problem is posed in
+    "impactqp/kernels/units.py": (
+        "tests/test_mutants_units.py", "tests/test_friction_scales.py", "tests/test_friction.py",
+        "tests/test_friction_certificate.py"),
+    # the one Moreau–Jean step every loop takes
+    "impactqp/kernels/step.py": (
+        "tests/test_mutants_step.py", "tests/test_compiled_moreau_jean.py"),
     # LZB's compliant impact
     "impactqp/kernels/lzb.py": ("tests/test_lzb_kernels.py",),
     "impactqp/kernels/lzb_model.py": ("tests/test_lzb_kernels.py",),
-    # modules under refactoring when this table was written (run them once they settle)
-    "impactqp/kernels/friction.py": ("tests/test_cones.py", "tests/test_friction.py"),
+    # the cone projection, De Saxcé's modified velocity, the natural map, NSGS
+    "impactqp/kernels/friction.py": (
+        "tests/test_mutants_friction.py", "tests/test_cones.py", "tests/test_friction.py"),
+    # under refactoring when this table was written (run it once it settles)
     "impactqp/kernels/moreau_jean.py": ("tests/test_compiled_moreau_jean.py",),
 }
 """Module (path from the repository root) → the test files run against each of its mutants."""
@@ -80,6 +96,19 @@ _ROUTE = ("to rounding: which of the two routes (the compiled dense kernel or nu
 
 _ABS = ("max(|·|) is ≥ 0 > −1: ``initial`` decides only for an empty array, which this one "
         "never is")
+
+_INF_ENTRY = ("an infinite entry of r or u makes the contact's size ‖r‖ + ‖ũ‖ infinite and r·ũ "
+              "infinite or NaN, so e is NaN and both sums are NaN")
+
+_NAN_TERM = ("the test only asks whether the sum is NaN: " + _INF_ENTRY + "; with finite "
+             "entries r_n and u_n are finite, so the sign of either changes nothing")
+
+_NAN_SIGN = ("to the verdict: the test only asks whether the sum is NaN, and turning the sign "
+             "of one non-negative term changes that only where two terms are +∞: "
+             + _INF_ENTRY + "; with finite entries that needs two of a, b, e, ‖r_T‖², ‖u_T‖² "
+             "overflowing (μ ≈ 1e300 or entries ≈ 1e154), and then one of the three figures is "
+             "+∞ or NaN in the original too, which every verdict refuses as it refuses NaN "
+             "(v ≤ tol is false for both)")
 
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ("impactqp/base/checks.py", "core/NumberReplacer",
@@ -197,13 +226,58 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "not strictly equivalent: the sparse solve's Λ is accepted down to −1e-12 instead of "
         "−1e-12·max|Λ| when max|Λ| < 1 (order-one units), and then clipped at 0; the "
         "answer moves by < 1e-12 relative, below every certificate's tolerance",
+    ("impactqp/kernels/friction.py", "core/NumberReplacer",
+     "gap = int(min(max(left, 1.0), CHECK_GAP))", "gap = int(min(max(left, 0.0), CHECK_GAP))"):
+        "left > 0 (both logarithms are negative once tol < err < last_err), so the two differ "
+        "only for left < 1, where the gap is 0 instead of 1: check_at = done or done + 1, and "
+        "either way the next sweep (done + 1) is not below it and evaluates ‖F‖",
+    ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
+     "if np.isnan(a - b + e + r[k] + u[k] + r_t2 + u_t2):"):
+        _NAN_SIGN,
+    ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
+     "if np.isnan(a + b - e + r[k] + u[k] + r_t2 + u_t2):"):
+        _NAN_SIGN,
+    ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
+     "if np.isnan(a + b + e - r[k] + u[k] + r_t2 + u_t2):"):
+        _NAN_TERM,
+    ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
+     "if np.isnan(a + b + e + r[k] - u[k] + r_t2 + u_t2):"):
+        _NAN_TERM,
+    ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
+     "if np.isnan(a + b + e + r[k] + u[k] - r_t2 + u_t2):"):
+        _NAN_SIGN,
+    ("impactqp/kernels/coulomb_conditions.py", "core/ReplaceBinaryOperator_Add_Sub",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 + u_t2):",
+     "if np.isnan(a + b + e + r[k] + u[k] + r_t2 - u_t2):"):
+        _NAN_SIGN,
+    ("impactqp/kernels/units.py", "core/ReplaceComparisonOperator_Gt_GtE",
+     "if x > w and x < np.inf:", "if x >= w and x < np.inf:"):
+        "where x == w the block's largest entry w is replaced by the same number (±0 only "
+        "while w ≤ 0, which is no unit either way)",
+    ("impactqp/kernels/units.py", "core/NumberReplacer", "w = 0.0", "w = -1.0"):
+        "the search of the block's largest entry starting at −1 instead of 0 may pick an "
+        "entry in (−1, 0], which is no unit either (w > 0 decides), and any positive finite "
+        "entry beats both starts: w ends the same positive number or non-positive",
+    ("impactqp/kernels/units.py", "core/NumberReplacer",
+     "for k in range(1, d):", "for k in range( 0, d):"):
+        "the search of the tangential entries runs only when the normal one is not positive "
+        "and finite, so adding it to the search adds an entry that is never picked",
 }
 """(module, operator, original line, mutated line) — lines stripped — → why no input can tell
 the mutant from the original. Keyed by text rather than line number, so that edits elsewhere
 in the module keep the entry."""
 
-_TIE = ("reached only when a variable of P has x = s = 0 exactly (a tie at a vertex), "
-        "which changes the path of the search and not its end: no test has such a tie")
+_TIE = ("reached only when a variable of P has x = s = 0 exactly (a tie at a vertex: at a "
+        "warm start's first move, where every x is 0, or where two variables reach zero in "
+        "one step), which changes which inner step drops the variable, and with it the "
+        "number of outer steps, not the end: the same status, and a solution of the same "
+        "LCP (another of them where G is singular and the solutions many; 3,000 random "
+        "integer LCPs with redundant columns, cold and warm, compared)")
 
 _BUDGET = ("the search's step budget 20m + 50 moved by m or 1: searches take m to 3m steps, "
            "so only an LCP near the budget could tell")
@@ -274,6 +348,12 @@ NOTES: dict[tuple[str, str, str, str], str] = {
         "leaves at once and is blocked instead of being stepped past; this could end a "
         "search with that variable still descending, which no test (150 random LCPs, "
         "redundant contacts, warm starts) has produced",
+    ("impactqp/kernels/friction.py", "core/ReplaceComparisonOperator_Gt_GtE",
+     "active = xn > 0.0", "active = xn >= 0.0"):
+        "Φ is the same ((x_n)₊ = 0 at x_n = 0 either way); only the Jacobian on the kink "
+        "x_n = r_n − ρu_n = 0 exactly changes branch, and both branches are elements of the "
+        "Clarke Jacobian there: a semismooth Newton step may take another path, not to "
+        "another end",
 }
 """Survivors that are not equivalent but not yet killed, keyed as :data:`EQUIVALENT`: what
 they change and why no test sees it. They count as survived."""
