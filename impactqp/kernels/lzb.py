@@ -11,9 +11,9 @@ falsi, and the piece ends at the earliest. Only the live contacts of a piece are
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate._ivp import dop853_coefficients as _dop853
 
 from .jit import inline_kernel, kernel
+from .lzb_groups import Piece, PieceEvents, Stages
 from .lzb_model import (
     DONE,
     ERROR,
@@ -41,13 +41,6 @@ from .lzb_model import (
 EPS = float(np.finfo(float).eps)
 KINK_ITERATIONS = 4
 """Secant steps that place the end of a piece on a kink of the rates."""
-
-
-def dop853_tableau() -> tuple[np.ndarray, ...]:
-    """(A, B, E3, E5, D) of DOP853, for :func:`integrate_impact` (the stage times C are not
-    needed: the rates do not depend on the independent variable)."""
-    return tuple(np.ascontiguousarray(a, dtype=float) for a in
-                 (_dop853.A, _dop853.B, _dop853.E3, _dop853.E5, _dop853.D))
 
 
 @inline_kernel
@@ -87,10 +80,11 @@ def _interpolate(F, x_old, theta, comps, nc, out):
 
 
 @kernel
-def _root(kind, j, k, ga, gb, F, x_old, level, live, nlive, comps, nc, law, indptr, indices,
-          data, gamma0, xt):
+def _root(kind, j, ga, gb, F, x_old, piece, impact, xt):
     """θ ∈ [0, 1] where the event's value on the dense output crosses zero (Illinois' regula
     falsi until the bracket is 4 ulp wide), on the far side of the crossing."""
+    k, live, nlive, comps, nc, level = piece
+    indptr, indices, data, gamma0, law = impact
     if ga == 0.0:
         return 0.0
     if gb == 0.0:
@@ -122,9 +116,12 @@ def _root(kind, j, k, ga, gb, F, x_old, level, live, nlive, comps, nc, law, indp
 
 
 @kernel
-def _rk_step(x, h, k, live, nlive, comps, nc, indptr, indices, data, gamma0, law, A, B, K,
-             xs, gamma, out):
+def _rk_step(x, h, piece, impact, tableau, stages, out):
     """One DOP853 step of length h from x (K[0] = its rates) into ``out``, stages into K."""
+    k, live, nlive, comps, nc = piece.k, piece.live, piece.nlive, piece.comps, piece.nc
+    indptr, indices, data, gamma0, law = impact
+    A, B = tableau.A, tableau.B
+    K, xs, gamma = stages
     for s in range(1, 12):
         _stage(K, A, s, x, h, comps, nc, xs)
         rates(xs, k, live, nlive, indptr, indices, data, gamma0, law, gamma, K[s])
@@ -135,17 +132,17 @@ def _rk_step(x, h, k, live, nlive, comps, nc, indptr, indices, data, gamma0, law
 
 
 @kernel
-def _step_to_kink(x, tau, kind, j, k, g0, level, live, nlive, comps, nc, indptr, indices,
-                  data, gamma0, law, A, B, K, xs, gamma, out, istate):
+def _step_to_kink(x, tau, kind, j, g0, piece, impact, tableau, stages, out, istate):
     """The state where a kink of the rates (a turn, a plastic stop) lies, into ``out``: the
     dense output of the step that crossed it is polluted by the stages past it, so the
     kink is reached by real steps from x, whose stages see only the rates before it; their
     length τ (first guess from the dense output) is refined by the secant method on the
     event's value (docs/theory.md §13)."""
+    k, live, nlive, level = piece.k, piece.live, piece.nlive, piece.level
+    indptr, indices, data, gamma0, law = impact
     t0, ga = 0.0, g0
     for _ in range(KINK_ITERATIONS):
-        _rk_step(x, tau, k, live, nlive, comps, nc, indptr, indices, data, gamma0, law, A, B,
-                 K, xs, gamma, out)
+        _rk_step(x, tau, piece, impact, tableau, stages, out)
         istate[EVALUATIONS] += 11
         g = event_value(kind, j, k, out, level, live, nlive, law, indptr, indices, data,
                         gamma0)
@@ -157,16 +154,20 @@ def _step_to_kink(x, tau, kind, j, k, g0, level, live, nlive, comps, nc, indptr,
 
 
 @kernel
-def _piece(x, k, live, nlive, kinds, contacts, directions, ne, rtol, fixed, max_steps,
-           indptr, indices, data, gamma0, law, A, B, E3, E5, Dd, istate, fstate, work):
+def _piece(x, k, live, nlive, events, rtol, fixed, max_steps, impact, tableau, istate, fstate,
+           work):
     """Integrate one piece from x until its first event (against time when k < 0), x
     replaced by the state there. Returns (status, index of the event or −1 at the end of
     the span). DOP853 with scipy's step-size control at rtol = atol, or, with ``fixed``
     > 0, steps of that length without error control; every step's error estimate (scipy's
     RMS over all 3m components, relative to 1 + |x|) is added to fstate[ERROR]."""
+    indptr, indices, data, gamma0, law = impact
+    A, E3, E5, Dd = tableau.A, tableau.E3, tableau.E5, tableau.D
+    kinds, contacts, directions, ne = events
     m = gamma0.size
     n = 3 * m
     K, xs, x_new, gamma, g_old, g_new, F, xt, comps, e5, e3 = work
+    stages = Stages(K, xs, gamma)
     nc = 3 * nlive
     for a in range(nlive):
         for r in range(3):
@@ -181,6 +182,7 @@ def _piece(x, k, live, nlive, kinds, contacts, directions, ne, rtol, fixed, max_
     rates(x, k, live, nlive, indptr, indices, data, gamma0, law, gamma, K[0])
     istate[EVALUATIONS] += 1
     level = fstate[LEVEL]
+    piece = Piece(k, live, nlive, comps, nc, level)
     for e in range(ne):
         g_old[e] = event_value(kinds[e], contacts[e], k, x, level, live, nlive, law, indptr,
                                indices, data, gamma0)
@@ -195,8 +197,7 @@ def _piece(x, k, live, nlive, kinds, contacts, directions, ne, rtol, fixed, max_
                 return STEP_TOO_SMALL, -1
             t_new = min(t + h_abs, PIECE_SPAN)
             h = t_new - t
-            _rk_step(x, h, k, live, nlive, comps, nc, indptr, indices, data, gamma0, law, A, B,
-                     K, xs, gamma, x_new)
+            _rk_step(x, h, piece, impact, tableau, stages, x_new)
             rates(x_new, k, live, nlive, indptr, indices, data, gamma0, law, gamma, K[12])
             istate[EVALUATIONS] += 12
             _combine(K, E5, 13, comps, nc, e5)
@@ -245,15 +246,13 @@ def _piece(x, k, live, nlive, kinds, contacts, directions, ne, rtol, fixed, max_
                     for r in range(3, 7):
                         F[r, i] *= h
                 dense = True
-            theta = _root(kinds[e], contacts[e], k, g_old[e], g_new[e], F, x, level, live,
-                          nlive, comps, nc, law, indptr, indices, data, gamma0, xt)
+            theta = _root(kinds[e], contacts[e], g_old[e], g_new[e], F, x, piece, impact, xt)
             if theta < first_theta:
                 first, first_theta = e, theta
         if first >= 0:
             if kinds[first] == TURN or kinds[first] == PLASTIC_STOP:
-                _step_to_kink(x, h * first_theta, kinds[first], contacts[first], k,
-                              g_old[first], level, live, nlive, comps, nc, indptr, indices,
-                              data, gamma0, law, A, B, K, xs, gamma, xt, istate)
+                _step_to_kink(x, h * first_theta, kinds[first], contacts[first], g_old[first],
+                              piece, impact, tableau, stages, xt, istate)
             else:
                 _interpolate(F, x, first_theta, comps, nc, xt)
             for c in range(nc):
@@ -271,16 +270,18 @@ def _piece(x, k, live, nlive, kinds, contacts, directions, ne, rtol, fixed, max_
 
 
 @kernel
-def integrate_impact(indptr, indices, data, gamma0, law, rtol, max_steps, max_pieces,
-                     A, B, E3, E5, Dd, y, P, D, left, istate, fstate, primaries):
-    """Integrate one multiple impact piece by piece until every contact is open
-    (docs/theory.md §13): y, P, D and ``left`` (energy still stored when a contact opened)
-    updated in place, the primary contact of each piece into ``primaries``
-    (max_pieces + 1 entries), counters into ``istate``/``fstate``
+def integrate_impact(impact, tableau, rtol, max_steps, max_pieces, y, P, D, left, istate,
+                     fstate, primaries):
+    """Integrate one multiple ``impact`` (:class:`~impactqp.kernels.lzb_model.Impact`) with
+    DOP853's ``tableau`` (:class:`~impactqp.kernels.lzb_groups.Tableau`) piece by piece
+    until every contact is open (docs/theory.md §13): y, P, D and ``left`` (energy still
+    stored when a contact opened) updated in place, the primary contact of each piece into
+    ``primaries`` (max_pieces + 1 entries), counters into ``istate``/``fstate``
     (:func:`impactqp.kernels.lzb_model.new_state`). fstate[FIXED_STEP] > 0 takes fixed
     steps of that (dimensionless) length in the primary impulse, the pieces against time
     staying adaptive. Returns DONE, OUT_OF_STEPS (``max_steps`` accepted steps spent),
     OUT_OF_PIECES or STEP_TOO_SMALL."""
+    indptr, indices, data, gamma0, law = impact
     m = gamma0.size
     n = 3 * m
     work = (np.zeros((16, n)), np.empty(n), np.empty(n), np.zeros(m), np.empty(3 * m + 3),
@@ -307,9 +308,8 @@ def integrate_impact(indptr, indices, data, gamma0, law, rtol, max_steps, max_pi
         piece_state(y, P, D, k, law, x)
         before = P[primary]
         fixed = fstate[FIXED_STEP] if k >= 0 else 0.0
-        status, fired = _piece(x, k, live, nlive, kinds, contacts, directions, ne, rtol,
-                               fixed, max_steps, indptr, indices, data, gamma0, law, A, B,
-                               E3, E5, Dd, istate, fstate, work)
+        status, fired = _piece(x, k, live, nlive, PieceEvents(kinds, contacts, directions, ne),
+                               rtol, fixed, max_steps, impact, tableau, istate, fstate, work)
         if status != DONE:
             return status
         kind = kinds[fired] if fired >= 0 else -1

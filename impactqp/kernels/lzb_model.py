@@ -25,6 +25,8 @@ plastic contact.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from .jit import inline_kernel, kernel
@@ -60,6 +62,26 @@ NEXT, PRIMARY, IN_TIME, SWITCHES, PIECES, STEPS, EVALUATIONS = 0, 1, 2, 3, 4, 5,
 LEVEL, IMPULSE_VARIABLE, FIXED_STEP, ERROR = 0, 1, 2, 3
 # what an integration returns
 DONE, OUT_OF_STEPS, OUT_OF_PIECES, STEP_TOO_SMALL = 0, 1, 2, 3
+
+
+class Impact(NamedTuple):
+    """What the kernels take about an impact (dimensionless, docs/theory.md §13).
+
+    Attributes
+    ----------
+    indptr, indices, data : int, int, float arrays
+        G = WᵀM⁻¹W (scaled) in compressed rows.
+    gamma0 : (m,) float array
+        γ⁻, the contact velocities before the impact.
+    law : (5, m) float array
+        The per-contact constants, rows KAPPA, ETA, POWER, EXPANSION and PLASTIC.
+    """
+
+    indptr: np.ndarray
+    indices: np.ndarray
+    data: np.ndarray
+    gamma0: np.ndarray
+    law: np.ndarray
 
 
 def new_state() -> tuple[np.ndarray, np.ndarray]:

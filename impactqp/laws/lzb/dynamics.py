@@ -23,7 +23,15 @@ import scipy.sparse as sp
 
 from ...base.arrays import Matrix
 from ...errors import InputError
-from ...kernels.lzb_model import ETA, EXPANSION, KAPPA, PLASTIC, POWER, contact_velocities
+from ...kernels.lzb_model import (
+    ETA,
+    EXPANSION,
+    KAPPA,
+    PLASTIC,
+    POWER,
+    Impact,
+    contact_velocities,
+)
 
 
 def log_force_coefficient(stiffness: np.ndarray, exponent: np.ndarray) -> np.ndarray:
@@ -118,7 +126,7 @@ class LZBDynamics:
         return out
 
     @property
-    def structure(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(indptr, indices, data, γ⁻, law): the arguments every kernel of
-        :mod:`impactqp.kernels.lzb` takes about the impact."""
-        return self.indptr, self.indices, self.data, self.gamma0, self.law
+    def structure(self) -> Impact:
+        """(indptr, indices, data, γ⁻, law): what the kernels of :mod:`impactqp.kernels.lzb`
+        take about the impact, grouped."""
+        return Impact(self.indptr, self.indices, self.data, self.gamma0, self.law)

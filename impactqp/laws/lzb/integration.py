@@ -31,7 +31,8 @@ from scipy.integrate import solve_ivp
 
 from ...errors import CertificateError, IntegrationBudgetError
 from ...kernels import lzb_model as kl
-from ...kernels.lzb import dop853_tableau, integrate_impact
+from ...kernels.lzb import integrate_impact
+from ...kernels.lzb_groups import dop853_tableau
 from .dynamics import LZBDynamics
 
 MAX_PIECES = 20_000
@@ -259,10 +260,8 @@ def integrate(dyn: LZBDynamics, *, rtol: float, step: float | None,
         status, primaries = _reference(dyn, rtol, h, budget, y, P, D, left, istate, fstate)
     else:
         buffer = np.empty(MAX_PIECES + 1, dtype=np.int64)
-        indptr, indices, data, gamma0, law = dyn.structure
-        status = integrate_impact(indptr, indices, data, gamma0, law, rtol, budget,
-                                  MAX_PIECES, *dop853_tableau(), y, P, D, left, istate, fstate,
-                                  buffer)
+        status = integrate_impact(dyn.structure, dop853_tableau(), rtol, budget, MAX_PIECES,
+                                  y, P, D, left, istate, fstate, buffer)
         primaries = buffer[:min(int(istate[kl.PIECES]), MAX_PIECES)].tolist()
     if status != kl.DONE:
         raise _budget_error(status, budget, dyn, step, rtol)

@@ -1,0 +1,99 @@
+"""The grouped arguments of the LZB stepper :mod:`impactqp.kernels.lzb` (docs/theory.md §13):
+DOP853's coefficients, the piece being integrated, its events and a step's scratch, each
+unpacked once per call by the kernels that take them. What the kernels take about the impact
+itself is :class:`impactqp.kernels.lzb_model.Impact`.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from scipy.integrate._ivp import dop853_coefficients as _dop853
+
+
+class Tableau(NamedTuple):
+    """DOP853's coefficients (the stage times C are not needed: the rates do not depend on
+    the independent variable).
+
+    Attributes
+    ----------
+    A : (16, 16) float array
+        The stages' coefficients (the last three for the dense output).
+    B : (12,) float array
+        The step's weights.
+    E3, E5 : (13,) float arrays
+        The 3rd- and 5th-order error estimators.
+    D : (4, 16) float array
+        The dense output's coefficients.
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    E3: np.ndarray
+    E5: np.ndarray
+    D: np.ndarray
+
+
+class Piece(NamedTuple):
+    """The piece being integrated, as its steps and events see it.
+
+    Attributes
+    ----------
+    k : int
+        The primary contact, or −1 against time.
+    live, nlive : int array, int
+        The contacts ``live[:nlive]`` that are stepped (the others are open).
+    comps, nc : int array, int
+        Their components ``comps[:nc]`` of x = (z, P, D).
+    level : float
+        The energy level of the piece (fstate[LEVEL]).
+    """
+
+    k: int
+    live: np.ndarray
+    nlive: int
+    comps: np.ndarray
+    nc: int
+    level: float
+
+
+class PieceEvents(NamedTuple):
+    """The events that end a piece (:func:`impactqp.kernels.lzb_model.piece_events`).
+
+    Attributes
+    ----------
+    kinds, contacts, directions : int, int, float arrays
+        Each event's kind, contact and direction (−1: its value falls through 0, +1: rises).
+    n : int
+        How many there are.
+    """
+
+    kinds: np.ndarray
+    contacts: np.ndarray
+    directions: np.ndarray
+    n: int
+
+
+class Stages(NamedTuple):
+    """Scratch of one DOP853 step over 3m components.
+
+    Attributes
+    ----------
+    K : (16, 3m) float array
+        The stages' rates (K[0] the rates at the step's start).
+    xs : (3m,) float array
+        The state of the stage being evaluated.
+    gamma : (m,) float array
+        The contact velocities of the last evaluation.
+    """
+
+    K: np.ndarray
+    xs: np.ndarray
+    gamma: np.ndarray
+
+
+def dop853_tableau() -> Tableau:
+    """DOP853's :class:`Tableau`, as :func:`impactqp.kernels.lzb.integrate_impact` takes it."""
+    return Tableau(*(np.ascontiguousarray(a, dtype=float) for a in
+                     (_dop853.A, _dop853.B, _dop853.E3, _dop853.E5, _dop853.D)))
