@@ -51,6 +51,7 @@ MODULES: dict[str, tuple[str, ...]] = {
     # LZB's compliant impact
     "impactqp/kernels/lzb.py": ("tests/test_lzb_kernels.py",),
     "impactqp/kernels/lzb_model.py": ("tests/test_lzb_kernels.py",),
+    "impactqp/kernels/lzb_groups.py": ("tests/test_lzb_kernels.py",),
     # the cone projection, De Saxcé's modified velocity, the natural map, NSGS
     "impactqp/kernels/friction.py": (
         "tests/test_mutants_friction.py", "tests/test_cones.py", "tests/test_friction.py"),
