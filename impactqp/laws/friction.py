@@ -14,6 +14,7 @@ none that fails is returned.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import numpy as np
 
@@ -28,7 +29,7 @@ from ..model.friction import (
 from ..qp import backends
 from ..qp.certified import Outcome, solve_certified
 from ..qp.friction import FrictionSolution
-from .planner import Route, plan_friction
+from .planner import plan_friction
 from .result import FrictionResult
 
 __all__ = ["FRICTION_BACKENDS", "FrictionResult", "solve_friction"]
@@ -78,24 +79,22 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
                          f"{type(problem).__name__}")
     tol = check_tol(tol)
     start = time.perf_counter()
-    route = plan_friction(problem, backend)  # units and the registry's plan, in one Route
-    out = solve_local(problem, route, backend, tol)
+    # units and the registry's plan, in one Route
+    route = plan_friction(problem, backend, lambda units: _finisher(problem, units, tol))
+    out = solve_certified(route.programs, named=backend != "auto", tol=tol)
     note = () if route.units is None else (f"solved in its contacts' units (2^{route.units.k})",)
     return _result(out, time.perf_counter() - start, note)
 
 
-def solve_local(problem: FrictionContactProblem, route: Route, backend: str,
-                tol: float) -> Outcome:
-    """The certified loop of ``route`` (:func:`~impactqp.laws.planner.plan_friction`) on
-    ``problem`` or, with ``route.units``, on the same problem in its contacts' units, each
-    answer then scaled back and certified once, on the problem as given
-    (:func:`_scaled_back`). Its answer is the method's
-    :class:`~impactqp.qp.friction.FrictionSolution` with r and u = W r + q as given.
-
-    The problem in contact units is W̃ = DWD, q̂ = 2⁻ᵏDq (the normal diagonal one and
-    max|q̂ᵢ| within :data:`~impactqp.model.friction.QUANTITY_RANGE`); an answer is scaled
-    back as r = 2ᵏ r̂/s, u = 2ᵏ s∘û (docs/theory.md §15)."""
-    units = route.units
+def _finisher(problem: FrictionContactProblem, units: ContactUnits | None,
+              tol: float) -> Callable[[FrictionSolution], tuple[tuple, FrictionCertificate]]:
+    """What finishes a method's answer on ``problem`` or, with ``units``, on the same problem
+    in its contacts' units (W̃ = DWD, q̂ = 2⁻ᵏDq: the normal diagonal one and max|q̂ᵢ| within
+    :data:`~impactqp.model.friction.QUANTITY_RANGE`): the answer is scaled back
+    (r = 2ᵏ r̂/s, u = 2ᵏ s∘û) and certified once, on the problem as given
+    (:func:`_scaled_back`, docs/theory.md §15). It gives the method's
+    :class:`~impactqp.qp.friction.FrictionSolution` with r and u = W r + q as given, and the
+    certificate."""
     posed = problem if units is None else units.problem
 
     def finish(sol: FrictionSolution) -> tuple[tuple[FrictionSolution, np.ndarray,
@@ -106,8 +105,7 @@ def solve_local(problem: FrictionContactProblem, route: Route, backend: str,
         r_given, u_given, cert = _scaled_back(problem, units, sol.r, u, tol)
         return (sol, r_given, u_given), cert
 
-    return solve_certified(route.programs._replace(finish=finish), named=backend != "auto",
-                           tol=tol)
+    return finish
 
 
 def _result(out: Outcome, seconds: float, note: tuple[str, ...] = ()) -> FrictionResult:

@@ -25,6 +25,7 @@ units it is posed (docs/theory.md §15).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -35,7 +36,7 @@ from ..model.friction import ContactUnits, FrictionContactProblem
 from ..model.problem import ImpactProblem
 from ..qp import backends
 from ..qp.backends import FORMS, FRICTION
-from ..qp.certified import Plan
+from ..qp.certified import Finish, Plan
 from ..qp.certified import plan as plan_programs
 from . import chain_rows, parallel, small
 from .base import FAMILIES, ImpactLaw
@@ -85,8 +86,7 @@ class Route:
         units, docs/theory.md §15) and each answer scaled back; None solves it as given.
     programs : Plan or None
         The registry's plan of a frictional problem: the friction methods tried in order on
-        the problem as posed (its ``finish`` is the caller's, supplied with
-        ``programs._replace(finish=...)``).
+        the problem as posed, and how each answer is finished.
     """
 
     mode: str
@@ -232,12 +232,14 @@ def plan(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", form: st
     return Route(mode, _loop(problem, law, backend, stepping))
 
 
-def plan_friction(problem: FrictionContactProblem, backend: str = "auto") -> Route:
+def plan_friction(problem: FrictionContactProblem, backend: str,
+                  finish: Callable[[ContactUnits | None], Finish]) -> Route:
     """The :class:`Route` of a local frictional contact problem (mode and path
     ``"friction"``): its units (the problem in its contacts' units,
     :meth:`~impactqp.FrictionContactProblem.in_contact_units`, unless it is already in them)
     and the registry's plan of the friction methods on the problem so posed (``"auto"``: the
-    registry's order; a named method alone).
+    registry's order; a named method alone), whose answers ``finish(units)`` finishes
+    (``units`` None: the problem is posed as given).
 
     Raises
     ------
@@ -250,8 +252,10 @@ def plan_friction(problem: FrictionContactProblem, backend: str = "auto") -> Rou
     """
     units = problem.in_contact_units()
     posed = units.problem
-    return Route("friction", "friction", units=None if posed is problem else units,
-                 programs=plan_programs(FRICTION, posed, None, backend))
+    if posed is problem:
+        units = None
+    return Route("friction", "friction", units=units,
+                 programs=plan_programs(FRICTION, posed, finish(units), backend))
 
 
 def loop_fits(problem: ImpactProblem, backend: str, stepping: Stepping) -> bool:
