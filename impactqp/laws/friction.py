@@ -14,6 +14,7 @@ none that fails is returned.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import numpy as np
 
@@ -26,8 +27,9 @@ from ..model.friction import (
     certify_friction,
 )
 from ..qp import backends
-from ..qp.certified import Outcome, plan, solve_certified
+from ..qp.certified import Outcome, solve_certified
 from ..qp.friction import FrictionSolution
+from .planner import plan_friction
 from .result import FrictionResult
 
 __all__ = ["FRICTION_BACKENDS", "FrictionResult", "solve_friction"]
@@ -76,19 +78,23 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
         raise InputError(f"problem must be a FrictionContactProblem, got "
                          f"{type(problem).__name__}")
     tol = check_tol(tol)
-    units = problem.in_contact_units()
-    if units.problem is not problem:
-        return _rescaled(problem, units, backend, tol)
     start = time.perf_counter()
-    return _result(solve_local(problem, backend, tol), time.perf_counter() - start)
+    # units and the registry's plan, in one Route
+    route = plan_friction(problem, backend, lambda units: _finisher(problem, units, tol))
+    out = solve_certified(route.programs, named=backend != "auto", tol=tol)
+    note = () if route.units is None else (f"solved in its contacts' units (2^{route.units.k})",)
+    return _result(out, time.perf_counter() - start, note)
 
 
-def solve_local(problem: FrictionContactProblem, backend: str, tol: float,
-                units: ContactUnits | None = None) -> Outcome:
-    """The certified loop on ``problem`` or, with ``units``, on ``units.problem`` (the same
-    problem in its contacts' units), each answer then scaled back and certified once, on the
-    problem as given (:func:`_scaled_back`). Its answer is the method's
-    :class:`~impactqp.qp.friction.FrictionSolution` with r and u = W r + q as given."""
+def _finisher(problem: FrictionContactProblem, units: ContactUnits | None,
+              tol: float) -> Callable[[FrictionSolution], tuple[tuple, FrictionCertificate]]:
+    """What finishes a method's answer on ``problem`` or, with ``units``, on the same problem
+    in its contacts' units (W̃ = DWD, q̂ = 2⁻ᵏDq: the normal diagonal one and max|q̂ᵢ| within
+    :data:`~impactqp.model.friction.QUANTITY_RANGE`): the answer is scaled back
+    (r = 2ᵏ r̂/s, u = 2ᵏ s∘û) and certified once, on the problem as given
+    (:func:`_scaled_back`, docs/theory.md §15). It gives the method's
+    :class:`~impactqp.qp.friction.FrictionSolution` with r and u = W r + q as given, and the
+    certificate."""
     posed = problem if units is None else units.problem
 
     def finish(sol: FrictionSolution) -> tuple[tuple[FrictionSolution, np.ndarray,
@@ -99,26 +105,13 @@ def solve_local(problem: FrictionContactProblem, backend: str, tol: float,
         r_given, u_given, cert = _scaled_back(problem, units, sol.r, u, tol)
         return (sol, r_given, u_given), cert
 
-    planned = plan(backends.FRICTION, posed, finish, backend)
-    return solve_certified(planned, named=backend != "auto", tol=tol)
+    return finish
 
 
 def _result(out: Outcome, seconds: float, note: tuple[str, ...] = ()) -> FrictionResult:
     (sol, r, u), cert = out.answer, out.checks
     return FrictionResult(r, u, cert.error, cert, sol.iterations, seconds, out.backend,
                           [*note, *out.attempts])
-
-
-def _rescaled(problem: FrictionContactProblem, units: ContactUnits, backend: str,
-              tol: float) -> FrictionResult:
-    """The problem solved in its contacts' units (W̃ = DWD, q̂ = 2⁻ᵏDq: the normal diagonal
-    one and max|q̂ᵢ| within :data:`~impactqp.model.friction.QUANTITY_RANGE`), each answer
-    scaled back (r = 2ᵏ r̂/s, u = 2ᵏ s∘û) and certified on the problem as given
-    (docs/theory.md §15)."""
-    start = time.perf_counter()
-    out = solve_local(problem, backend, tol, units)
-    return _result(out, time.perf_counter() - start,
-                   (f"solved in its contacts' units (2^{units.k})",))
 
 
 def _scaled_back(problem: FrictionContactProblem, units: ContactUnits, r_unit: np.ndarray,

@@ -28,7 +28,7 @@ from ..qp.certified import FAST_PATHS, solve_in_forms
 from ..qp.program import QPSolution
 from . import parallel, small
 from .base import Answer, ImpactLaw
-from .planner import plan, validate
+from .planner import TRIVIAL, plan, validate
 from .result import ImpactResult
 
 LOG = logging.getLogger(__name__)
@@ -92,7 +92,10 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
     backend : str
         ``"auto"`` (exact fast paths first, then QP solvers, falling back on failure; for
         Coulomb's law the friction methods in the registry's order) or a registered backend
-        that serves the law's program (:func:`impactqp.available_backends`), tried alone.
+        that serves the law's program (:func:`impactqp.available_backends`), tried alone;
+        a law evaluated in closed form also takes its ``closed_form_backend``, and
+        ``"none"`` asks for u⁺ = u⁻, Λ = 0 (an impact without contact or with u⁻ = 0). The
+        result's ``backend`` is always a name this call takes back.
     form : {"auto", "velocity", "impulse"}
         Which program to solve, for laws that have several (they give the same u⁺).
     tol : float
@@ -152,11 +155,16 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         answer = _trivial(problem)
         cert = law.certificate(problem, answer, tol)
         if cert.ok:  # the shortcut answers only when the law's own certificate passes
-            return _result(problem, law, answer, "none", cert, start,
+            return _result(problem, law, answer, TRIVIAL, cert, start,
                            attempts=["no contact or u⁻ = 0: u⁺ = u⁻, Λ = 0"])
         if problem.n_contacts == 0:
             raise CertificateError(f"{law.title} without contacts: u⁺ = u⁻ fails its "
                                    f"certificate, {cert.summary()}")
+    if backend == TRIVIAL:
+        raise BackendUnsuitableError(f"backend={TRIVIAL!r} answers u⁺ = u⁻, Λ = 0, an impact "
+                                     f"without contact or with u⁻ = 0 that {law.title}'s "
+                                     "certificate passes; this one is not: pass "
+                                     "backend='auto'")
     if way == "closed_form":
         return _closed_form(problem, law, backend, tol, start)
 

@@ -1,5 +1,5 @@
-"""Which route answers: the one decision :func:`impactqp.solve`, :func:`impactqp.solve_batch`
-and :func:`impactqp.simulate` share (docs/theory.md §9).
+"""Which route answers: the one decision :func:`impactqp.solve`, :func:`impactqp.solve_batch`,
+:func:`impactqp.solve_friction` and :func:`impactqp.simulate` share (docs/theory.md §9).
 
 The entry points validate their input with :func:`validate` and ask :func:`plan` for a
 :class:`Route`: the units an impact is solved in, the collapse of its parallel contacts,
@@ -18,20 +18,26 @@ never its class. The paths of one impact:
     a law's quadratic programs, tried form by form on the registry's backends.
 
 A compiled answer that misses its certificate falls through to the programs, so the route
-only says where to start.
+only says where to start. A local frictional contact problem (:func:`plan_friction`) has
+one path, the registry's friction methods (form ``"friction"``), and its route says in which
+units it is posed (docs/theory.md §15).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from ..base.arrays import check_tol
 from ..base.checks import UNIT_RANGE
 from ..errors import InputError
+from ..model.friction import ContactUnits, FrictionContactProblem
 from ..model.problem import ImpactProblem
 from ..qp import backends
-from ..qp.backends import FORMS
+from ..qp.backends import FORMS, FRICTION
+from ..qp.certified import Finish, Plan
+from ..qp.certified import plan as plan_programs
 from . import chain_rows, parallel, small
 from .base import FAMILIES, ImpactLaw
 
@@ -44,7 +50,11 @@ impact row by row, the closed form on all rows, the programs (a vectorised fast-
 backend where one takes them, else row by row through :func:`impactqp.solve`)."""
 LOOPS = ("compiled", "python", "friction-compiled", "friction")
 """The loops of a Moreau–Jean run (docs/theory.md §14, §17)."""
-MODES = ("single", "batch", "run")
+MODES = ("single", "batch", "run", "friction")
+
+TRIVIAL = "none"
+"""The backend of the answer u⁺ = u⁻, Λ = 0 of an impact without contact or with u⁻ = 0
+(:func:`impactqp.solve` reports it, and takes it back, refusing it for any other impact)."""
 
 MAX_COMPILED_LOOP = 400
 """Most degrees of freedom and most contact columns a compiled Moreau–Jean loop takes (it
@@ -57,11 +67,13 @@ class Route:
 
     Attributes
     ----------
-    mode : {"single", "batch", "run"}
-        One impact, the rows of a batch, or a Moreau–Jean run.
+    mode : {"single", "batch", "run", "friction"}
+        One impact, the rows of a batch, a Moreau–Jean run, or a local frictional contact
+        problem (:func:`plan_friction`).
     path : str
         Where the answer starts: one of :data:`ROUTES` (one impact), :data:`BATCH_PATHS`
-        (a batch) or :data:`LOOPS` (a run).
+        (a batch), :data:`LOOPS` (a run) or ``"friction"`` (the registry's friction
+        methods).
     scale : float
         Units: the impact is solved with u⁻ divided by ``scale`` and the answer scaled back
         (a homogeneous law whose velocities lie outside the range worked in as given,
@@ -69,12 +81,20 @@ class Route:
     groups : parallel.Groups or None
         The groups of parallel contacts the impact is solved collapsed by
         (:mod:`.parallel`, docs/theory.md §1); None solves it as it is.
+    units : ContactUnits or None
+        Units of a frictional problem: it is solved as ``units.problem`` (in its contacts'
+        units, docs/theory.md §15) and each answer scaled back; None solves it as given.
+    programs : Plan or None
+        The registry's plan of a frictional problem: the friction methods tried in order on
+        the problem as posed, and how each answer is finished.
     """
 
     mode: str
     path: str
     scale: float = 1.0
     groups: parallel.Groups | None = None
+    units: ContactUnits | None = None
+    programs: Plan | None = None
 
 
 _SINGLE = {path: Route("single", path) for path in ROUTES}
@@ -143,7 +163,7 @@ def validate(problem: Any, law: Any, backend: Any, form: Any, tol: Any) -> float
     """
     check_problem(problem)
     check_law(law)
-    if law.forms or backend != law.closed_form_backend:
+    if backend != TRIVIAL and (law.forms or backend != law.closed_form_backend):
         check_backend(backend)
     check_form(law, form)
     tol = check_tol(tol)
@@ -210,6 +230,32 @@ def plan(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", form: st
     if mode != "run" or stepping is None:
         raise InputError(f"mode must be one of {MODES} (with stepping for a run), got {mode!r}")
     return Route(mode, _loop(problem, law, backend, stepping))
+
+
+def plan_friction(problem: FrictionContactProblem, backend: str,
+                  finish: Callable[[ContactUnits | None], Finish]) -> Route:
+    """The :class:`Route` of a local frictional contact problem (mode and path
+    ``"friction"``): its units (the problem in its contacts' units,
+    :meth:`~impactqp.FrictionContactProblem.in_contact_units`, unless it is already in them)
+    and the registry's plan of the friction methods on the problem so posed (``"auto"``: the
+    registry's order; a named method alone), whose answers ``finish(units)`` finishes
+    (``units`` None: the problem is posed as given).
+
+    Raises
+    ------
+    UnknownBackendError
+        Unknown or uninstalled backend.
+    BackendUnsuitableError
+        A named backend that does not solve this frictional problem (the message says why).
+    OutOfRangeError
+        Floats cannot pose the problem in its contacts' units.
+    """
+    units = problem.in_contact_units()
+    posed = units.problem
+    if posed is problem:
+        units = None
+    return Route("friction", "friction", units=units,
+                 programs=plan_programs(FRICTION, posed, finish(units), backend))
 
 
 def loop_fits(problem: ImpactProblem, backend: str, stepping: Stepping) -> bool:

@@ -18,8 +18,11 @@ from ..model.friction import FrictionContactProblem, certify_friction
 from .compiled_driver import CompiledDriver, compressed_rows
 from .friction_step import FrictionEvent
 
-LOOP_BACKEND = "compiled frictional loop"
-"""What answered a step solved inside the compiled loop (its events' ``result.backend``)."""
+LOOP_BACKEND = "nsgs"
+"""What answered a step solved inside the compiled loop (its events' ``result.backend``): the
+registry's projected Gauss–Seidel (the loop runs its compiled sweeps,
+:func:`impactqp.kernels.friction.nsgs`), a name :func:`impactqp.simulate` takes back as
+``backend=`` (the Python loop then solves each step with it)."""
 
 SWEEPS = 500
 """Most Gauss–Seidel sweeps per step before the step goes to :func:`impactqp.solve_friction`."""
