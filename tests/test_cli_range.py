@@ -64,8 +64,11 @@ def test_huge_problem_files_end_in_a_result_or_a_named_error(tmp_path: Path,
     out = subprocess.run([sys.executable, "-m", "impactqp", command[0], str(path),
                           *command[1:]], capture_output=True, text=True, timeout=120)
     assert "Traceback" not in out.stderr and "OverflowError" not in out.stderr
-    if out.returncode == 2:  # the report's energies (|v|² / 2) are beyond the floats
-        assert "left the range of floats" in out.stderr
+    if out.returncode == 2:  # one named error: the report's energies (|v|² / 2) beyond the
+        # floats, or S's cone program refusing a candidate at 1e308 by name
+        assert len(out.stderr.strip().splitlines()) == 1
+        assert "left the range of floats" in out.stderr or \
+            "no backend certified the cone program" in out.stderr, out.stderr
     else:
         assert out.returncode in (0, 1)
         assert not re.search(r"(?<![a-z])[+-]?(inf|nan)(?![a-z])", out.stdout), out.stdout
