@@ -17,7 +17,8 @@ from impactqp.kernels.coulomb_conditions import coulomb_violation_sums
 
 
 def _reference(r: np.ndarray, u: np.ndarray, mu: np.ndarray, d: int):
-    """(cone², dual², complementarity²) summed over the contacts, from §15's definitions."""
+    """(cone², dual², complementarity²) summed over the contacts, from the definitions of
+    docs/theory.md §15."""
     cone = dual = comp = 0.0
     for c, m in enumerate(mu):
         rc, uc = r[c * d:(c + 1) * d], u[c * d:(c + 1) * d]
