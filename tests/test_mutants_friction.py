@@ -3,7 +3,8 @@ written here in numpy from the theory's formulas, written to kill the mutants
 benchmarks/mutation.py makes of impactqp/kernels/friction.py.
 
 The projection on K_μ is written here again from its closed form (docs/theory.md §15): x
-itself when ‖x_T‖ ≤ μx_n, 0 when μ‖x_T‖ ≤ −x_n, else a·(1, μx_T/‖x_T‖) with a = (x_n + μ‖x_T‖)/(1 + μ²).
+itself when ‖x_T‖ ≤ μx_n, 0 when μ‖x_T‖ ≤ −x_n, else a·(1, μx_T/‖x_T‖) with
+a = (x_n + μ‖x_T‖)/(1 + μ²).
 """
 
 from __future__ import annotations
