@@ -48,14 +48,18 @@ def _env(cache) -> dict[str, str]:
 @pytest.mark.timeout(900)
 def test_compile_fills_the_cache_and_later_processes_compile_nothing(tmp_path):
     cache = tmp_path / "numba"
+    # its own session, and early in the suite: run after the dask tests, the compile was
+    # ended by SIGTERM in one CI run (returncode -15)
     done = subprocess.run([sys.executable, "-m", "impactqp", "compile", "--list"],
-                          env=_env(cache), capture_output=True, text=True, timeout=850)
+                          env=_env(cache), capture_output=True, text=True, timeout=850,
+                          start_new_session=True)
     assert done.returncode == 0, done.stderr
     assert "kernels ready" in done.stdout
     assert done.stderr.count(NOTICE) == 1, done.stderr  # said once, however many kernels
     assert str(cache) in done.stderr
     later = subprocess.run([sys.executable, "-c", ROUTES], env=_env(cache),
-                           capture_output=True, text=True, timeout=300)
+                           capture_output=True, text=True, timeout=300,
+                           start_new_session=True)
     assert later.returncode == 0, later.stderr
     assert "compilations 0" in later.stdout, later.stdout
     assert NOTICE not in later.stderr
