@@ -113,3 +113,12 @@ def test_a_batch_verdict_per_row_at_its_edge() -> None:
     assert bool(BatchCertificate({"a": [0.0, TOL]}, TOL))
     empty = BatchCertificate({"a": []}, TOL)
     assert empty.worst == ("none", 0.0) and empty.ok.tolist() == []
+
+
+def test_a_certificate_takes_its_residuals_by_name_and_its_figures_by_keyword_only() -> None:
+    """values and tol may be named; reported, extras, tols and names are keyword-only (a
+    positional third argument is not silently taken for the reported figures)."""
+    cert = iq.results.Certificate(values={"a": 0.5 * TOL}, tol=TOL)
+    assert cert.ok and cert.residuals == {"a": 0.5 * TOL}
+    with pytest.raises(TypeError):
+        iq.results.Certificate({"a": 0.5 * TOL}, TOL, {"b": 1.0})
