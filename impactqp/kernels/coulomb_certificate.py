@@ -88,7 +88,7 @@ class FrictionalAnswer(NamedTuple):
 @inline_kernel
 def certificate_ratio(num, den):
     """num/den as the friction certificate reports it: 0 when num is 0, +inf for a NaN or a
-    non-positive den (the rule of :mod:`impactqp.model.friction`)."""
+    non-positive den; :mod:`impactqp.model.friction` calls it as plain Python."""
     if num == 0.0:
         return 0.0
     v = num / den if den > 0.0 else np.inf

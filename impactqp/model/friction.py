@@ -20,6 +20,7 @@ import scipy.sparse as sp
 from ..base.arrays import as_array, as_count, as_matrix, check_tol
 from ..base.checks import Certificate
 from ..errors import InputError, OutOfRangeError, ShapeError
+from ..kernels.coulomb_certificate import certificate_ratio
 from ..kernels.coulomb_conditions import coulomb_violation_sums
 from ..kernels.friction import natural_map
 from ..kernels.units import contact_units
@@ -255,12 +256,9 @@ acceptance figure.
 """
 
 
-def _ratio(num: float, den: float) -> float:
-    """num/den for the certificate: 0 when num is 0, NaN as +inf."""
-    if num == 0.0:
-        return 0.0
-    v = num / den if den > 0.0 else math.inf
-    return v if v == v else math.inf
+# num/den for the certificate (0 when num is 0, NaN as +inf): the compiled certificate's one
+# definition, called here as plain Python (a compiled call per figure would cost more)
+_ratio = getattr(certificate_ratio, "py_func", certificate_ratio)
 
 
 def _norm(x: np.ndarray) -> float:
