@@ -19,7 +19,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..base.arrays import check_tol
-from ..errors import InputError, OutOfRangeError
+from ..errors import CertificateError, InputError, OutOfRangeError
 from ..model.friction import (
     ContactUnits,
     FrictionCertificate,
@@ -70,7 +70,10 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
         A backend that does not solve frictional problems, or not this one (the message says
         why).
     CertificateError
-        No method reached the tolerance; the message gives each attempt.
+        No method reached the tolerance; the message gives each attempt, and the
+        exception's ``best`` is the answer that came closest: a :class:`FrictionResult`
+        with ``status == "not certified"``, its ABH ``error`` and its certificate (None
+        when no method answered at all), ``attempts`` the attempts.
     OutOfRangeError
         The answer is beyond what floats hold in the problem's units.
     """
@@ -81,8 +84,16 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     start = time.perf_counter()
     # units and the registry's plan, in one Route
     route = plan_friction(problem, backend, lambda units: _finisher(problem, units, tol))
-    out = solve_certified(route.programs, named=backend != "auto", tol=tol)
     note = () if route.units is None else (f"solved in its contacts' units (2^{route.units.k})",)
+    try:
+        out = solve_certified(route.programs, named=backend != "auto", tol=tol)
+    except CertificateError as exc:
+        if not isinstance(exc.best, Outcome):
+            raise
+        best = _result(exc.best, time.perf_counter() - start, note)
+        raise CertificateError(f"{exc} (the best answer found, error {best.error:.2e}, is "
+                               "the exception's .best)", best=best,
+                               attempts=exc.attempts) from None
     return _result(out, time.perf_counter() - start, note)
 
 
