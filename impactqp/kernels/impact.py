@@ -9,7 +9,7 @@ diagonal; Frémond: full), :func:`solve_impact`
    :mod:`impactqp.kernels.active_set` (warm-started from the support of the previous solve),
 3. recovers u⁺ and recomputes every residual of the certificate by
    :func:`impactqp.kernels.residuals.dense_residuals`, with the impact equation measured by
-   an M⁻¹W of the certificate's own (LU with partial pivoting of M, not the Cholesky factor
+   an M⁻¹W of the certificate's own (Gaussian elimination of M, not the Cholesky factor
    the recovery uses: docs/theory.md §8, "Independence"),
 
 and says whether every residual is within the tolerance; the caller returns the answer only
@@ -43,7 +43,7 @@ class Operators(NamedTuple):
     s : (m,) float array
         The contact scales sᵢ = √Gᵢᵢ.
     check : (n, m) float array
-        M⁻¹W solved by LU with partial pivoting: the certificate's impact equation.
+        M⁻¹W solved by Gaussian elimination: the certificate's impact equation.
     """
 
     M: np.ndarray
@@ -56,21 +56,14 @@ class Operators(NamedTuple):
 
 @inline_kernel
 def lu_solve_columns(M, W, X):
-    """X = M⁻¹W by Gaussian elimination with partial pivoting on a copy of M: an M⁻¹W that
-    shares nothing with the Cholesky-based one of :func:`pack` (docs/theory.md §8)."""
+    """X = M⁻¹W by Gaussian elimination on a copy of M (M = LU, L unit lower triangular):
+    an M⁻¹W that shares nothing with the Cholesky-based one of :func:`pack`
+    (docs/theory.md §8). M is symmetric positive definite, so every pivot is positive
+    without row exchanges."""
     n, m = W.shape
     A = M.copy()
     X[:, :] = W
     for k in range(n):
-        p = k
-        for i in range(k + 1, n):
-            if abs(A[i, k]) > abs(A[p, k]):
-                p = i
-        if p != k:
-            for j in range(n):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-            for c in range(m):
-                X[k, c], X[p, c] = X[p, c], X[k, c]
         for i in range(k + 1, n):
             f = A[i, k] / A[k, k]
             for j in range(k + 1, n):
