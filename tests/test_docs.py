@@ -179,9 +179,34 @@ def _included(page: str) -> set[str]:
     return set(re.findall(r"^\.\. literalinclude:: \.\./(\S+)$", text, flags=re.M))
 
 
-def test_gallery_shows_every_example_script() -> None:
-    scripts = {f"examples/{p.name}" for p in (DOCS.parent / "examples").glob("*.py")}
-    assert _included("gallery.rst") == scripts
+EXAMPLES = DOCS.parent / "examples"
+NOT_RUN = {"benchmark_run.py"}  # the gallery shows it without running it (a benchmark suite)
+
+
+def _gallery_conf() -> dict:
+    """``sphinx_gallery_conf`` of docs/conf.py, read without importing Sphinx."""
+    tree = ast.parse((DOCS / "conf.py").read_text(encoding="utf-8"))
+    node = next(n for n in tree.body if isinstance(n, ast.Assign)
+                and getattr(n.targets[0], "id", "") == "sphinx_gallery_conf")
+    return ast.literal_eval(node.value)
+
+
+def test_every_example_is_a_gallery_page_and_all_but_the_benchmark_run() -> None:
+    """sphinx-gallery makes a page of every script of examples/ whose docstring opens with a
+    reST title (its first line, underlined by as many "="), and runs those its
+    filename_pattern matches: all but the benchmark run."""
+    conf = _gallery_conf()
+    assert (conf["examples_dirs"], conf["gallery_dirs"]) == ("../examples", "auto_examples")
+    scripts = sorted(EXAMPLES.glob("*.py"))
+    assert scripts
+    for script in scripts:
+        doc = ast.get_docstring(ast.parse(script.read_text(encoding="utf-8")), clean=False)
+        assert doc is not None, script.name
+        title, underline, blank, *_ = doc.split("\n")
+        assert title.strip() and underline == "=" * len(title) and not blank, script.name
+        runs = re.search(conf["filename_pattern"], str(script)) is not None
+        assert runs == (script.name not in NOT_RUN), script.name
+    assert (EXAMPLES / "GALLERY_HEADER.rst").is_file()
 
 
 def test_file_formats_page_shows_every_sample_file() -> None:
