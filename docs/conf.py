@@ -57,7 +57,19 @@ autodoc_preserve_defaults = True
 # numpydoc: class members are documented by autodoc, not listed again by numpydoc
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
-numpydoc_xref_param_type = False
+numpydoc_xref_param_type = True  # the types of Parameters/Returns link where they can
+numpydoc_xref_ignore = "all"  # only the names below and numpydoc's own (int, ndarray, ...)
+numpydoc_xref_aliases = {
+    "Path": "pathlib.Path",
+    "Figure": "matplotlib.figure.Figure",
+    "Axes": "matplotlib.axes.Axes",
+    "sparse": "scipy.sparse",
+    "csr_matrix": "scipy.sparse.csr_matrix",
+    "csc_matrix": "scipy.sparse.csc_matrix",
+    "LinearOperator": "scipy.sparse.linalg.LinearOperator",
+    "Generator": "numpy.random.Generator",
+    "callable": ":term:`python:callable`",  # the glossary's entry, not "callable()"
+}
 
 # myst-parser: the theory note is Markdown with tables and LaTeX formulas ($…$, $$…$$ and
 # amsmath environments), rendered by MathJax; its numbered sections are anchored sec-N
@@ -126,6 +138,23 @@ def _help_text(path: str) -> str:
 
 
 PUBLIC_MODULES = ("impactqp", *(f"impactqp.{sub}" for sub in impactqp.SUBMODULES))
+
+
+def _public_classes() -> dict[str, str]:
+    """Name → path of every public class (the top level's first), so that a class named as
+    a parameter's or a result's type links to its entry."""
+    import importlib
+
+    found: dict[str, str] = {}
+    for module in PUBLIC_MODULES:
+        namespace = importlib.import_module(module)
+        for name in namespace.__all__:
+            if isinstance(getattr(namespace, name), type):
+                found.setdefault(name, f"{module}.{name}")
+    return found
+
+
+numpydoc_xref_aliases.update(_public_classes())
 
 
 def _public_reference(app, env, node, contnode):

@@ -16,6 +16,7 @@ import builtins
 import importlib
 import sys
 
+from docutils import nodes
 from sphinx.ext.intersphinx import InventoryAdapter
 
 # the top-level modules each inventory documents
@@ -53,7 +54,7 @@ def unlinked_offline(app, env, node, contnode):
     target = node.get("reftarget", "")
     project, _, rest = target.partition(":")
     if rest and project in offline:  # an explicit inventory, as numpydoc writes python:list
-        return contnode
+        return _without_prefix(contnode, f"{project}:")
     if node.get("refdomain") != "py":
         return None
     target = target.lstrip("~.")
@@ -65,6 +66,16 @@ def unlinked_offline(app, env, node, contnode):
     if "python" in offline and top in sys.stdlib_module_names and _exists(target):
         return contnode  # the standard library: pathlib.Path
     return None
+
+
+def _without_prefix(contnode, prefix: str):
+    """The reference's text without the inventory's name, as intersphinx shows it."""
+    text = contnode.astext()
+    if not text.startswith(prefix):
+        return contnode
+    shown = contnode.deepcopy()
+    shown.children = [nodes.Text(text[len(prefix):])]
+    return shown
 
 
 def setup(app):

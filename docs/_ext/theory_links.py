@@ -9,7 +9,8 @@ every cited N exists). This extension
 - turns every citation in a docstring rendered by autodoc — "docs/theory.md §N", and the
   further "§M" of a group such as "docs/theory.md §14 and §15" — into a link to that anchor
   (a citation of a section that does not exist is an undefined label, a build warning);
-- does the same in the running text of the gallery's pages (the examples' docstrings);
+- does the same in the running text of the reST pages and of the gallery's pages (the
+  examples' docstrings);
 - links the bare "§N" of the theory note's own text to its section.
 """
 
@@ -117,10 +118,10 @@ def process_docstring(app, what, name, obj, options, lines: list[str]) -> None:
     lines[:] = linked
 
 
-def process_gallery_source(app, docname: str, source: list[str]) -> None:
-    """``source-read``: link the citations of the gallery's pages (the examples' docstrings)
-    in their running text, not in their code (indented lines)."""
-    if not docname.startswith("auto_examples/"):
+def process_page_source(app, docname: str, source: list[str]) -> None:
+    """``source-read``: link the citations of the reST pages, the gallery's included (the
+    examples' docstrings), in their running text, not in their code (indented lines)."""
+    if docname == THEORY:
         return
     chunks = re.split(r"((?:^[ \t].*\n?|^\n)+)", source[0], flags=re.M)
     source[0] = "".join(chunk if i % 2 else link_citations(chunk)
@@ -129,6 +130,7 @@ def process_gallery_source(app, docname: str, source: list[str]) -> None:
 
 def setup(app):
     app.connect("doctree-read", add_anchors)
-    app.connect("source-read", process_gallery_source)
-    app.connect("autodoc-process-docstring", process_docstring, priority=400)
+    app.connect("source-read", process_page_source)
+    # after numpydoc (500), which writes the docstrings of properties into Attributes
+    app.connect("autodoc-process-docstring", process_docstring, priority=600)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
