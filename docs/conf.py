@@ -115,9 +115,13 @@ html_title = f"impactqp {release}"
 html_static_path: list[str] = []
 html_theme_options = {
     "navigation_with_keys": False,
+    "header_links_before_dropdown": 4,
     "show_toc_level": 2,
     "secondary_sidebar_items": ["page-toc", "sourcelink"],
 }
+# the left column lists a section's pages: only the gallery has any, the other pages (the
+# theory note's formulas above all) take its width
+html_sidebars = {"*": [], "auto_examples/*": ["sidebar-nav-bs"]}
 html_show_sourcelink = True
 
 
