@@ -63,6 +63,7 @@ numpydoc_xref_aliases = {
     "Path": "pathlib.Path",
     "Figure": "matplotlib.figure.Figure",
     "Axes": "matplotlib.axes.Axes",
+    "matplotlib.axes.Axes": "matplotlib.axes.Axes",
     "sparse": "scipy.sparse",
     "csr_matrix": "scipy.sparse.csr_matrix",
     "csc_matrix": "scipy.sparse.csc_matrix",
