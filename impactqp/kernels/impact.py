@@ -9,8 +9,8 @@ diagonal; Frémond: full), :func:`solve_impact`
    :mod:`impactqp.kernels.active_set` (warm-started from the support of the previous solve),
 3. recovers u⁺ and recomputes every residual of the certificate by
    :func:`impactqp.kernels.residuals.dense_residuals`, with the impact equation measured by
-   an M⁻¹W of the certificate's own (Gaussian elimination of M, not the Cholesky factor
-   the recovery uses: docs/theory.md §8, "Independence"),
+   an M⁻¹W of the certificate's own (LU of M, not the Cholesky factor the recovery uses:
+   docs/theory.md §8, "Independence"),
 
 and says whether every residual is within the tolerance; the caller returns the answer only
 then. The structure's operators travel as one packed array (:func:`pack`): one argument
@@ -22,9 +22,10 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from scipy.linalg import lapack
 
 from .active_set import SOLVED, lcp_psd_work
-from .jit import inline_kernel, kernel
+from .jit import kernel
 from .residuals import dense_residuals
 
 
@@ -43,7 +44,7 @@ class Operators(NamedTuple):
     s : (m,) float array
         The contact scales sᵢ = √Gᵢᵢ.
     check : (n, m) float array
-        M⁻¹W solved by Gaussian elimination: the certificate's impact equation.
+        M⁻¹W solved by LU with partial pivoting: the certificate's impact equation.
     """
 
     M: np.ndarray
@@ -54,79 +55,22 @@ class Operators(NamedTuple):
     check: np.ndarray
 
 
-@inline_kernel
-def lu_solve_columns(M, W, X):
-    """X = M⁻¹W by Gaussian elimination on a copy of M (M = LU, L unit lower triangular):
-    an M⁻¹W that shares nothing with the Cholesky-based one of :func:`pack`
-    (docs/theory.md §8). M is symmetric positive definite, so every pivot is positive
-    without row exchanges."""
-    n, m = W.shape
-    A = M.copy()
-    X[:, :] = W
-    for k in range(n):
-        for i in range(k + 1, n):
-            f = A[i, k] / A[k, k]
-            for j in range(k + 1, n):
-                A[i, j] -= f * A[k, j]
-            for c in range(m):
-                X[i, c] -= f * X[k, c]
-    for c in range(m):
-        for i in range(n - 1, -1, -1):
-            v = X[i, c]
-            for j in range(i + 1, n):
-                v -= A[i, j] * X[j, c]
-            X[i, c] = v / A[i, i]
-
-
-@kernel
-def pack(M, W):
+def pack(M: np.ndarray, W: np.ndarray) -> np.ndarray:
     """M (n × n), Wᵀ (m × n), M⁻¹W (n × m), G = WᵀM⁻¹W (m × m), sᵢ = √Gᵢᵢ and the
-    certificate's M⁻¹W (n × m, :func:`lu_solve_columns`) in one flat array (views:
-    :class:`Operators`), from M = LLᵀ and B = L⁻¹W: G = BᵀB, M⁻¹W = L⁻ᵀB (docs/theory.md §1).
-    Plain loops: no inverse, no eigen-decomposition, no BLAS call for the small M of one
-    impact. M must be symmetric positive definite (the structure has checked it)."""
-    n, m = W.shape
-    L = np.zeros((n, n))
-    for j in range(n):
-        d = M[j, j]
-        for k in range(j):
-            d -= L[j, k] * L[j, k]
-        L[j, j] = np.sqrt(d)
-        for i in range(j + 1, n):
-            v = M[i, j]
-            for k in range(j):
-                v -= L[i, k] * L[j, k]
-            L[i, j] = v / L[j, j]
-    B = np.empty((n, m))
-    X = np.empty((n, m))
-    for c in range(m):
-        for i in range(n):  # B = L⁻¹W
-            v = W[i, c]
-            for k in range(i):
-                v -= L[i, k] * B[k, c]
-            B[i, c] = v / L[i, i]
-        for i in range(n - 1, -1, -1):  # M⁻¹W = L⁻ᵀB
-            v = B[i, c]
-            for k in range(i + 1, n):
-                v -= L[k, i] * X[k, c]
-            X[i, c] = v / L[i, i]
-    out = np.empty(n * n + 3 * m * n + m * m + m)
-    out[:n * n] = M.ravel()
-    a = n * n
-    for c in range(m):
-        for i in range(n):
-            out[a + c * n + i] = W[i, c]  # Wᵀ, row by row
-            out[a + m * n + i * m + c] = X[i, c]
-    d = a + 2 * m * n
-    for r in range(m):
-        for c in range(m):
-            v = 0.0
-            for i in range(n):
-                v += B[i, r] * B[i, c]
-            out[d + r * m + c] = v
-        out[d + m * m + r] = np.sqrt(out[d + r * m + r])
-    lu_solve_columns(M, W, out[d + m * m + m:].reshape((n, m)))
-    return out
+    certificate's M⁻¹W (n × m) in one flat array (views: :class:`Operators`), by LAPACK once
+    per structure: M = LLᵀ and B = L⁻¹W give G = BᵀB and M⁻¹W = L⁻ᵀB (docs/theory.md §1);
+    the certificate's M⁻¹W is solved apart, by LU with partial pivoting (``gesv``), so that
+    it shares nothing with the Cholesky factor the recovery uses (docs/theory.md §8). M must
+    be symmetric positive definite (the structure has checked it). Plain Python: nothing to
+    compile for a call made once per structure."""
+    M = np.ascontiguousarray(M, dtype=float)
+    W = np.ascontiguousarray(W, dtype=float)
+    L, _ = lapack.dpotrf(M, lower=1, clean=1)
+    B = lapack.dtrtrs(L, W, lower=1)[0]
+    X = lapack.dtrtrs(L, B, lower=1, trans=1)[0]
+    G = B.T @ B
+    return np.concatenate((M.ravel(), W.T.ravel(), X.ravel(), G.ravel(),
+                           np.sqrt(np.diag(G)), np.linalg.solve(M, W).ravel()))
 
 
 @kernel
