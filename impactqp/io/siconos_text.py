@@ -99,7 +99,7 @@ class _Numbers:
         where = self.pos if at is None else at
         return ProblemFileError(f"{self.path}: {field} (number {where + 1} of the file): {what}")
 
-    def _take(self, field: str, count: int) -> list[str]:
+    def take(self, field: str, count: int) -> list[str]:
         if count > len(self.tokens) - self.pos:
             raise self.error(field, f"the file ends after {len(self.tokens)} numbers, "
                                     f"{count} more expected here (truncated, or a count in the "
@@ -109,7 +109,7 @@ class _Numbers:
         return out
 
     def integer(self, field: str, low: int, high: int) -> int:
-        token = self._take(field, 1)[0]
+        token = self.take(field, 1)[0]
         try:
             value = int(token)
         except ValueError:
@@ -120,7 +120,7 @@ class _Numbers:
 
     def integers(self, field: str, count: int, low: int, high: int) -> np.ndarray:
         start = self.pos
-        tokens = self._take(field, count)
+        tokens = self.take(field, count)
         try:
             values = np.array([int(t) for t in tokens], dtype=np.int64)
         except ValueError:
@@ -134,7 +134,7 @@ class _Numbers:
 
     def floats(self, field: str, count: int) -> np.ndarray:
         start = self.pos
-        tokens = self._take(field, count)
+        tokens = self.take(field, count)
         try:
             values = np.array(tokens, dtype=float)
         except ValueError:
@@ -192,20 +192,50 @@ def _blocks(numbers: _Numbers, n0: int, n1: int) -> sp.csr_matrix:
                                                       f"end at {nblocks} blocks", at)
     colidx = numbers.integers("W's block-column indices", nblocks, 0, bcols - 1)
     row_start, col_start = np.r_[0, row_end[:-1]], np.r_[0, col_end[:-1]]
-    rows, cols, vals = [], [], []
-    for bi in range(brows):
-        h = int(row_end[bi] - row_start[bi])
-        for k in range(int(rowptr[bi]), int(rowptr[bi + 1])):
-            bj = int(colidx[k])
-            numbers.integer(f"W's block {k} number", k, k)
-            w = int(col_end[bj] - col_start[bj])
-            block = numbers.floats(f"W's block {k} (column by column)", h * w).reshape(w, h).T
-            i, j = np.nonzero(block)
-            rows.append(i + row_start[bi])
-            cols.append(j + col_start[bj])
-            vals.append(block[i, j])
-    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(n0, n1))
+    block_row = np.repeat(np.arange(brows), np.diff(rowptr))  # of each block, in file order
+    h = (row_end - row_start)[block_row]
+    w = (col_end - col_start)[colidx]
+    size = h * w
+    first = np.r_[0, np.cumsum(size + 1)[:-1]]  # where each block's number is, from here
+    at = numbers.pos
+    tokens = numbers.take("W's blocks", int(first[-1] + size[-1] + 1))
+    values = _block_values(numbers, tokens, first, at)
+    # each entry's block, then its place in the block, column by column
+    owner = np.repeat(np.arange(nblocks), size)
+    local = np.arange(owner.size) - np.repeat(first - np.arange(nblocks), size)
+    entries = np.delete(values, first)
+    rows = row_start[block_row][owner] + local % h[owner]
+    cols = col_start[colidx][owner] + local // h[owner]
+    keep = entries != 0
+    return sp.csr_matrix((entries[keep], (rows[keep], cols[keep])), shape=(n0, n1))
+
+
+def _block_values(numbers: _Numbers, tokens: list[str], first: np.ndarray,
+                  at: int) -> np.ndarray:
+    """The numbers of W's blocks (each block's own number, then its entries), all finite and
+    each block numbered in order; an error names the block of the offending number."""
+
+    def field(index: int) -> str:
+        k = int(np.searchsorted(first, index, side="right")) - 1
+        return f"W's block {k} number" if first[k] == index else \
+            f"W's block {k} (column by column)"
+
+    for k, index in enumerate(first.tolist()):
+        token = tokens[index]
+        if token != str(k) and not (token.lstrip("+").isdigit() and int(token) == k):
+            what = f"{token} is outside [{k}, {k}]" if token.lstrip("+-").isdigit() else \
+                f"{token!r} is not an integer"
+            raise numbers.error(field(index), what, at + index)
+    try:
+        values = np.array(tokens, dtype=float)
+    except ValueError:
+        bad = next(k for k, t in enumerate(tokens) if not _is_float(t))
+        raise numbers.error(field(bad), f"{tokens[bad]!r} is not a number", at + bad) from None
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise numbers.error(field(int(bad[0])), f"holds {bad.size} non-finite number(s) (NaN "
+                                                "or infinity), the first here", at + int(bad[0]))
+    return values
 
 
 def read_siconos_text(path: str | Path) -> FrictionContactProblem:
