@@ -63,6 +63,8 @@ PYTHON_ADVICE = ("iq.", "()", "normal_problem", "Coulomb(", "Newton(")
 @pytest.mark.parametrize("argv, words", [
     (["solve", "examples/sphere_on_plane.toml", "--law", "moreau"], "--law coulomb --mu"),
     (["solve", "examples/cradle.toml", "--law", "coulomb", "--mu", "0.3"], "--law newton"),
+    (["solve", "examples/cradle.toml", "--law", "sector", "--backend", "clarabel"],
+     "drop --backend clarabel"),
     (["plot", "S", "examples/sphere_on_plane.toml", "--out", "{tmp}/s.png"], "contact_dim = 1"),
 ])
 def test_errors_speak_in_flags(argv, words, tmp_path: Path, capsys, monkeypatch) -> None:

@@ -92,9 +92,14 @@ def solve_law(problem: ImpactProblem, law: str, coefficients: Any,
               backend: str = "auto") -> ImpactResult:
     """Apply the law called ``law`` (docs/theory.md §3, §6, §10, §16) through
     :func:`impactqp.solve`, with exactly its checks (a closed-form law refuses a named
-    backend, as in Python); for Coulomb's law ``backend`` is a friction method of the registry
-    (:data:`~impactqp.laws.friction.FRICTION_BACKENDS`), as for :func:`impactqp.solve`."""
-    return solve(problem, law_named(law, coefficients), backend)
+    backend, as in Python, here in the command line's words); for Coulomb's law ``backend``
+    is a friction method of the registry (:data:`~impactqp.laws.friction.FRICTION_BACKENDS`),
+    as for :func:`impactqp.solve`."""
+    impact_law = law_named(law, coefficients)
+    if not impact_law.forms and backend not in ("auto", impact_law.closed_form_backend):
+        raise InputError(f"--law {law} is evaluated in closed form: drop --backend {backend} "
+                         "(or pass --backend auto)")
+    return solve(problem, impact_law, backend)
 
 
 def run(args: argparse.Namespace) -> int:
