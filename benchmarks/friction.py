@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 import impactqp as iq
+from impactqp.io.siconos_text import write_siconos_text
 from impactqp.model.friction import FrictionCertificate, certify_friction
 
 from . import friction_data
@@ -186,7 +187,7 @@ class SiconosPeer:
         """Run one solver on ``case``; its row (failed rows keep the time spent)."""
         path = Path(self.tmp.name) / f"{case.name}.dat"
         if not path.exists():
-            friction_data.write_siconos_text(case.problem, path)
+            write_siconos_text(case.problem, path)
         if self.server is None or not self.server.alive:
             self.server = SiconosServer(self.python, WORKER, "--fc3d-serve")
         name = f"siconos:{solver}"

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from . import perf_profile
 from .friction import BASELINE, DEFAULT, METHODS, TOL
-from .measure import fmt_time
+from .measure import fmt_time, missed_by
 
 PREFIX = "friction:"
 PROFILE_PNG = "friction_profile.png"
@@ -138,7 +138,7 @@ def targets(rows: list[dict]) -> list[tuple[str, str, str]]:
         g = geomean([v for v, _, _ in ratio.values()])
         out.append((f"friction: geometric mean of {DEFAULT} / {BASELINE} ≤ {GEOMEAN_TARGET:g}",
                     f"{g:.3f}", "met" if g <= GEOMEAN_TARGET
-                    else f"MISSED by {g / GEOMEAN_TARGET:.1f}×"))
+                    else missed_by(g / GEOMEAN_TARGET)))
     times = profile_times(rows)
     if DEFAULT in times and len(times) > 1:
         fastest = perf_profile.profile(times, [1.0])[DEFAULT][0]

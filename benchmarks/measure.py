@@ -46,6 +46,16 @@ def fmt_time(seconds: float | None) -> str:
     return f"{seconds * 1e9:.3g} ns"
 
 
+def missed_by(factor: float) -> str:
+    """The verdict of a target missed by ``factor`` (> 1): "MISSED by 1.3×", with as many
+    digits as it takes for the factor not to read as 1 (1.04×, 1.004×): a miss never prints
+    as "MISSED by 1.0×"."""
+    digits = 1
+    while digits < 6 and float(f"{factor:.{digits}f}") <= 1.0:
+        digits += 1
+    return f"MISSED by {factor:.{digits}f}×"
+
+
 def output_size(raw: Any) -> float | None:
     """MB of a batch result's own arrays (u⁺, Λ, the residuals): what peak memory must hold
     anyway, so that what a batch needs beyond input and output can be told apart."""

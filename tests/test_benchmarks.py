@@ -280,53 +280,6 @@ def test_performance_profile_by_hand():
         ratios({"A": [0.0]})
 
 
-SBM_TEXT = """2
-2
-1
-4
-4
-3
-2
-2
-2\t4\t
-2\t4\t
-3
-3
-0\t2\t3\t
-0\t1\t1\t
-0
-1.0 2.0 3.0 4.0
-1
-5.0 0.0 0.0 6.0
-2
-7.0 8.0 9.0 10.0
--1.0 0.5 -2.0 0.25
-0.3 0.6
-"""
-
-
-def test_siconos_text_reader_by_hand(tmp_path):
-    """A sparse-block file written out by hand: blocks column-major, the block numbers
-    skipped, an empty block (row 2, column 1) left zero."""
-    import numpy as np
-
-    from benchmarks.friction_data import read_siconos_text, write_siconos_text
-
-    (tmp_path / "p.dat").write_text(SBM_TEXT)
-    p = read_siconos_text(tmp_path / "p.dat")
-    assert p.contact_dim == 2 and p.n_contacts == 2
-    assert np.array_equal(p.dense_W(), [[1, 3, 5, 0], [2, 4, 0, 6],
-                                        [0, 0, 7, 9], [0, 0, 8, 10]])
-    assert list(p.q) == [-1.0, 0.5, -2.0, 0.25] and list(p.mu) == [0.3, 0.6]
-    for storage in (0, 1):  # both layouts read back bit for bit
-        write_siconos_text(p, tmp_path / f"{storage}.dat", storage=storage)
-        back = read_siconos_text(tmp_path / f"{storage}.dat")
-        assert np.array_equal(back.dense_W(), p.dense_W()) and np.array_equal(back.q, p.q)
-    (tmp_path / "short.dat").write_text(SBM_TEXT[:60])
-    with pytest.raises(ValueError, match="ends after"):
-        read_siconos_text(tmp_path / "short.dat")
-
-
 def test_suite_problems_load():
     import numpy as np
 

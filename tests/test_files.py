@@ -156,7 +156,7 @@ def test_every_law_named_in_files_is_the_registrys() -> None:
     frictional = iq.ImpactProblem(sphere.M, np.hstack([sphere.structure.W] * 2), sphere.u_minus,
                                   contact_dim=2)
     coefficients = {"eps": 0.5, "e": [1.0, 0.5], "E": [[0.5, 0.0], [0.0, 0.5]],
-                    "mu": [0.2, 0.4]}
+                    "mu": [0.2, 0.4], "stiffness": 1e6, "exponent": 1.5}
     for name, law_class in NAMED_LAWS.items():
         keys = law_class.coefficient_keys
         given = tuple(coefficients[k] for k in keys)
@@ -169,6 +169,6 @@ def test_every_law_named_in_files_is_the_registrys() -> None:
             with pytest.raises(iq.InputError, match="needs its coefficients"):
                 law_named(name)
     with pytest.raises(iq.InputError, match="must be one of"):
-        law_named("lzb")
+        law_named("hertz")
     with pytest.raises(iq.InputError, match="takes no coefficients"):
         law_named("sector", 0.5)

@@ -31,7 +31,8 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-NUMBER_OPTIONS = ("--u-plus", "--eps", "--e", "--E", "--mu", "--v", "--mass")
+NUMBER_OPTIONS = ("--u-plus", "--eps", "--e", "--E", "--mu", "--v", "--mass", "--stiffness",
+                  "--exponent")
 """Options whose value may start with a minus sign (``--u-plus -1,0,0``)."""
 
 
@@ -57,6 +58,19 @@ def _fail(message: str) -> int:
     return 2
 
 
+def _closed_output() -> int:
+    """The reader of our output went away (``impactqp ... | head``): end quietly, as Unix
+    tools do. Output still buffered would fail again when the interpreter flushes it at exit,
+    so stdout is pointed at the null device first."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):  # stdout without a file descriptor (captured in tests)
+        pass
+    return 0
+
+
 def out_of_range(command: str, exc: OverflowError) -> OutOfRangeError:
     """The named error of a number that left the float range while ``command`` ran."""
     cause = exc.args[-1] if exc.args else type(exc).__name__
@@ -80,12 +94,17 @@ def main(argv: list[str] | None = None) -> int:
         The command's own status (``verify``: 0 admissible, 1 not), 2 for any failure:
         bad input, unreadable or hostile files, unwritable outputs, solver failures. A
         failure is one line on stderr, never a traceback (set IMPACTQP_DEBUG=1 to see one).
+        Output into a pipe closed by its reader (``| head``) ends the command quietly with 0.
     """
     argv = join_negative_values(list(sys.argv[1:] if argv is None else argv))
     args = build_parser().parse_args(argv)
     try:
         with verbosity(min(args.verbose, 2)):
-            return int(args.func(args))
+            status = int(args.func(args))
+            sys.stdout.flush()  # a closed pipe shows here, not at the interpreter's exit
+            return status
+    except BrokenPipeError:
+        return _closed_output()
     except ImpactError as exc:
         return _fail(str(exc))
     except OSError as exc:  # unwritable --out, vanished files

@@ -1,7 +1,8 @@
 """A heartbeat for long steps of the command line, without any extra dependency.
 
 Nothing is printed for steps that finish within ``after`` seconds, so quick commands stay
-quiet; a long step (a large problem file) says on stderr what it is doing and for how long.
+quiet; a long step (a large problem file) says on stderr what it is doing and for how long,
+when stderr is a terminal (a log file or a pipe gets no heartbeat: :func:`on_terminal`).
 """
 
 from __future__ import annotations
@@ -12,6 +13,16 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import IO
+
+
+def on_terminal(stream: IO[str] | None = None) -> bool:
+    """True when ``stream`` (default ``sys.stderr`` at call time) is a terminal: progress is
+    shown there only, never written into a log file or a pipe."""
+    out = sys.stderr if stream is None else stream
+    try:
+        return bool(out.isatty())
+    except (AttributeError, ValueError):  # no isatty, or a closed stream
+        return False
 
 
 @contextmanager
@@ -28,8 +39,12 @@ def progress(message: str, *, after: float = 2.0, every: float = 5.0,
     every : float
         Seconds between later reports.
     stream : text stream, optional
-        Where to report (default ``sys.stderr`` at call time).
+        Where to report (default ``sys.stderr`` at call time, and then only when it is a
+        terminal); a stream given is reported to whatever it is.
     """
+    if stream is None and not on_terminal():
+        yield
+        return
     out = sys.stderr if stream is None else stream
     done = threading.Event()
     start = time.monotonic()

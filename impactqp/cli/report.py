@@ -19,7 +19,7 @@ from ..model.admissible import AdmissibleSet, Membership
 from ..model.problem import ImpactProblem
 
 COEFFICIENT_NAMES = {name: law.coefficient_symbol for name, law in NAMED_LAWS.items()}
-KEY_SYMBOLS = {"mu": "μ"}
+KEY_SYMBOLS = {"mu": "μ", "stiffness": "K", "exponent": "η"}
 """How reports print a coefficient of a law of several (Coulomb's μ and e) by its key."""
 CONDITIONS = ("kinetic", "kinematic", "energetic")
 CONDITION_TEXT = {"kinetic": "u⁺ ∈ u⁻ + N", "kinematic": "u⁺ ∈ T_C",
@@ -122,6 +122,8 @@ def _conditions_text(report: dict[str, Any]) -> list[str]:
 def format_solution(report: dict[str, Any]) -> str:
     """Plain text of :func:`solution_report`."""
     coef, law = report["coefficients"], report["law"]
+    if isinstance(coef, dict):  # the LZB model's stiffness, exponent and restitution
+        coef = tuple(coef.values())
     if coef is None:
         coef_text = ""
     elif isinstance(coef, tuple):

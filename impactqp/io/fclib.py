@@ -1,4 +1,5 @@
-"""FCLib files: frictional contact problems in HDF5, read and written with h5py.
+"""FCLib files: frictional contact problems in HDF5, read and written with h5py (and, through
+the same :func:`load_fclib`, Siconos' text files of them: :mod:`.siconos_text`).
 
 FCLib (Acary, Brémond, Huber et al.) stores one problem per file, in one of two forms:
 
@@ -43,6 +44,7 @@ from ..base.outputs import atomic_output
 from ..errors import InputError, ProblemFileError
 from ..model.friction import FrictionContactProblem
 from .hdf5_reader import CheckedReader, h5py_module
+from .siconos_text import looks_like_siconos_text, read_siconos_text
 
 MAX_FCLIB_DIM = 1_000_000
 """Largest row or column count of a matrix in an FCLib file (degrees of freedom, d·contacts)."""
@@ -177,9 +179,12 @@ def _read(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]:
 
 
 def load_fclib(path: str | Path) -> FrictionContactProblem:
-    """Read a frictional contact problem from an FCLib HDF5 file.
+    """Read a frictional contact problem from an FCLib HDF5 file or a Siconos text file.
 
-    A local problem (``/fclib_local``) is returned as stored; a global one
+    The content decides, not the name: a file that is gzip-compressed or starts with a
+    number is read as Siconos' text layout (``.dat``, ``.dat.gz``;
+    :func:`~impactqp.io.siconos_text.read_siconos_text`, as strictly as HDF5), any other as
+    FCLib HDF5. A local problem (``/fclib_local``) is returned as stored; a global one
     (``/fclib_global``: M v = H r + f, u = Hᵀ v + w) is reduced to the local form
     u = W r + q with W = Hᵀ M⁻¹ H and q = Hᵀ M⁻¹ f + w (docs/theory.md §1). A file holding
     both is read as local.
@@ -187,13 +192,14 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
     Parameters
     ----------
     path : str or Path
-        An FCLib file (``.hdf5``).
+        An FCLib file (``.hdf5``) or a Siconos text file (``.dat``, ``.dat.gz``).
 
     Returns
     -------
     FrictionContactProblem
-        W as a scipy.sparse CSC matrix, q, μ (one per contact) and ``contact_dim`` (FCLib's
-        ``spacedim``).
+        W as a scipy.sparse CSC matrix (from HDF5; a Siconos text file gives W as stored:
+        dense, or CSR from sparse blocks), q, μ (one per contact) and ``contact_dim``
+        (FCLib's ``spacedim``, Siconos' d).
 
     Raises
     ------
@@ -204,16 +210,32 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
         file), a dataset stored outside the file (external raw storage, a virtual dataset),
         one declaring more than :data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES`, or a
         problem that does not fit in memory. The message names the file and the dataset.
+        For a Siconos text file: the errors of
+        :func:`~impactqp.io.siconos_text.read_siconos_text` (truncated, non-numeric or
+        non-finite numbers, counts that do not fit, negative μ, a damaged gzip stream), each
+        naming the file, the field and the position of the number.
     """
     if not isinstance(path, (str, Path)):
         raise ProblemFileError(f"path must be a str or Path, got {type(path).__name__}")
     path = Path(path)
-    h5py = h5py_module()
     try:
         if not stat.S_ISREG(path.stat().st_mode):
             raise ProblemFileError(f"{path}: not a regular file")
+        with path.open("rb") as raw:
+            head = raw.read(64)
+    except OSError as exc:
+        raise ProblemFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    if looks_like_siconos_text(head):
+        try:
+            return read_siconos_text(path)
+        except MemoryError:
+            raise ProblemFileError(f"{path}: the problem does not fit in this machine's "
+                                   "memory") from None
+    h5py = h5py_module()
+    try:
         if not h5py.is_hdf5(path):
-            raise ProblemFileError(f"{path}: not an HDF5 file (FCLib problems are HDF5)")
+            raise ProblemFileError(f"{path}: not an HDF5 file (FCLib) nor a Siconos text "
+                                   "problem file (.dat, .dat.gz: it starts with a number)")
         handle = h5py.File(path, "r")
     except OSError as exc:
         raise ProblemFileError(f"{path}: cannot read: {exc.strerror or exc}") from None

@@ -53,6 +53,8 @@ def coefficient(law: str, key: str, value: float | np.ndarray,
     if key == "mu":
         friction_coefficients(value, m)
         return value
+    if key in ("stiffness", "exponent"):  # the LZB model's, checked by the law itself
+        return value
     if NAMED_LAWS[law].frictional:  # e of Coulomb's law: kept as the file gives it
         check_restitution(key, value, m)
         return value

@@ -69,8 +69,8 @@ VERSION = 1
 CONTACT_DIMS = (1, 2, 3)
 GENERAL_KEYS = ("M", "W")
 CHAIN_KEYS = ("masses", "left_wall", "right_wall")
-KNOWN_KEYS = ("version", *GENERAL_KEYS, "contact_dim", *CHAIN_KEYS, "u_minus", "law", "eps",
-              "e", "E", "mu", "u_plus")
+KNOWN_KEYS = ("version", *GENERAL_KEYS, "contact_dim", *CHAIN_KEYS, "u_minus", "law",
+              *KNOWN_COEFFICIENTS, "u_plus")
 FORMATS = {".json": "json", ".toml": "toml"}
 
 
@@ -186,8 +186,9 @@ def _bool(name: str, value: Any) -> bool:
 
 
 def _typed_coefficients(data: dict[str, Any]) -> dict[str, Any]:
-    """The coefficients present in ``data``, typed: ``E`` a matrix, ``eps`` a number, ``e``
-    and ``mu`` a number or a vector (what they mean is checked by the law's reading)."""
+    """The coefficients present in ``data``, typed: ``E`` a matrix, ``eps`` a number, the
+    others (``e``, ``mu``, the LZB model's ``stiffness`` and ``exponent``) a number or a vector
+    (what they mean is checked by the law's reading)."""
     out: dict[str, Any] = {}
     for key in KNOWN_COEFFICIENTS:
         if key not in data:

@@ -1,7 +1,9 @@
 """Writing problem files in the flat schema of :mod:`impactqp.io.files` (JSON or TOML).
 
-TOML is written by ``tomli_w`` (floats as their shortest ``repr``, which round-trips
-exactly); JSON by the standard library. Every file is validated by
+TOML is written here, scalars by ``tomli_w`` and floats as their shortest ``repr`` (which
+round-trips exactly), with each array on one line where it fits in :data:`TOML_LINE`
+characters, a matrix one row a line otherwise, and a long vector wrapped; JSON by the
+standard library. Every file is validated by
 :func:`impactqp.io.files.problem_from_dict` before it is written.
 """
 
@@ -65,9 +67,43 @@ def problem_to_dict(problem: ImpactProblem, *, law: str | None = None, coefficie
     return data
 
 
+TOML_LINE = 100
+"""Longest line of a TOML file written here, where the numbers allow it."""
+
+
+def _toml_scalar(value: Any) -> str:
+    if isinstance(value, float) and np.isfinite(value):
+        return repr(value)  # what tomli_w writes, without a call per number
+    return tomli_w.dumps({"v": value})[len("v = "):].rstrip("\n")
+
+
+def _toml_inline(value: Any) -> str:
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_inline(v) for v in value) + "]"
+    return _toml_scalar(value)
+
+
+def _toml_entry(key: str, value: Any) -> list[str]:
+    """The lines of ``key = value``: one where it fits, else a matrix one row a line or a
+    vector wrapped at :data:`TOML_LINE` characters."""
+    one = f"{key} = {_toml_inline(value)}"
+    if len(one) <= TOML_LINE or not isinstance(value, (list, tuple)) or not value:
+        return [one]
+    if all(isinstance(v, (list, tuple)) for v in value):
+        return [f"{key} = [", *(f"    {_toml_inline(row)}," for row in value), "]"]
+    lines, line = [f"{key} = ["], "   "
+    for item in (_toml_inline(v) for v in value):
+        if len(line) + len(item) + 2 > TOML_LINE and line.strip():
+            lines.append(line)
+            line = "   "
+        line += f" {item},"
+    return [*lines, line, "]"]
+
+
 def to_toml(data: dict[str, Any]) -> str:
     """TOML text of the flat schema (top-level keys with numbers, booleans, strings and
-    nested arrays of numbers), written by ``tomli_w``.
+    nested arrays of numbers): each array on one line where it fits in :data:`TOML_LINE`
+    characters, a matrix one row a line otherwise, a long vector several numbers a line.
 
     Parameters
     ----------
@@ -79,7 +115,12 @@ def to_toml(data: dict[str, Any]) -> str:
     str
         TOML text that :func:`impactqp.load_problem` reads back bit-exactly.
     """
-    return tomli_w.dumps(data)
+    bare = set("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-")
+    lines = []
+    for key, value in data.items():
+        name = key if key and set(key) <= bare else tomli_w.dumps({key: 0}).split(" = ")[0]
+        lines += _toml_entry(name, value)
+    return "\n".join(lines) + "\n"
 
 
 def to_json(data: dict[str, Any]) -> str:

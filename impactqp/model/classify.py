@@ -50,6 +50,16 @@ class Classification:
     impulses: np.ndarray
     kinetic_residual: float
 
+    def summary(self) -> str:
+        """One line with α to 0.01° and the others to four digits: what a classification
+        says, without the last bits of round-off (α = 30° computes as 29.999999999999996)."""
+        alpha = "undefined" if np.isnan(self.alpha_deg) else f"{self.alpha_deg:.4g}°"
+        return (f"α = {alpha}, dissipation ε = {self.dissipation:.4g}, intensity "
+                f"{self.intensity:.4g}")
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.summary()})"
+
 
 def _unit(p: ImpactProblem, v: np.ndarray) -> np.ndarray:
     n = p.norm(v)

@@ -21,6 +21,20 @@ from .system import LinearSystem
 
 FORMATS = (".npz", ".csv")
 
+LEAVING_S = {"kinetic": "velocity jump not an impulse of the cones",
+             "kinematic": "kinematic residual above tolerance",
+             "energetic": "energy rising"}
+"""How a summary names each condition of u⁺ ∈ S (docs/theory.md §2) that a step fails."""
+
+
+def _failed(verdict: Any) -> list[str]:
+    """The conditions of u⁺ ∈ S a verdict fails: a frictionless
+    :class:`~impactqp.model.admissible.Membership` or a frictional step's certificate."""
+    if hasattr(verdict, "failed"):
+        return list(verdict.failed())
+    return [name for name, value in verdict.values.items()
+            if not (np.isfinite(value) and value <= verdict.tol_of(name))]
+
 
 class Trajectory:
     """States of a simulated system and the impacts on the way.
@@ -112,8 +126,38 @@ class Trajectory:
         """u⁺ ∈ S for every event (computed on first call per event, docs/theory.md §2)."""
         return np.array([bool(e.admissible) for e in self.events], dtype=bool)
 
+    def outside_S(self) -> dict[str, int]:
+        """How many certified events leave S, by the condition of u⁺ ∈ S they fail
+        (``kinetic``, ``kinematic``, ``energetic``; an event failing two counts under both).
+
+        A certificate proves that an event solves its law; u⁺ ∈ S is a separate verdict, and
+        some laws' certified answers leave S: Newton's restitution keeps a separating contact
+        closed on a time step (the kinematic condition, docs/theory.md §14, §17) and, with
+        Coulomb friction, can gain kinetic energy (the energetic one, docs/theory.md §16)."""
+        counts = dict.fromkeys(LEAVING_S, 0)
+        for event in self.events:
+            if not event.admissible:
+                for name in _failed(event.admissible):
+                    counts[name] += 1
+        return {name: count for name, count in counts.items() if count}
+
+    def _outside_S_text(self) -> list[str]:
+        counts = self.outside_S()
+        if not counts:
+            return []
+        reasons = "; ".join(f"{LEAVING_S[name]}: {count} step{'s' if count > 1 else ''}"
+                            for name, count in counts.items())
+        frictional = self.system.contact_dim > 1
+        why = ("Newton's restitution with Coulomb friction does this: its certified steps may "
+               "keep a separating contact closed or gain energy (docs/theory.md §16, §17)"
+               if frictional else
+               "Newton's restitution on a time step keeps a separating contact closed "
+               "(docs/theory.md §14)")
+        return [f"  certified yet outside S — {reasons}", f"    {why}"]
+
     def summary(self) -> str:
-        """A few lines: scheme, law, records, events, certificates, S-verdicts, energy."""
+        """A few lines: scheme, law, records, events, certificates, S-verdicts (with the count
+        of each reason why certified events leave S, :meth:`outside_S`), energy."""
         adm = self.admissible()
         drift = self.energy_drift()
         kept = self.settings.get("keep_events", True)
@@ -124,6 +168,7 @@ class Trajectory:
             f"  certificates: {'all ok' if self.certified else 'FAILED'}; "
             f"u⁺ ∈ S: {int(adm.sum())} of {adm.size}" if kept else
             "  certificates: every impact passed (a failing one stops the run)",
+            *(self._outside_S_text() if kept else []),
             f"  energy: {self.total_energy[0]:.10g} → {self.total_energy[-1]:.10g} "
             f"(largest relative change {drift:.3g})",
         ])

@@ -1,5 +1,6 @@
-"""``impactqp fclib FILE.hdf5``: solve an FCLib frictional contact problem (docs/theory.md
-§15) with :func:`~impactqp.solve_friction` and print its certificate.
+"""``impactqp fclib FILE``: solve a frictional contact problem (docs/theory.md §15) of an FCLib
+HDF5 file or a Siconos text file (``.dat``, ``.dat.gz``; :func:`~impactqp.load_fclib` tells
+them apart by content) with :func:`~impactqp.solve_friction` and print its certificate.
 
 Exit status 0 on a certified answer, 2 otherwise (an unreadable or malformed file, a bad
 option, no method certified at ``--tol``).
@@ -59,9 +60,10 @@ def run(args: argparse.Namespace) -> int:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("fclib", help="solve an FCLib frictional contact problem (.hdf5) with a "
-                                     "certificate")
-    p.add_argument("file", help="FCLib problem file (.hdf5), local or global")
+    p = sub.add_parser("fclib", help="solve a frictional contact problem (FCLib .hdf5 or "
+                                     "Siconos .dat/.dat.gz) with a certificate")
+    p.add_argument("file", help="FCLib problem file (.hdf5, local or global) or Siconos text "
+                                "file (.dat, .dat.gz)")
     p.add_argument("--backend", default="auto", choices=FRICTION_BACKENDS,
                    help="method of solve_friction (default auto)")
     p.add_argument("--tol", type=float, default=1e-8,

@@ -48,6 +48,11 @@ def run_S(args: argparse.Namespace) -> int:
     figure_format(args.out)
     out = _target(args)
     content = load_problem(args.file)
+    if content.problem.contact_dim > 1:
+        raise InputError(f"plot S draws S of frictionless contacts; {args.file} is "
+                         f"frictional (contact_dim = {content.problem.contact_dim}): give "
+                         "plot S a file with contact_dim = 1 and the normal columns of W "
+                         "only")
     marks = {}
     if content.law is not None:
         result = solve_law(content.problem, content.law, content.coefficients)

@@ -39,12 +39,31 @@ def parse_numbers(flag: str, text: str) -> float | np.ndarray:
     return np.array(rows)
 
 
+def check_fit(law: str, contact_dim: int, file: str, source: str) -> None:
+    """InputError, in the command line's words, when ``law`` (from ``source``: ``--law`` or
+    the file) does not act on the file's contacts: a frictional law on frictionless contacts
+    or a frictionless one on frictional contacts (docs/theory.md §16)."""
+    frictional = [name for name, cls in NAMED_LAWS.items() if cls.frictional]
+    if NAMED_LAWS[law].frictional and contact_dim == 1:
+        raise InputError(f"{source} {law} needs frictional contacts, but {file} has "
+                         "frictionless contacts (no contact_dim, or contact_dim = 1): pass "
+                         "--law newton --e E (or another frictionless law), or give the file "
+                         "contact_dim = 2 or 3 with that many columns of W per contact")
+    if not NAMED_LAWS[law].frictional and contact_dim > 1:
+        raise InputError(f"{source} {law} acts on frictionless contacts, but {file} has "
+                         f"frictional contacts (contact_dim = {contact_dim}): pass --law "
+                         f"{frictional[0]} --mu MU (and --e E for restitution), or give the "
+                         "file contact_dim = 1 with the normal columns of W only")
+
+
 def choose_law(args: argparse.Namespace, content: ProblemFile) -> tuple[str, Any]:
     """The law and coefficients: command-line flags override the file (which may have none).
     A law of several coefficients (Coulomb's μ and e) takes each from its flag or else from
     the file; the first of its keys is required when the law needs coefficients."""
     frictional = content.problem.contact_dim > 1
     law = args.law or content.law or ("coulomb" if frictional else "moreau")
+    check_fit(law, content.problem.contact_dim, args.file,
+              "--law" if args.law else "the file's law")
     keys = COEFFICIENT_KEYS.get(law, ())
     flags = {key: getattr(args, key) for key in KNOWN_COEFFICIENTS}
     stray = [k for k, v in flags.items() if v is not None and k not in keys]
@@ -73,9 +92,14 @@ def solve_law(problem: ImpactProblem, law: str, coefficients: Any,
               backend: str = "auto") -> ImpactResult:
     """Apply the law called ``law`` (docs/theory.md §3, §6, §10, §16) through
     :func:`impactqp.solve`, with exactly its checks (a closed-form law refuses a named
-    backend, as in Python); for Coulomb's law ``backend`` is a friction method of the registry
-    (:data:`~impactqp.laws.friction.FRICTION_BACKENDS`), as for :func:`impactqp.solve`."""
-    return solve(problem, law_named(law, coefficients), backend)
+    backend, as in Python, here in the command line's words); for Coulomb's law ``backend``
+    is a friction method of the registry (:data:`~impactqp.laws.friction.FRICTION_BACKENDS`),
+    as for :func:`impactqp.solve`."""
+    impact_law = law_named(law, coefficients)
+    if not impact_law.forms and backend not in ("auto", impact_law.closed_form_backend):
+        raise InputError(f"--law {law} is evaluated in closed form: drop --backend {backend} "
+                         "(or pass --backend auto)")
+    return solve(problem, impact_law, backend)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -97,13 +121,17 @@ def register(sub: argparse._SubParsersAction) -> None:
                                                "or coulomb for frictional contacts)")
     p.add_argument("--eps", help="Moreau's restitution ε in [0, 1]")
     p.add_argument("--e", help="Newton's coefficients (newton, and the normal restitution of "
-                               "coulomb, default 0): one number or one per contact, e.g. "
-                               "0.5,0.8")
+                               "coulomb, default 0; the energetic restitution of lzb, "
+                               "default 1): one number or one per contact, e.g. 0.5,0.8")
     p.add_argument("--E", help="Frémond's matrix, rows separated by ';', e.g. '0.5,0;0,0.5'")
     p.add_argument("--mu", help="Coulomb's friction coefficients ≥ 0: one number or one per "
                                 "contact, e.g. 0.3")
+    p.add_argument("--stiffness", help="the LZB model's contact stiffnesses K > 0 (lzb, "
+                                       "required): one number or one per contact, e.g. 1e7")
+    p.add_argument("--exponent", help="the LZB model's force exponents η in [1, 3] (lzb, "
+                                      "default 1.5, Hertz)")
     p.add_argument("--backend", default="auto",
-                   help="backend of the registry (default auto; iq.available_backends()): a "
+                   help="backend of the registry (default auto): a "
                         "QP backend, or for coulomb a friction method: "
                         f"{', '.join(FRICTION_BACKENDS)}")
     p.add_argument("--json", action="store_true", help="print the report as JSON")

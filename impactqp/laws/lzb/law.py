@@ -127,6 +127,10 @@ class LZB(ImpactLaw):
 
     name = "lzb"
     title = "the LZB model"
+    by_name = True
+    coefficient_keys = ("stiffness", "exponent", "e")
+    coefficient_symbol = "(K, η, e)"
+    needs_coefficients = True
     closed_form_backend = "lzb"
     always_solvable = True
     compliant = True
@@ -145,6 +149,28 @@ class LZB(ImpactLaw):
         self.energy_target = None if energy_target is None else \
             as_real("energy_target", energy_target, positive=True)
 
+
+    @classmethod
+    def from_coefficients(cls, coefficients: Any = None) -> LZB:
+        """The LZB model named in a file or on the command line: ``coefficients`` is the
+        triple (K, η, e) of the keys ``stiffness``, ``exponent`` and ``e`` (η None for
+        Hertz's 3/2, e None for 1), or the mapping :attr:`coefficients`.
+
+        Raises
+        ------
+        InputError, RestitutionError
+            No stiffness, or coefficients the law refuses.
+        """
+        if isinstance(coefficients, dict):
+            coefficients = tuple(coefficients.get(k) for k in ("stiffness", "exponent",
+                                                                "restitution"))
+        if not isinstance(coefficients, tuple) or len(coefficients) != 3 \
+                or coefficients[0] is None:
+            raise InputError("law 'lzb' needs its coefficients: the contact stiffness "
+                             "'stiffness' (required), 'exponent' (default 1.5) and 'e' "
+                             f"(default 1); got {coefficients!r}")
+        stiffness, exponent, e = coefficients
+        return cls(stiffness, 1.5 if exponent is None else exponent, 1.0 if e is None else e)
 
     @property
     def homogeneous(self) -> bool:
