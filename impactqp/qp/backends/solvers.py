@@ -60,7 +60,8 @@ SOLVERS: dict[str, Solver] = {s.name: s for s in (
 )}
 """The solvers impactqp names for its families with sub-solvers, with the extra that
 installs each (pyproject.toml: Clarabel and OSQP come with impactqp, the ``solvers`` extra
-brings the others but ProxQP); :func:`sub_solvers` says which are installed."""
+brings the others but ProxQP); :func:`impactqp.qp.backends.sub_solvers` says which are
+installed."""
 
 
 def missing_solver(family: str, solver: str, installed: tuple[str, ...]) -> UnknownBackendError:
