@@ -279,3 +279,31 @@ def test_backends_lists_the_registry_and_what_to_install(
     assert scs.split()[1] == "no" and "install: pip install 'impactqp[solvers]'" in scs
     kernel = next(line for line in text.splitlines() if line.startswith("kernel"))
     assert kernel.split()[1] == "yes" and "coulomb" in kernel
+
+
+def test_threads_share_one_redirection_and_restore_everything() -> None:
+    import os
+    import threading
+    import time
+    import warnings
+
+    from impactqp.qp.backends.quiet import quiet
+
+    before = (sys.stdout, list(warnings.filters), os.fstat(1).st_ino)
+    inside: list[tuple[bool, int]] = []
+    start = threading.Barrier(4)
+
+    def work(delay: float) -> None:
+        start.wait()
+        with quiet():
+            time.sleep(delay)
+            inside.append((sys.stdout is before[0], os.fstat(1).st_ino))
+
+    threads = [threading.Thread(target=work, args=(d,)) for d in (0.05, 0.0, 0.1, 0.02)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    null = os.stat(os.devnull).st_ino
+    assert inside and all(not same and ino == null for same, ino in inside)
+    assert (sys.stdout, list(warnings.filters), os.fstat(1).st_ino) == before
