@@ -9,7 +9,8 @@ admissible set S (:class:`AdmissibleSet`) and the geometric classification
 :func:`moreau`, :func:`newton`, :func:`fremond`, :func:`sector_law`,
 :func:`reflection_law`), many impacts at once (:func:`solve_batch`, :func:`moreau_batch`,
 :func:`sector_law_batch`), LCPs with symmetric matrices (:func:`solve_lcp`), the law
-verifier :func:`verify_law`, motion with any law (:class:`LinearSystem`, :func:`simulate`),
+verifier :func:`verify_law`, every backend compared on one impact
+(:func:`compare_backends`), motion with any law (:class:`LinearSystem`, :func:`simulate`),
 FCLib's local contact problems (:class:`FrictionContactProblem`, :func:`solve_friction`,
 :func:`load_fclib`) and the errors callers catch most (:class:`ImpactError` and below).
 
@@ -70,6 +71,7 @@ from .qp.lcp import solve_lcp
 from .simulation.simulate import simulate
 from .simulation.system import LinearForce, LinearSystem
 from .simulation.trajectory import Trajectory
+from .verification.bench import compare_backends
 from .verification.sampled import verify_law
 
 try:
@@ -87,7 +89,7 @@ __all__ = [
     # solving
     "solve", "moreau", "newton", "fremond", "sector_law", "reflection_law", "solve_batch",
     "moreau_batch", "sector_law_batch", "solve_lcp", "available_backends", "ImpactResult",
-    "verify_law",
+    "verify_law", "compare_backends",
     # motion
     "LinearSystem", "LinearForce", "simulate", "Trajectory",
     # friction

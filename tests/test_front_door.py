@@ -11,8 +11,10 @@ import pytest
 
 import impactqp as iq
 
+# names added to the top level after the public submodules came (issue 27)
+ADDED = {"compare_backends"}
 # the top level before the public submodules (107 names); each must still resolve
-FORMER_TOP_LEVEL = sorted(set(iq.__all__) | set(iq._MOVED))
+FORMER_TOP_LEVEL = sorted((set(iq.__all__) | set(iq._MOVED)) - ADDED)
 
 
 def test_the_top_level_is_small() -> None:

@@ -9,9 +9,20 @@ from importlib.metadata import PackageNotFoundError, version
 
 from ..base.log import verbosity
 from ..errors import ImpactError, OutOfRangeError
-from .commands import compile, demo, fclib, plot, sector, simulate, solve, verify
+from .commands import (
+    backends,
+    bench,
+    compile,
+    demo,
+    fclib,
+    plot,
+    sector,
+    simulate,
+    solve,
+    verify,
+)
 
-COMMANDS = [demo, solve, verify, fclib, plot, sector, simulate, compile]
+COMMANDS = [demo, solve, verify, fclib, plot, sector, simulate, compile, bench, backends]
 
 
 def build_parser() -> argparse.ArgumentParser:

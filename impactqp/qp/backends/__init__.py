@@ -15,7 +15,10 @@ Each entry declares the program forms it serves (``"velocity"``: general ``Ax �
 ``"friction"``: u = W r + q, r ∈ K_μ ⟂ ũ ∈ K*_μ), whether its answers are exact (no polishing
 needed), and what it is for; :data:`AUTO_ORDER` says in which order ``"auto"`` tries the
 entries of the cone and friction forms.
-:func:`available_backends` lists them with their install state.
+:func:`available_backends` lists them with their install state; :data:`SOLVERS`
+(:mod:`.solvers`) lists the solvers the families ``"cvxpy"`` and ``"qpsolvers"`` reach, with
+the extra that installs each, and a sub-solver that is not installed is refused by name with
+that extra (:func:`.solvers.missing_solver`); :func:`sub_solvers` says which are installed.
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from functools import cache
 from types import ModuleType
 
 from ...errors import BackendUnsuitableError, InputError, UnknownBackendError
+from .solvers import SOLVERS
 
 FORMS = ("velocity", "impulse")
 """The forms of quadratic programs (the ``form=`` of :func:`impactqp.solve`)."""
@@ -102,12 +106,15 @@ REGISTRY: dict[str, Backend] = {b.name: b for b in (
             options="attributes of clarabel.DefaultSettings (max_iter, tol_gap_abs, ...)"),
     Backend("osqp", "osqp_", "osqp", "osqp", FORMS, False, "OSQP (operator splitting), sparse",
             options="OSQP settings of its setup (max_iter, eps_abs, rho, ...)"),
-    Backend("cvxpy", "cvxpy_", "cvxpy", "cvxpy", FORMS + (CONE,), False,
+    Backend("cvxpy", "cvxpy_", "cvxpy", "cvxpy-base (a dependency of impactqp; pip install "
+            "'impactqp[solvers]' adds SCS, ECOS, HiGHS, PIQP and DAQP for it)",
+            FORMS + (CONE,), False,
             "any solver installed for cvxpy ('cvxpy:SOLVER'; default Clarabel)",
             sub_solver="optional",
             options="keyword arguments of cvxpy's Problem.solve for the solver"),
-    Backend("qpsolvers", "qpsolvers_", "qpsolvers", "qpsolvers (pip install 'impactqp[solvers]' "
-            "adds daqp, piqp, ecos, quadprog)", FORMS, False,
+    Backend("qpsolvers", "qpsolvers_", "qpsolvers", "qpsolvers (a dependency of impactqp; pip "
+            "install 'impactqp[solvers]' adds daqp, piqp, quadprog, ecos, scs and highs for it)",
+            FORMS, False,
             "any solver installed for qpsolvers ('qpsolvers:NAME', e.g. daqp, piqp, highs; "
             "'qpsolvers' alone: the best installed one for the program)",
             sub_solver="optional", options="keyword arguments of the qpsolvers solver"),
@@ -137,6 +144,23 @@ NSGS on well-conditioned problems, Newton from r = 0 most of the rest, the SOCP 
 badly conditioned ones, the damped and least-squares Newton some rank-deficient ones, a long
 NSGS last; the SOCP route, the least-squares Newton and the long NSGS start from the best
 answer so far (docs/theory.md §15)."""
+
+def sub_solvers(entry: Backend) -> list[dict]:
+    """The solvers of :data:`SOLVERS` that ``entry`` runs, as ``"family:solver"``, each with
+    whether it is installed and what to install (empty for a backend without sub-solvers).
+
+    Returns
+    -------
+    list of dict
+        Keys ``name``, ``installed`` and ``install``.
+    """
+    if entry.sub_solver == "none":
+        return []
+    have = set(load(entry).installed_solvers()) if entry.installed else set()
+    return [{"name": f"{entry.name}:{s.spelled(entry.name)}",
+             "installed": s.spelled(entry.name) in have, "install": s.install}
+            for s in SOLVERS.values() if entry.name in s.families]
+
 
 #: how each solver (qpsolvers or cvxpy name, lower case) spells its stopping tolerances
 TOLERANCE_OPTIONS: dict[str, tuple[str, ...]] = {

@@ -8,6 +8,11 @@ the linear term only (a parametrized quadratic term would make cvxpy build dense
 Cone programs (:class:`~impactqp.qp.cones.ConeProgram`) are built with fixed data each time
 (no parameter), the second-order cones of one size as one ``cp.SOC`` over rows; any conic
 solver of cvxpy takes them (Clarabel by default, ECOS or SCS by name).
+
+impactqp depends on ``cvxpy-base`` (cvxpy without bundled solvers): Clarabel and OSQP come
+with impactqp, ``pip install 'impactqp[solvers]'`` adds SCS, ECOS, HiGHS, PIQP and DAQP, and a
+solver that is not installed is refused by name with that extra. Solvers run quietly
+(:mod:`.quiet`).
 """
 
 from __future__ import annotations
@@ -18,10 +23,12 @@ import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 
-from ...errors import InputError, SolverError, UnknownBackendError
+from ...errors import InputError, SolverError
 from ..cones import ConeProgram, ConeSolution
 from ..program import QPSolution, QuadraticProgram
 from . import tolerance_options
+from .quiet import quiet
+from .solvers import missing_solver
 
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
@@ -63,20 +70,32 @@ def _compiled(qp: QuadraticProgram, solver: str | None):
     return entry[0]
 
 
+def installed_solvers() -> tuple[str, ...]:
+    """The solvers installed for cvxpy, as cvxpy spells them (``"CLARABEL"``, ``"SCS"``)."""
+    return tuple(cp.installed_solvers())
+
+
 def _solver_name(solver: str | None) -> str:
-    """cvxpy's name of ``solver`` (the default for None), or UnknownBackendError."""
-    if solver is not None and solver.upper() not in cp.installed_solvers():
-        raise UnknownBackendError(f"backend 'cvxpy:{solver}': that solver is not installed "
-                                  "for cvxpy; installed: "
-                                  f"{', '.join(cp.installed_solvers())}")
-    return solver.upper() if solver else DEFAULT_SOLVER
+    """cvxpy's name of ``solver`` (the default for None).
+
+    Raises
+    ------
+    UnknownBackendError
+        A solver not installed for cvxpy, named with the extra that installs it.
+    """
+    name = (solver or DEFAULT_SOLVER).upper()
+    installed = installed_solvers()
+    if name not in installed:
+        raise missing_solver("cvxpy", name, installed)
+    return name
 
 
 def _run(prob: cp.Problem, x: cp.Variable, name: str, tol: float,
          options: dict | None) -> str:
     """Solve ``prob`` with solver ``name``; the solver's name as cvxpy reports it."""
     try:
-        prob.solve(solver=name, **{**tolerance_options(name, tol), **(options or {})})
+        with quiet(options):
+            prob.solve(solver=name, **{**tolerance_options(name, tol), **(options or {})})
     except TypeError as exc:  # a keyword the solver does not take
         raise InputError(f"cvxpy ({name}) options {options}: {exc}") from exc
     except (cp.error.SolverError, ValueError) as exc:
