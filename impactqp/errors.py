@@ -32,6 +32,7 @@ __all__ = [
     "SectorInputError",
     "SectorTableTooLarge",
     "IntegrationBudgetError",
+    "UndrawableSystemError",
 ]
 
 
@@ -111,6 +112,11 @@ class CertificateError(SolverError):
 
 class SectorLawError(InputError):
     """The sector law does not apply to this problem (not a chain, walls, unequal masses)."""
+
+
+class UndrawableSystemError(InputError):
+    """An animation was asked of a system whose bodies impactqp does not know (one built
+    from matrices); the message says what can be drawn."""
 
 
 class SectorInputError(InputError):
