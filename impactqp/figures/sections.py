@@ -141,7 +141,7 @@ def plot_admissible(S: Any, path: str | Path | None = None, *,
         title = "S = (u⁻ + N) ∩ T_C ∩ B(0, ‖u⁻‖) " + (
             "in the plane u⁻ + range(M⁻¹W)" if whole else
             f"cut by a plane through u⁻ ({st.m} contacts)")
-    fig = new_figure(6.4, 7.4 + 0.2 * len(notes))
+    fig = new_figure(6.4, 7.4 + 0.3 * (len(marks) + 2 * len(notes)))  # room for the legend
     draw_plane(picture, fig.add_subplot(), title, plane=plane_name, notes=notes)
     if path is not None:
         save_figure(fig, path)
