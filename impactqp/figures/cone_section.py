@@ -1,6 +1,6 @@
 """The cones of a piecewise-linear impact law — the sector law (docs/theory.md §6) or the
-reflection law (§10) — cut by a plane of contact velocities γ through 0, as arrays for
-:func:`impactqp.figures.plots.draw_sectors`.
+reflection law (docs/theory.md §10) — cut by a plane of contact velocities γ through 0, as
+arrays for :func:`impactqp.figures.plots.draw_sectors`.
 
 The plane is drawn in coordinates orthonormal for the kinetic metric G⁻¹ of γ-space
 (:func:`sector_frame`), where the cones have their true angles (60° for three equal balls)
@@ -23,7 +23,8 @@ from .plane_cone import kinetic_frame
 @dataclass(frozen=True)
 class Wedge:
     """The trace of one cone of a piecewise-linear law (the sector law, docs/theory.md §6,
-    or the reflection law, §10) in a plane of γ-space, drawn as a circular sector.
+    or the reflection law, docs/theory.md §10) in a plane of γ-space, drawn as a circular
+    sector.
 
     All points are in the G⁻¹-orthonormal coordinates y of the plane (γ = ``frame @ y``);
     ``sample`` is a γ⁻ inside the cone and ``image`` its γ⁺ = Q γ⁻ projected on the plane,

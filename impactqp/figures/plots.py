@@ -161,7 +161,7 @@ def draw_sectors(wedges: list[Wedge], ax: Any, radius: float = 1.0, title: str |
     Parameters
     ----------
     wedges : list of Wedge
-        From :func:`~impactqp.figures.geometry2d.cone_section`.
+        From :func:`~impactqp.figures.cone_section.cone_section`.
     ax : matplotlib.axes.Axes
         Where to draw.
     radius : float

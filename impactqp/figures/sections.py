@@ -193,8 +193,8 @@ def plot_sectors(problem: ImpactProblem | None = None, path: str | Path | None =
                  n_balls: int = 3, masses: ArrayLike | None = None, plane: Any = None,
                  title: str | None = None) -> Any:
     """Draw the cones of the sector law (equal balls, docs/theory.md §6) or of the reflection
-    law (masses whose contact angles are 180°/k, §10) cut by a plane of γ⁻ through 0, with
-    γ⁻ ↦ γ⁺ on each cone.
+    law (masses whose contact angles are 180°/k, docs/theory.md §10) cut by a plane of γ⁻
+    through 0, with γ⁻ ↦ γ⁺ on each cone.
 
     With three balls γ-space is the plane and the figure shows every cone; with more it
     shows the section by ``plane`` — by default the plane of a γ⁻ and its image γ⁺ (the

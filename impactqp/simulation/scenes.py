@@ -159,7 +159,7 @@ def _box(ax: Any, Q: np.ndarray, sizes: dict) -> Update:
 def draw_scene(trajectory: Any, ax: Any, Q: np.ndarray, *, length: float | None = None,
                radius: float | None = None) -> Update:
     """Draw the bodies of a builder's system on ``ax`` and return the function that moves
-    them to a position q (what each frame of :func:`animate` calls).
+    them to a position q (what each frame of :func:`~impactqp.simulation.pictures.animate` calls).
 
     Parameters
     ----------
