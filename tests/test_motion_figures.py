@@ -41,13 +41,8 @@ def cradle():
     return iq.simulate(cradle_system(3), iq.SectorLaw(), 1.0, scheme="event-driven", h=0.05)
 
 
-def _figure_axes(fig):
-    return fig.axes
-
-
 def test_coordinates_are_grouped_by_kind_with_units(sphere):
-    fig = sphere.plot("positions")
-    axes = _figure_axes(fig)
+    axes = sphere.plot("positions").axes
     assert len(axes) == 2
     assert [ax.get_ylabel() for ax in axes] == ["position (m)", "angle (rad)"]
     assert [[line.get_label() for line in ax.get_lines()] for ax in axes] == [["x", "y"], ["φ"]]
@@ -191,6 +186,18 @@ def test_animations_draw_the_builders_bodies(sphere, cradle):
     normal = np.array([-np.sin(0.4), np.cos(0.4)])
     heights = patch.get_xy()[:4] @ normal  # above the incline nᵀx = 0, two corners on it
     assert sorted(heights)[:2] == pytest.approx([Q[1] @ normal] * 2, abs=1e-9)
+
+
+def test_balls_on_a_vertical_line_sit_on_the_ground():
+    from matplotlib.figure import Figure
+
+    for radius in (0.0, 0.1):  # q the lowest point of a point ball, else the centre
+        tr = iq.simulate(iq.simulation.bouncing_ball(q0=1.0, radius=radius), iq.Newton(0.5),
+                         1.0, scheme="event-driven", h=0.01)
+        _, Q = frames_of(tr, 50)
+        (ball,) = draw_scene(tr, Figure().add_subplot(), Q)(Q[np.argmin(Q[:, 0])])
+        assert ball.center[1] - ball.radius == pytest.approx(Q[:, 0].min() - radius, abs=1e-9)
+        assert ball.center[1] - ball.radius >= -1e-9
 
 
 def test_an_animation_is_written_and_an_unknown_system_refused(tmp_path, sphere):

@@ -50,6 +50,13 @@ def test_the_section_is_S_point_by_point(problem):
     step = 1e-6 * pic.radius
     outward = (poly - centre) / np.linalg.norm(poly - centre, axis=1)[:, None]
     assert not any(S.contains(u) for u in pic.lift(poly + step * outward))
+    # each vertex lies on the energy circle or on the line of one of the exact half-planes
+    for x in poly:
+        on_circle = abs(np.linalg.norm(x) - pic.radius) <= 1e-9 * pic.radius
+        on_line = min(abs(n @ x - c) / np.linalg.norm(n) for n, c in pic.halfplanes)
+        assert on_circle or on_line <= 1e-9 * pic.radius
+        assert all(n @ x - c >= -1e-9 * pic.radius * np.linalg.norm(n)
+                   for n, c in pic.halfplanes)
     # a grid of the plane: exact membership agrees with the polygon away from its boundary
     g = np.linspace(-pic.half_width, pic.half_width, 23)
     agree = checked = 0
@@ -164,3 +171,7 @@ def test_reflection_law_cones_and_a_refusal(tmp_path):
     assert (tmp_path / "r.png").read_bytes()[:4] == b"\x89PNG"
     with pytest.raises(iq.errors.SectorLawError, match="no continuous elastic law"):
         iq.plot_sectors(HEAVY)
+    with pytest.raises(iq.InputError, match="path='s.png'"):
+        iq.plot_sectors("s.png")
+    with pytest.raises(iq.InputError, match="at least 3 positive"):
+        iq.plot_sectors(masses=[1.0, -1.0, 1.0])

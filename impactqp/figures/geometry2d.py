@@ -5,8 +5,8 @@
 S is drawn by its section through u⁻ with a plane, for any number of contacts. With two
 independent contacts, ``u⁻ + N`` and hence S lie in the 2-D affine plane
 ``u⁻ + range(M⁻¹W)`` (for the 3-ball cradle: the momentum-conserving velocities
-u₁ + u₂ + u₃ = v), the default plane. Coordinates in a plane are taken in an M-orthonormal basis, so
-Euclidean lengths and angles of the picture are the kinetic ones of docs/theory.md §1: the
+u₁ + u₂ + u₃ = v), the default plane. Coordinates in a plane are taken in an M-orthonormal
+basis, so Euclidean lengths and angles of the picture are the kinetic ones of docs/theory.md §1: the
 energy ball becomes a true circle and the angle α of docs/theory.md §4 is the angle seen on
 paper. Everything here is arrays; :mod:`impactqp.figures.plots` draws them.
 """

@@ -238,6 +238,9 @@ def plot_sectors(problem: ImpactProblem | None = None, path: str | Path | None =
         figure_format(path)
     left = right = False
     gamma = None
+    if isinstance(problem, (str, Path)):
+        raise InputError(f"plot_sectors takes a chain problem first; give the output file as "
+                         f"path={str(problem)!r}")
     if problem is not None:
         info = require_chain(problem, "picture of the sector law")
         weights, left, right = info.masses, info.left_wall, info.right_wall

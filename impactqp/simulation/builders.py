@@ -64,7 +64,7 @@ def bouncing_ball(mass: float = 1.0, q0: float = 1.0, v0: float = 0.0, gravity: 
     M, H, info = _chain_matrices(np.array([mass]), left_wall=True, sparse=False)
     return LinearSystem(M, [q0], [v0], [-mass * gravity], H, [-radius], chain=info,
                         coordinates=_numbered("y", 1),
-                        scene=Scene("vertical balls", {"radius": radius, "lowest": True}))
+                        scene=Scene("vertical balls", {"radius": radius}))
 
 
 def cradle_system(n_balls: int = 3, mass: float = 1.0, length: float = 1.0,
@@ -158,7 +158,7 @@ def bead_chain(n_beads: int = 10, mass: float = 1.0, radius: float = 0.1, height
     q0 = height + spacing * np.arange(n)
     return LinearSystem(M, q0, np.full(n, velocity), np.full(n, -mass * gravity), H, b,
                         chain=info, coordinates=_numbered("y", n),
-                        scene=Scene("vertical balls", {"radius": radius, "lowest": False}))
+                        scene=Scene("vertical balls", {"radius": radius}))
 
 
 def block_on_incline(angle: float, mass: float = 1.0, gravity: float = 9.81, dim: int = 2,

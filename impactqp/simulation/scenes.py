@@ -64,13 +64,13 @@ def _pendulums(ax: Any, Q: np.ndarray, sizes: dict, length: float | None,
 
 def _vertical_balls(ax: Any, Q: np.ndarray, sizes: dict, radius: float | None) -> Update:
     """Balls on a vertical line above the ground; q is a centre's height, or the lowest
-    point's (a bouncing ball of radius 0, as the builder measures it)."""
+    point's for balls of radius 0 (as the builders measure it), drawn with a small radius."""
     from matplotlib.patches import Circle
 
     top = float(Q.max())
     r = sizes["radius"] if radius is None else radius
     r = r if r > 0 else 0.05 * max(top, 1e-3)
-    lift = r if sizes["lowest"] or sizes["radius"] == 0 else 0.0
+    lift = r if sizes["radius"] == 0 else 0.0
     n = Q.shape[1]
     _view(ax, (-4 * r, 4 * r), (-0.5 * r, top + lift + 1.5 * r))
     ax.plot([-4 * r, 4 * r], [0, 0], color="0.3", lw=2)
