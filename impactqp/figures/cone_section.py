@@ -45,7 +45,9 @@ class Wedge:
 
 
 def _matrix_text(Q: np.ndarray) -> str:
-    return "Q = [" + "; ".join(" ".join(f"{v + 0.0:g}" for v in row) for row in Q) + "]"
+    """``Q = [a b; c d]`` with 4 digits, round-off below 10⁻¹² of the largest entry shown 0."""
+    Q = np.where(np.abs(Q) <= 1e-12 * np.abs(Q).max(), 0.0, Q)
+    return "Q = [" + "; ".join(" ".join(f"{v + 0.0:.4g}" for v in row) for row in Q) + "]"
 
 
 def sector_frame(G: ArrayLike) -> np.ndarray:

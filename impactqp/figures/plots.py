@@ -183,25 +183,23 @@ def draw_sectors(wedges: list[Wedge], ax: Any, radius: float = 1.0, title: str |
         color = colors[k % len(colors)]
         ax.fill(*wedge.polygon.T, color=color, alpha=0.18, lw=0)
         ax.text(*wedge.anchor, wedge.text, ha="center", va="center",
-                fontsize=8 if full else 6)
+                fontsize=8 if full and len(wedges) <= 6 else 6)
         if wedge.off_plane <= 1e-9:
             ax.plot(*wedge.sample, "o", color=color, ms=5)
             ax.annotate("", wedge.image, xytext=wedge.sample,
                         arrowprops={"arrowstyle": "->", "color": color, "lw": 1.2})
             ax.plot(*wedge.image, "x", color=color, ms=7, mew=1.5)
-    if full:
+    for wedge in wedges:  # the boundaries of the cones
+        ax.plot([0, radius * wedge.rays[0][0]], [0, radius * wedge.rays[0][1]],
+                color="0.3", lw=0.8)
+    if full:  # name the lines γᵢ = 0, boundaries of T_C = {γ ≥ 0}, a cone of every law
         to_y = np.linalg.inv(wedges[0].frame)
-        for g, name in (([1, 0], "γ₂ = 0"), ([0, 1], "γ₁ = 0"), ([1, -1], "γ₁ + γ₂ = 0")):
+        for g, name in (([1, 0], "γ₂ = 0"), ([0, 1], "γ₁ = 0")):
             d = to_y @ np.array(g, dtype=float)
             d *= radius / np.linalg.norm(d)
-            ax.plot([-d[0], d[0]], [-d[1], d[1]], color="0.3", lw=0.8)
             ax.annotate(name, d, xytext=6 * d / radius, textcoords="offset points",
                         fontsize=8, color="0.3", ha="left" if d[0] > 0.01 else "center",
                         va="bottom" if d[1] >= 0 else "top")
-    else:
-        for wedge in wedges:
-            ax.plot([0, radius * wedge.rays[0][0]], [0, radius * wedge.rays[0][1]],
-                    color="0.3", lw=0.8)
     if gamma is not None:
         g_minus, g_plus = gamma
         ax.plot(*g_minus, "s", color="black", ms=6)

@@ -276,7 +276,8 @@ def plot_sectors(problem: ImpactProblem | None = None, path: str | Path | None =
         shown = ", ".join(f"{w:.4g}" for w in np.asarray(weights)[:8])
         title = (f"{name}, {np.asarray(weights).size} balls, masses ({shown}): "
                  f"γ⁺ = Q γ⁻ on each cone\n"
-                 + ("dots: sample γ⁻, crosses: their images γ⁺" if m == 2 else
+                 + ("in the kinetic metric G⁻¹ every Q is an isometry; dots: sample γ⁻, "
+                    "crosses: their images γ⁺" if m == 2 else
                     f"section of {m}-dimensional γ-space by the plane of γ⁻ and γ⁺; "
                     "black: γ⁻ ↦ γ⁺"))
     fig = new_figure(7.0, 7.0)
