@@ -12,7 +12,9 @@ admissible set S (:class:`AdmissibleSet`) and the geometric classification
 verifier :func:`verify_law`, every backend compared on one impact
 (:func:`compare_backends`), motion with any law (:class:`LinearSystem`, :func:`simulate`),
 FCLib's local contact problems (:class:`FrictionContactProblem`, :func:`solve_friction`,
-:func:`load_fclib`) and the errors callers catch most (:class:`ImpactError` and below).
+:func:`load_fclib`), figures of S and of the sector law (:func:`plot_admissible`,
+:func:`plot_sectors`; the ``plot`` extra) and the errors callers catch most
+(:class:`ImpactError` and below).
 
 Everything else lives in public submodules, each a complete view of its area:
 :mod:`impactqp.problems`, :mod:`impactqp.results`, :mod:`impactqp.friction`,
@@ -46,6 +48,7 @@ from .errors import (
     OutOfRangeError,
     SolverError,
 )
+from .figures.sections import plot_admissible, plot_sectors
 from .io.fclib import load_fclib, save_fclib
 from .io.files import load_problem
 from .io.save import save_problem
@@ -92,6 +95,8 @@ __all__ = [
     "verify_law", "compare_backends",
     # motion
     "LinearSystem", "LinearForce", "simulate", "Trajectory",
+    # figures (the plot extra)
+    "plot_admissible", "plot_sectors",
     # friction
     "FrictionContactProblem", "solve_friction", "load_fclib", "save_fclib",
     # errors

@@ -32,6 +32,7 @@ __all__ = [
     "SectorInputError",
     "SectorTableTooLarge",
     "IntegrationBudgetError",
+    "UndrawableSystemError",
 ]
 
 
@@ -136,6 +137,11 @@ def _rebuild_certificate_error(cls: type, message: str, best: object,
 
 class SectorLawError(InputError):
     """The sector law does not apply to this problem (not a chain, walls, unequal masses)."""
+
+
+class UndrawableSystemError(InputError):
+    """An animation was asked of a system whose bodies impactqp does not know (one built
+    from matrices); the message says what can be drawn."""
 
 
 class SectorInputError(InputError):

@@ -154,19 +154,19 @@ def test_figures(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, trajectory) ->
     from matplotlib.figure import Figure
 
     from impactqp.figures.compare_plot import plot_comparison
-    from impactqp.figures.plots import plot_sectors
+    from impactqp.figures.sections import plot_sectors
 
     path = previous(tmp_path / "s.png")
     with monkeypatch.context() as patch:
         patch.setattr(Figure, "savefig", method_writing_half_then_failing)
         with pytest.raises(Interrupted):
-            plot_sectors(path)
+            plot_sectors(path=path)
         with pytest.raises(Interrupted):
             trajectory.plot("energy", path)
         with pytest.raises(Interrupted):
             plot_comparison([iq.verification.compare_chain(iq.chains.monodisperse_chain(3))], path)
     assert_untouched(path)
-    plot_sectors(path)
+    plot_sectors(path=path)
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.png"]
 

@@ -147,6 +147,23 @@ def test_plot_commands(capsys, tmp_path, cradle_file):
     assert (tmp_path / "c.pdf").read_bytes().startswith(b"%PDF")
 
 
+def test_plot_draws_any_number_of_contacts_and_balls(capsys, tmp_path):
+    heavy = iq.save_problem(iq.chain([1.0, 1.0, 1.0, 3.0], [1.0, 0.0, 0.0, 0.0]),
+                            tmp_path / "heavy.json")
+    four = iq.save_problem(iq.newtons_cradle(4), tmp_path / "four.json")
+    for argv in (["plot", "S", heavy, "--out", tmp_path / "S4.png"],
+                 ["plot", "sectors", four, "--out", tmp_path / "s4.png"],
+                 ["plot", "sectors", "--balls", "5", "--out", tmp_path / "s5.png"],
+                 ["plot", "sectors", "--masses", "1", "0.41421356237309503", "1",
+                  "--out", tmp_path / "r3.png"]):
+        code, out, err = run(capsys, *argv)
+        assert (code, err) == (0, "") and out == f"wrote {argv[-1]}\n"
+        assert argv[-1].read_bytes()[:4] == b"\x89PNG"
+    code, _, err = run(capsys, "plot", "sectors", four, "--balls", "4", "--out",
+                       tmp_path / "x.png")
+    assert code == 2 and "not both" in err
+
+
 def test_plot_refuses_to_overwrite_without_force(capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     code, out, _ = run(capsys, "plot", "sectors")  # default output: ./sectors.png
@@ -171,9 +188,13 @@ def test_plot_help_documents_the_default(capsys):
 
 
 def test_plot_errors_exit_2(capsys, tmp_path, monkeypatch):
-    path = iq.save_problem(iq.newtons_cradle(4), tmp_path / "four.json")
+    path = iq.save_problem(iq.newtons_cradle(3, v=-1.0), tmp_path / "away.json")
     code, _, err = run(capsys, "plot", "S", path, "--out", tmp_path / "x.png")
-    assert code == 2 and "exactly 2 independent contacts" in err
+    assert code == 2 and "S = {u⁻}" in err
+    heavy = iq.save_problem(iq.chain([1.0, 1.0, 1.0, 3.0], [1.0, 0.0, 0.0, 0.0]),
+                            tmp_path / "heavy.json")
+    code, _, err = run(capsys, "plot", "sectors", heavy, "--out", tmp_path / "x.png")
+    assert code == 2 and "no continuous elastic law" in err and "45°" in err
     code, _, err = run(capsys, "plot", "cradle", "--out", tmp_path / "x.jpg")
     assert code == 2 and "must end in one of" in err
     monkeypatch.setitem(sys.modules, "matplotlib.figure", None)

@@ -22,6 +22,8 @@ EXPECTED = {
     "benchmark_run.py": ["# impactqp benchmark — suite `smoke`", "## Targets"],
     "lzb_comparison.py": ["3 balls, u⁻ = (1, 0, …, 0) m/s", "10 balls"],
     "simulate_cradle.py": ["cradle.gif"],
+    "figures.py": ["the sphere rolls from t = 0.195 s (2v₀/(7μg) = 0.194 s)",
+                   "S of the heavy 4-ball cradle: 3 contacts", "sectors_4_balls.png"],
     "friction.py": ["sphere on the floor", " 0.05  slip ", "  0.3  stick ",
                     "FCLib LMGC_GlobalFrictionContactProblem00046.hdf5: 9 contacts, d = 3",
                     "certificate ok at tol 1e-08"],
@@ -31,6 +33,8 @@ WRITES = {
     "benchmark_run.py": {"results.csv", "results.json", "summary.md", "plot.png"},
     "lzb_comparison.py": {"lzb_comparison.png"},
     "simulate_cradle.py": {"bouncing_ball_energy.png", "cradle_positions.png", "cradle.gif"},
+    "figures.py": {"sphere_positions.png", "sphere_contacts.png", "sphere.gif",
+                   "S_heavy_cradle.png", "sectors_4_balls.png"},
 }
 """The files each writing example leaves in the folder it prints last."""
 

@@ -12,7 +12,7 @@ import pytest
 import impactqp as iq
 
 # names added to the top level after the public submodules came (issue 27)
-ADDED = {"compare_backends"}
+ADDED = {"compare_backends", "plot_admissible", "plot_sectors"}
 # the top level before the public submodules (107 names); each must still resolve
 FORMER_TOP_LEVEL = sorted((set(iq.__all__) | set(iq._MOVED)) - ADDED)
 
@@ -21,6 +21,14 @@ def test_the_top_level_is_small() -> None:
     assert len(iq.__all__) <= 55
     assert len(set(iq.__all__)) == len(iq.__all__)
     assert len(FORMER_TOP_LEVEL) == 107
+
+
+def test_the_figures_are_at_the_top_level() -> None:
+    from impactqp.figures import sections
+
+    assert ADDED <= set(iq.__all__)
+    assert iq.plot_admissible is sections.plot_admissible
+    assert iq.plot_sectors is sections.plot_sectors
 
 
 def test_dir_shows_the_top_level_and_the_submodules_only() -> None:

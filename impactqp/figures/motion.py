@@ -30,7 +30,8 @@ def plot_energy(trajectory: Trajectory, path: str | Path, title: str = "") -> Pa
 
 def plot_positions(trajectory: Trajectory, path: str | Path, title: str = "",
                    dofs: Any = None) -> Path:
-    """Write the positions qᵢ(t) over time (``trajectory.plot("positions")``)."""
+    """Write the coordinates over time, one axes per kind (``trajectory.plot("positions")``);
+    ``dofs`` chooses them by name or by 1-based number, as the labels show."""
     pictures.plot(_check(trajectory), "positions", path, title=title, dofs=dofs)
     return Path(path)
 
@@ -41,6 +42,7 @@ def cradle_frames(trajectory: Trajectory, frames: int) -> tuple[np.ndarray, np.n
 
 
 def animate_cradle(trajectory: Trajectory, path: str | Path, **options: Any) -> Path:
-    """Write an animation of a cradle run (``trajectory.animate(path, **options)``)."""
+    """Write an animation of a run (``trajectory.animate(path, **options)``): a cradle's
+    balls on their pendulums, or the bodies of any other builder's system."""
     pictures.animate(_check(trajectory), path, **options)
     return Path(path)

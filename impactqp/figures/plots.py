@@ -1,5 +1,6 @@
-"""Figures of S (docs/theory.md §2–§5) and of the sector law (docs/theory.md §6), drawn from
-:mod:`impactqp.figures.geometry2d`.
+"""Drawing S (docs/theory.md §2–§5) and the cones of the sector law (docs/theory.md §6) on
+matplotlib axes, from the data of :mod:`impactqp.figures.geometry2d`; the figures that use
+them are in :mod:`impactqp.figures.sections`.
 
 matplotlib is an optional extra (``pip install 'impactqp[plot]'``), imported only here and
 only when a figure is drawn. Figures are built on a bare :class:`matplotlib.figure.Figure`
@@ -14,18 +15,12 @@ share it (Moreau's half-line), so that neither hides the other.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
 
-from ..base.figure import figure_format, new_figure, save_figure
-from ..model.builders import newtons_cradle
-from ..model.problem import ImpactProblem
-from ..tables.sector_table import sector_velocity_map
-from .geometry2d import PlanePicture, Wedge, plane_picture, sector_picture
+from .cone_section import Wedge
+from .geometry2d import PlanePicture
 
 COLORS = {"reaction": ("#d6e6f4", "tab:blue"), "tangent": "tab:orange", "S": "#74c476"}
 """Fill and edge colours of the regions of :func:`draw_plane`."""
@@ -66,7 +61,8 @@ def _edges(polygon: np.ndarray, half_width: float) -> np.ndarray:
 
 
 def draw_plane(picture: PlanePicture, ax: Any, title: str = "",
-               plane: str = "the plane u⁻ + range(M⁻¹W)") -> None:
+               plane: str = "the plane u⁻ + range(M⁻¹W)", notes: list[str] | None = None,
+               ) -> None:
     """Draw S, u⁻ + N, T_C, the energy circle, Moreau's half-line and the candidates
     (docs/theory.md §5).
 
@@ -84,22 +80,32 @@ def draw_plane(picture: PlanePicture, ax: Any, title: str = "",
         Axes title.
     plane : str
         How the axis labels name the plane (its coordinates are M-orthonormal).
+    notes : list of str, optional
+        Lines added to the legend (laws that are not defined for the problem, say).
     """
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
     h = picture.half_width
     fill, edge = COLORS["reaction"]
-    ax.fill(*picture.reaction_cone.T, fc=fill, lw=0, zorder=1)
-    ax.plot(*_edges(picture.reaction_cone, h).T, color=edge, lw=1.3, zorder=2)
+    if len(picture.reaction_cone) > 2:
+        ax.fill(*picture.reaction_cone.T, fc=fill, lw=0, zorder=1)
+        ax.plot(*_edges(picture.reaction_cone, h).T, color=edge, lw=1.3, zorder=2)
+    else:  # the trace of u⁻ + N is a ray (or u⁻ alone)
+        ax.plot(*picture.reaction_cone.T, color=edge, lw=1.3, zorder=2)
     ax.fill(*picture.tangent_cone.T, fc="none", ec=COLORS["tangent"], hatch="///", lw=0,
             zorder=1.5)
     ax.plot(*_edges(picture.tangent_cone, h).T, color=COLORS["tangent"], lw=4.0,
             solid_capstyle="butt", zorder=2.5)
-    ax.fill(*picture.admissible.T, fc=COLORS["S"], lw=0, zorder=2)
+    if len(picture.admissible) > 2:
+        ax.fill(*picture.admissible.T, fc=COLORS["S"], lw=0, zorder=2)
+    else:  # a section that is a segment
+        ax.plot(*picture.admissible.T, color=COLORS["S"], lw=6, solid_capstyle="butt",
+                zorder=2)
     circle = np.vstack([picture.circle, picture.circle[:1]])
     ax.plot(*circle.T, ls="--", color="0.3", lw=1.0, zorder=3)
-    ax.plot(*picture.moreau_line.T, color="black", lw=1.4, zorder=3)
+    if len(picture.moreau_line):
+        ax.plot(*picture.moreau_line.T, color="black", lw=1.4, zorder=3)
     for eps, x in picture.moreau_marks.items():
         ax.plot(*x, "o", color="black", ms=5, zorder=4)
         ax.annotate(f"ε = {eps:g}" + (" (z)" if eps == 0 else ""), x, xytext=(-12, 0),
@@ -113,13 +119,16 @@ def draw_plane(picture: PlanePicture, ax: Any, title: str = "",
               label="T_C (its trace in the plane)"),
         Patch(fc=COLORS["S"], label="S"),
         Line2D([], [], ls="--", color="0.3", lw=1.0, label="energy circle ‖u‖ = ‖u⁻‖"),
-        Line2D([], [], color="black", lw=1.4, marker="o", ms=4,
-               label="Moreau's half-line (ε marked)"),
     ]
+    if len(picture.moreau_line):
+        handles.append(Line2D([], [], color="black", lw=1.4, marker="o", ms=4,
+                              label="Moreau's half-line (ε marked)"))
     for k, cand in enumerate(picture.candidates):
         style = candidate_style(k)
         alpha = ("α undefined: u⁺ = u⁻" if np.isnan(cand.alpha_deg)
                  else f"α = {cand.alpha_deg:.1f}°")
+        if cand.off_plane > 1e-9:
+            alpha += f"; off the plane by {cand.off_plane:.2g}‖u⁻‖, projected"
         (mark,) = ax.plot(*cand.point, zorder=5 + 0.01 * k, label=f"{cand.label} ({alpha})",
                           **style)
         handles.append(mark)
@@ -127,148 +136,87 @@ def draw_plane(picture: PlanePicture, ax: Any, title: str = "",
             ax.plot(*cand.arc.T, color=style["color"], lw=1.2, zorder=4)
             ax.plot(*np.array([picture.u_minus, cand.point]).T, color=style["color"], lw=0.9,
                     ls=":", zorder=4)
+    handles += [Line2D([], [], ls="none", label=note) for note in notes or []]
     ax.set_xlim(-h, h)
     ax.set_ylim(-h, h)
     ax.set_aspect("equal")
-    ax.set_xlabel(f"x₁: M-orthonormal coordinate in {plane}, ⊥ Moreau's half-line",
-                  fontsize=9)
-    ax.set_ylabel(f"x₂: M-orthonormal coordinate in {plane}, along u⁻ − z", fontsize=9)
+    moreau = len(picture.moreau_line) > 0
+    ax.set_xlabel(f"x₁: M-orthonormal coordinate in {plane}"
+                  + (", ⊥ Moreau's half-line" if moreau else ""), fontsize=9)
+    ax.set_ylabel(f"x₂: M-orthonormal coordinate in {plane}"
+                  + (", along u⁻ − z" if moreau else ""), fontsize=9)
     # below the axes: the α of each candidate is read there, never written over the picture
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2,
-              fontsize=8, frameon=False)
+    wide = any(len(line) > 48 for h in handles for line in h.get_label().split("\n"))
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09),
+              ncol=1 if wide else 2, fontsize=8, frameon=False)
     ax.set_title(title, fontsize=10)
 
 
-def draw_sectors(wedges: list[Wedge], ax: Any, radius: float = 1.0) -> None:
-    """Draw the six cones of the γ⁻ plane with their Q and sample points γ⁻ ↦ γ⁺
-    (docs/theory.md §6), in the G⁻¹-orthonormal coordinates of the wedges.
+def draw_sectors(wedges: list[Wedge], ax: Any, radius: float = 1.0, title: str | None = None,
+                 gamma: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+    """Draw the cones of a piecewise-linear law cut by a plane of γ⁻ with their labels and
+    sample points γ⁻ ↦ γ⁺ (docs/theory.md §6, §10), in the G⁻¹-orthonormal coordinates of
+    the wedges.
 
     Parameters
     ----------
     wedges : list of Wedge
-        From :func:`~impactqp.figures.geometry2d.sector_picture`.
+        From :func:`~impactqp.figures.cone_section.cone_section`.
     ax : matplotlib.axes.Axes
         Where to draw.
     radius : float
         Radius of the wedges.
+    title : str, optional
+        Axes title (default: that of the 3-ball sector law).
+    gamma : pair of (2,) arrays, optional
+        A γ⁻ and its γ⁺ in the plane's coordinates, drawn as a black arrow (a problem's).
+
+    Notes
+    -----
+    The image of a sample that leaves the plane (γ-space of more than two contacts) is not
+    drawn: its arrow would point at a projection.
     """
-    colors = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown"]
-    for wedge, color in zip(wedges, colors):
+    colors = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
+              "tab:pink", "tab:olive", "tab:cyan", "tab:gray"]
+    full = wedges[0].frame.shape[1] == wedges[0].frame.shape[0]  # γ-space is the plane
+    for k, wedge in enumerate(wedges):
+        color = colors[k % len(colors)]
         ax.fill(*wedge.polygon.T, color=color, alpha=0.18, lw=0)
-        ax.text(*wedge.anchor, wedge.text, ha="center", va="center", fontsize=8)
-        ax.plot(*wedge.sample, "o", color=color, ms=5)
-        ax.annotate("", wedge.image, xytext=wedge.sample,
-                    arrowprops={"arrowstyle": "->", "color": color, "lw": 1.2})
-        ax.plot(*wedge.image, "x", color=color, ms=7, mew=1.5)
-    to_y = np.linalg.inv(wedges[0].frame)
-    for gamma, name in (([1, 0], "γ₂ = 0"), ([0, 1], "γ₁ = 0"), ([1, -1], "γ₁ + γ₂ = 0")):
-        d = to_y @ np.array(gamma, dtype=float)
-        d *= radius / np.linalg.norm(d)
-        ax.plot([-d[0], d[0]], [-d[1], d[1]], color="0.3", lw=0.8)
-        ax.annotate(name, d, xytext=6 * d / radius, textcoords="offset points", fontsize=8,
-                    color="0.3", ha="left" if d[0] > 0.01 else "center",
-                    va="bottom" if d[1] >= 0 else "top")
+        ax.text(*wedge.anchor, wedge.text, ha="center", va="center",
+                fontsize=8 if full and len(wedges) <= 6 else 6)
+        if wedge.off_plane <= 1e-9:
+            ax.plot(*wedge.sample, "o", color=color, ms=5)
+            ax.annotate("", wedge.image, xytext=wedge.sample,
+                        arrowprops={"arrowstyle": "->", "color": color, "lw": 1.2})
+            ax.plot(*wedge.image, "x", color=color, ms=7, mew=1.5)
+    for wedge in wedges:  # the boundaries of the cones
+        ax.plot([0, radius * wedge.rays[0][0]], [0, radius * wedge.rays[0][1]],
+                color="0.3", lw=0.8)
+    if full:  # name the lines γᵢ = 0, boundaries of T_C = {γ ≥ 0}, a cone of every law
+        to_y = np.linalg.inv(wedges[0].frame)
+        for g, name in (([1, 0], "γ₂ = 0"), ([0, 1], "γ₁ = 0")):
+            d = to_y @ np.array(g, dtype=float)
+            d *= radius / np.linalg.norm(d)
+            ax.annotate(name, d, xytext=6 * d / radius, textcoords="offset points",
+                        fontsize=8, color="0.3", ha="left" if d[0] > 0.01 else "center",
+                        va="bottom" if d[1] >= 0 else "top")
+    if gamma is not None:
+        g_minus, g_plus = gamma
+        ax.plot(*g_minus, "s", color="black", ms=6)
+        ax.annotate("γ⁻", g_minus, xytext=(6, 4), textcoords="offset points", fontsize=10)
+        ax.annotate("", g_plus, xytext=g_minus,
+                    arrowprops={"arrowstyle": "->", "color": "black", "lw": 1.6})
+        ax.plot(*g_plus, "*", color="crimson", ms=12)
+        ax.annotate("γ⁺", g_plus, xytext=(6, 4), textcoords="offset points", fontsize=10)
     lim = 1.15 * radius
     ax.set_xlim(-lim, lim)
     ax.set_ylim(-lim, lim)
     ax.set_aspect("equal")
-    ax.set_xlabel("y₁: G⁻¹-orthonormal coordinate of the γ⁻ plane (γ = L y, G = WᵀM⁻¹W = LLᵀ)",
+    ax.set_xlabel("y₁: G⁻¹-orthonormal coordinate of the γ⁻ plane (γ = F y, FᵀG⁻¹F = I)",
                   fontsize=9)
-    ax.set_ylabel("y₂: G⁻¹-orthonormal coordinate (γᵀG⁻¹γ = y₁² + y₂²)", fontsize=9)
-    ax.set_title("Sector law, 3 equal balls: γ⁺ = Q γ⁻ on each cone (u⁺ = sort(u⁻));\n"
+    ax.set_ylabel("y₂: G⁻¹-orthonormal coordinate (γᵀG⁻¹γ = y₁² + y₂² in the plane)",
+                  fontsize=9)
+    ax.set_title(title if title is not None else
+                 "Sector law, 3 equal balls: γ⁺ = Q γ⁻ on each cone (u⁺ = sort(u⁻));\n"
                  "in the kinetic metric G⁻¹ every cone is 60° and every Q an isometry.\n"
                  "dots: sample γ⁻, crosses: their images γ⁺ (all in γ ≥ 0)", fontsize=10)
-
-
-def plot_S(problem: ImpactProblem, path: str | Path,
-           candidates: Mapping[str, ArrayLike] | None = None, title: str = "",
-           plane: str = "the plane u⁻ + range(M⁻¹W)") -> Path:
-    """Write the picture of S for a problem with two independent contacts.
-
-    Parameters
-    ----------
-    problem : ImpactProblem
-        Two contacts with independent directions, at least one approaching.
-    path : str or Path
-        Output file; the format follows the suffix (``.png``, ``.svg`` or ``.pdf``).
-    candidates : mapping of label → (n,) array_like, optional
-        Post-impact velocities to mark, each with a marker of its own; the legend names
-        each with its angle α to Moreau's half-line.
-    title : str
-        Figure title (default: what S is).
-    plane : str
-        How the axis labels name the plane of the picture.
-
-    Returns
-    -------
-    Path
-        The file written.
-
-    Raises
-    ------
-    InputError
-        For an unknown suffix, or a problem or candidate that cannot be drawn in the plane.
-    OptionalDependencyError
-        When matplotlib is not installed.
-    """
-    figure_format(path)
-    picture = plane_picture(problem, candidates)
-    fig = new_figure(6.4, 7.4)
-    draw_plane(picture, fig.add_subplot(), title or "S = (u⁻ + N) ∩ T_C ∩ B(0, ‖u⁻‖) in the "
-               "plane u⁻ + range(M⁻¹W)", plane=plane)
-    return save_figure(fig, path)
-
-
-def plot_cradle(path: str | Path, v: float = 1.0) -> Path:
-    """Write the picture of docs/theory.md §5: the 3-ball cradle's S, Moreau's half-line and
-    the sector-law point (0, 0, v) at α = 30°, in the plane u₁ + u₂ + u₃ = v.
-
-    Parameters
-    ----------
-    path : str or Path
-        Output file; the format follows the suffix (``.png``, ``.svg`` or ``.pdf``).
-    v : float
-        Speed of the released ball (positive).
-
-    Returns
-    -------
-    Path
-        The file written.
-
-    Raises
-    ------
-    InputError
-        For an unknown suffix or v ≤ 0 (nothing to draw).
-    OptionalDependencyError
-        When matplotlib is not installed.
-    """
-    p = newtons_cradle(3, v=v)
-    return plot_S(p, path, {"sector law u⁺ = (0, 0, v)": sector_velocity_map(p.u_minus)},
-                  title=f"3-ball Newton's cradle, u⁻ = (v, 0, 0), v = {v:g}: the plane "
-                        "u₁ + u₂ + u₃ = v", plane="the plane u₁+u₂+u₃ = v")
-
-
-def plot_sectors(path: str | Path) -> Path:
-    """Write the figure of the six cones of the 3-ball sector law (docs/theory.md §6).
-
-    Parameters
-    ----------
-    path : str or Path
-        Output file; the format follows the suffix (``.png``, ``.svg`` or ``.pdf``).
-
-    Returns
-    -------
-    Path
-        The file written.
-
-    Raises
-    ------
-    InputError
-        For an unknown suffix.
-    OptionalDependencyError
-        When matplotlib is not installed.
-    """
-    figure_format(path)
-    fig = new_figure()
-    draw_sectors(sector_picture(), fig.add_subplot())
-    return save_figure(fig, path)

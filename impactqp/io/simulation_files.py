@@ -10,7 +10,9 @@ Three tables, stored as JSON or TOML (chosen by the file suffix)::
                                      # "box_on_floor" | "linear"
     n_balls = 5                      # the builder's own arguments (cradle_system, ...);
     amplitude = 0.1                  # "linear": M, q0, v0, force, stiffness, H, b,
-                                     # contact_dim
+                                     # contact_dim, coordinates (names, for figures)
+                                     # and coordinate_kinds ("translation" | "rotation"
+                                     # | "generalized", one per name)
     [law]
     name = "sector"                  # "moreau" (eps) | "newton" (e) | "fremond" (E) |
                                      # "sector" | "reflection" | "coulomb" (mu, e)
@@ -79,9 +81,12 @@ SYSTEMS = {
     "block_on_incline": ("angle", "mass", "gravity", "dim", "position", "speed", "gap",
                          "normal_speed", "twist"),
     "box_on_floor": ("dim", "mass", "half_sizes", "gravity", "velocity", "gap"),
-    "linear": ("M", "q0", "v0", "force", "stiffness", "H", "b", "contact_dim"),
+    "linear": ("M", "q0", "v0", "force", "stiffness", "H", "b", "contact_dim", "coordinates",
+               "coordinate_kinds"),
 }
 """Each system kind and its keys: a builder's arguments, or the matrices of LinearSystem."""
+NAMES = ("coordinates", "coordinate_kinds")
+"""Keys that hold a list of strings."""
 SIMULATION = ("scheme", "t_end", "h", "theta", "t0", "backend", "record_every", "keep_events",
               "gap_tol", "rest_velocity", "method", "rtol", "atol", "max_events")
 
@@ -98,6 +103,10 @@ def _table(data: Any, name: str, known: tuple[str, ...]) -> dict[str, Any]:
 def _value(name: str, value: Any) -> Any:
     """A number, a bool, a string or a rectangular array of numbers, checked for its kind."""
     key = name.rsplit(".", 1)[-1]
+    if key in NAMES:
+        if not isinstance(value, list) or not all(isinstance(x, str) for x in value):
+            raise ProblemFileError(f"{name} must be a list of strings, got {value!r}")
+        return value
     if key in CHOICES:
         if isinstance(value, bool) or not isinstance(value, int) or value not in CHOICES[key]:
             raise ProblemFileError(f"{name} must be one of the integers {CHOICES[key]}, "
@@ -225,8 +234,14 @@ def _system(data: Any) -> LinearSystem:
     force = args.get("force")
     if "stiffness" in args:
         force = LinearForce(args["stiffness"], force)
+    names, kinds = args.get("coordinates"), args.get("coordinate_kinds")
+    if kinds is not None:
+        if names is None or len(kinds) != len(names):
+            raise ProblemFileError("system.coordinate_kinds needs system.coordinates, one kind "
+                                   "per name")
+        names = list(zip(names, kinds))
     return LinearSystem(args["M"], args["q0"], args["v0"], force, H, args.get("b"),
-                        contact_dim=d)
+                        contact_dim=d, coordinates=names)
 
 
 def _law(data: Any, system: LinearSystem) -> ImpactLaw:

@@ -16,6 +16,8 @@ from .builders import (
     cradle_system,
     rolling_sphere,
 )
+from .contact_states import contact_states
+from .coordinates import Coordinate, Scene
 from .friction_step import FrictionEvent
 from .impacts import ImpactEvent
 from .simulate import simulate
@@ -26,5 +28,5 @@ from .trajectory import Trajectory
 __all__ = [
     "LinearSystem", "LinearForce", "simulate", "Trajectory", "ImpactEvent", "FrictionEvent",
     "MoreauJeanStep", "bouncing_ball", "cradle_system", "bead_chain", "block_on_incline",
-    "rolling_sphere", "box_on_floor",
+    "rolling_sphere", "box_on_floor", "Coordinate", "Scene", "contact_states",
 ]

@@ -1,7 +1,12 @@
 """Systems to simulate (docs/theory.md §14): a bouncing ball, Newton's cradle on pendulums and
 a column of beads under gravity — all 1-D chains of balls in the sense of docs/theory.md §5,
 so the sector law and the O(N) isotonic path apply to their impacts; and, with friction
-(docs/theory.md §17), a block on an incline, a sphere and a box on a floor."""
+(docs/theory.md §17), a block on an incline, a sphere and a box on a floor.
+
+Each names its coordinates for figures (``y`` the height of a ball, ``x1 … xN`` the
+displacements of a cradle's balls, ``x, y, φ`` a sphere's centre and rotation; bodies are
+numbered from 1) and describes its bodies for animations
+(:class:`~impactqp.simulation.coordinates.Scene`)."""
 
 from __future__ import annotations
 
@@ -14,7 +19,15 @@ from ..base.arrays import as_count, as_flag, as_real, as_vector
 from ..errors import InputError
 from ..model.builders import chain_directions
 from ..model.structure import ChainInfo
+from .coordinates import Coordinate, Scene
 from .system import LinearForce, LinearSystem
+
+
+def _numbered(name: str, n: int, kind: str = "translation") -> list[Coordinate]:
+    """``name`` alone for one body, ``name1 … nameN`` (1-based) for several."""
+    if n == 1:
+        return [Coordinate(name, kind)]
+    return [Coordinate(f"{name}{i + 1}", kind) for i in range(n)]
 
 
 def _chain_matrices(masses: np.ndarray, *, left_wall: bool, sparse: bool):
@@ -49,7 +62,9 @@ def bouncing_ball(mass: float = 1.0, q0: float = 1.0, v0: float = 0.0, gravity: 
     if q0 < radius:
         raise InputError(f"q0 must be at least the radius {radius!r}, got {q0!r}")
     M, H, info = _chain_matrices(np.array([mass]), left_wall=True, sparse=False)
-    return LinearSystem(M, [q0], [v0], [-mass * gravity], H, [-radius], chain=info)
+    return LinearSystem(M, [q0], [v0], [-mass * gravity], H, [-radius], chain=info,
+                        coordinates=_numbered("y", 1),
+                        scene=Scene("vertical balls", {"radius": radius}))
 
 
 def cradle_system(n_balls: int = 3, mass: float = 1.0, length: float = 1.0,
@@ -95,7 +110,9 @@ def cradle_system(n_balls: int = 3, mass: float = 1.0, length: float = 1.0,
     K = sp.diags(np.full(n, k), format="csr") if sparse else k * np.eye(n)
     q0 = np.zeros(n)
     q0[:released] = -amplitude
-    return LinearSystem(M, q0, np.zeros(n), LinearForce(K), H, chain=info)
+    return LinearSystem(M, q0, np.zeros(n), LinearForce(K), H, chain=info,
+                        coordinates=_numbered("x", n),
+                        scene=Scene("pendulums", {"length": length}))
 
 
 def bead_chain(n_beads: int = 10, mass: float = 1.0, radius: float = 0.1, height: float = 1.0,
@@ -140,7 +157,8 @@ def bead_chain(n_beads: int = 10, mass: float = 1.0, radius: float = 0.1, height
     b = np.concatenate([[-radius], np.full(n - 1, -2.0 * radius)])
     q0 = height + spacing * np.arange(n)
     return LinearSystem(M, q0, np.full(n, velocity), np.full(n, -mass * gravity), H, b,
-                        chain=info)
+                        chain=info, coordinates=_numbered("y", n),
+                        scene=Scene("vertical balls", {"radius": radius}))
 
 
 def block_on_incline(angle: float, mass: float = 1.0, gravity: float = 9.81, dim: int = 2,
@@ -202,7 +220,10 @@ def block_on_incline(angle: float, mass: float = 1.0, gravity: float = 9.81, dim
     weight[-1] = -mass * gravity
     q0 = position * up + gap * normal
     v0 = speed * up + normal_speed * normal
-    return LinearSystem(mass * np.eye(dim), q0, v0, weight, H, contact_dim=dim)
+    names = ("x", "y") if dim == 2 else ("x", "y", "z")
+    return LinearSystem(mass * np.eye(dim), q0, v0, weight, H, contact_dim=dim,
+                        coordinates=[Coordinate(c, "translation") for c in names],
+                        scene=Scene("block on incline", {"angle": angle, "dim": dim}))
 
 
 def rolling_sphere(mass: float = 1.0, radius: float = 0.1, gravity: float = 9.81,
@@ -250,7 +271,11 @@ def rolling_sphere(mass: float = 1.0, radius: float = 0.1, gravity: float = 9.81
     M = np.diag([mass, mass, 0.4 * mass * radius**2])
     H = np.array([[0.0, 1.0], [1.0, 0.0], [0.0, radius]])
     return LinearSystem(M, [0.0, height, 0.0], [velocity, vertical_velocity, spin],
-                        [0.0, -mass * gravity, 0.0], H, [-radius], contact_dim=2)
+                        [0.0, -mass * gravity, 0.0], H, [-radius], contact_dim=2,
+                        coordinates=[Coordinate("x", "translation"),
+                                     Coordinate("y", "translation"),
+                                     Coordinate("φ", "rotation")],
+                        scene=Scene("sphere", {"radius": radius}))
 
 
 def box_on_floor(dim: int = 3, mass: float = 1.0, half_sizes: Any = None,
@@ -322,5 +347,9 @@ def box_on_floor(dim: int = 3, mass: float = 1.0, half_sizes: Any = None,
     v0[:dim - 1] = horizontal
     weight = np.zeros(n)
     weight[dim - 1] = -mass * gravity
+    names = [("x", "translation"), ("y", "translation"), ("φ", "rotation")] if dim == 2 else \
+        [(c, "translation") for c in ("x", "y", "z")] + \
+        [(c, "rotation") for c in ("ρx", "ρy", "ρz")]
     return LinearSystem(M, q0, v0, weight, np.column_stack(columns),
-                        np.full(len(corners), -height), contact_dim=dim)
+                        np.full(len(corners), -height), contact_dim=dim, coordinates=names,
+                        scene=Scene("box", {"half_sizes": tuple(sizes.tolist()), "dim": dim}))

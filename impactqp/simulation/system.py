@@ -22,6 +22,7 @@ from ..base.arrays import Matrix, as_count, as_matrix, as_vector
 from ..errors import InputError, MassMatrixError, NonFiniteStateError, ShapeError
 from ..model.builders import chain_directions
 from ..model.structure import ChainInfo, ImpactStructure
+from .coordinates import Coordinate, Scene, as_coordinates
 
 Force = Callable[[float, np.ndarray, np.ndarray], Any]
 
@@ -117,6 +118,20 @@ class LinearSystem:
         d, the columns of H per contact: 1 (frictionless, the default), 2 (normal and one
         tangent, motion in the plane) or 3 (normal and two tangents, in space). A system with
         d > 1 is simulated with ``iq.Coulomb(mu, restitution)``.
+    coordinates : sequence, optional
+        What each qᵢ is, for figures: n entries, each a
+        :class:`~impactqp.simulation.coordinates.Coordinate` (name, kind, unit), a name or a
+        pair (name, kind) with kind ``"translation"``, ``"rotation"`` or ``"generalized"``.
+        Default ``q1 … qn`` of unknown kind. The builders name theirs (``x``, ``y``, ``φ``).
+    scene : Scene, optional
+        The bodies an animation draws (the builders set it; a system built from matrices
+        has none and :meth:`Trajectory.animate <impactqp.Trajectory.animate>` refuses it).
+
+    Attributes
+    ----------
+    coordinates : tuple of Coordinate
+        One per degree of freedom.
+    scene : Scene or None
 
     Raises
     ------
@@ -126,7 +141,8 @@ class LinearSystem:
 
     def __init__(self, M: Matrix, q0: Any, v0: Any, force: Any = None, H: Matrix = None,
                  b: Any = None, *, potential: Callable[[np.ndarray], float] | None = None,
-                 chain: ChainInfo | None = None, contact_dim: int = 1) -> None:
+                 chain: ChainInfo | None = None, contact_dim: int = 1,
+                 coordinates: Any = None, scene: Scene | None = None) -> None:
         d = as_count("contact_dim", contact_dim, minimum=1)
         if d not in CONTACT_DIMS:
             raise InputError(f"contact_dim must be one of {CONTACT_DIMS} (frictionless, planar "
@@ -156,6 +172,10 @@ class LinearSystem:
         self.q0 = as_vector("q0", q0, n)
         self.v0 = as_vector("v0", v0, n)
         self.b = np.zeros(m) if b is None else as_vector("b", b, m)
+        self.coordinates: tuple[Coordinate, ...] = as_coordinates(coordinates, n)
+        if scene is not None and not isinstance(scene, Scene):
+            raise InputError(f"scene must be an impactqp Scene, got {type(scene).__name__}")
+        self.scene = scene
         self.force, self._potential, self.constant_force = _check_force(force, n)
         if potential is not None:
             if not callable(potential):

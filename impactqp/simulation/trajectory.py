@@ -180,28 +180,47 @@ class Trajectory:
     # --- saving --------------------------------------------------------------------------
     def plot(self, kind: str = "positions", path: str | Path | None = None, *,
              title: str = "", dofs: Any = None) -> Any:
-        """Draw the positions qᵢ(t) (``kind="positions"``) or the energies T, V, T + V
-        (``"energy"``) over time, and write the figure when given ``path`` (.png, .svg,
-        .pdf). Needs the ``plot`` extra (matplotlib).
+        """Draw a quantity of the run over time and write the figure when given ``path``
+        (.png, .svg, .pdf). Needs the ``plot`` extra (matplotlib).
+
+        Parameters
+        ----------
+        kind : {"positions", "velocities", "energy", "impulses", "contacts"}
+            Coordinates or their velocities (one axes per kind of coordinate — translations,
+            rotations — labelled with the system's names and units), the energies T, V and
+            T + V, the contact impulses, or each contact's state (open/closed; with
+            friction open, stick or slide).
+        path : str or Path, optional
+        title : str
+        dofs : int, str or sequence of them, optional
+            The coordinates drawn, by name (``"x"``, ``"φ"``, ``"q2"``) or by 1-based
+            number as in the labels (default: the first 12).
 
         Returns
         -------
         matplotlib.figure.Figure
-            (``impactqp.simulation.pictures.plot`` documents the parameters in full.)
+            (:func:`impactqp.simulation.pictures.plot` documents it in full.)
         """
         from . import pictures
 
         return pictures.plot(self, kind, path, title=title, dofs=dofs)
 
     def animate(self, path: str | Path | None = None, **options: Any) -> Any:
-        """Animate the balls of a pendulum run (:func:`impactqp.simulation.cradle_system`),
-        written when given ``path`` (.gif or .mp4); ``options`` are ``length``, ``radius``,
-        ``frames``, ``fps`` and ``size``. Needs the ``plot`` extra (matplotlib).
+        """Animate the bodies of a builder's system — a cradle's balls on pendulums, balls
+        on a vertical line, a rolling sphere with a mark that turns with it, a block on an
+        incline, a box on a floor — written when given ``path`` (.gif or .mp4); ``options``
+        are ``length``, ``radius``, ``frames``, ``fps`` and ``size``. Needs the ``plot``
+        extra (matplotlib).
 
         Returns
         -------
         matplotlib.animation.FuncAnimation
-            (``impactqp.simulation.pictures.animate`` documents the parameters in full.)
+            (:func:`impactqp.simulation.pictures.animate` documents it in full.)
+
+        Raises
+        ------
+        impactqp.errors.UndrawableSystemError
+            A system built from matrices, whose bodies are unknown.
         """
         from . import pictures
 
