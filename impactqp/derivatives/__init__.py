@@ -1,0 +1,1 @@
+"""Certified derivatives of impact maps (docs/theory.md §18–§20)."""
