@@ -93,6 +93,7 @@ def flow(system: LinearSystem, law: ImpactLaw, T: np.ndarray, Q: np.ndarray, V: 
     gaps = np.atleast_2d(system.gaps(Q))
     gam = np.atleast_2d(system.contact_velocities(V))
     speed = max(float(np.abs(gam).max(initial=0.0)), rest, 1e-300)
+    length = max(float(np.abs(gaps).max(initial=0.0)), gap_tol, 1e-300)
     at_rest = (gaps <= gap_tol) & (np.abs(gam) <= rest)
     held = [at_rest[r] & at_rest[r + 1] if T[r + 1] > T[r] else at_rest[r] & False
             for r in range(len(T) - 1)]
@@ -102,6 +103,10 @@ def flow(system: LinearSystem, law: ImpactLaw, T: np.ndarray, Q: np.ndarray, V: 
     margin = np.inf
     for r in range(len(T) - 1):
         if T[r + 1] > T[r]:
+            for i, dist in _touches(float(T[r + 1] - T[r]), gaps[r:r + 2], gam[r:r + 2],
+                                    ~held[r], length):
+                kinks.append(Kink(float(T[r]), "grazing", (i,), dist))
+                margin = min(margin, dist)
             jumps.append(motion.transition(float(T[r + 1] - T[r]), held[r]))
             params.append(np.zeros((2 * n, p)))
             continue
@@ -125,6 +130,25 @@ def flow(system: LinearSystem, law: ImpactLaw, T: np.ndarray, Q: np.ndarray, V: 
         return lam, ap
 
     return Sensitivities("flow", cols, S, transposed, kinks, margin)
+
+
+def _touches(tau: float, g: np.ndarray, gamma: np.ndarray, free: np.ndarray,
+             length: float) -> list[tuple[int, float]]:
+    """(contact, relative distance) of the free contacts whose gap comes within
+    :data:`GRAZING` of the length scale between two records without closing: a grazing
+    touch, found as the minimum of the cubic Hermite interpolant of (g, γ) at both ends."""
+    out = []
+    for i in np.flatnonzero(free & (gamma[0] < 0.0) & (gamma[1] > 0.0)):
+        g0, g1, d0, d1 = g[0, i], g[1, i], gamma[0, i] * tau, gamma[1, i] * tau
+        # g(s) = a s³ + b s² + d0 s + g0 on s ∈ [0, 1]; g'(s) = 3a s² + 2b s + d0
+        a, b = 2.0 * (g0 - g1) + d0 + d1, 3.0 * (g1 - g0) - 2.0 * d0 - d1
+        roots = np.roots([3.0 * a, 2.0 * b, d0]) if abs(a) + abs(b) > 0 else np.zeros(0)
+        s = [float(x.real) for x in np.atleast_1d(roots) if abs(x.imag) < 1e-12
+             and 0.0 <= x.real <= 1.0]
+        low = min([g0, g1] + [((a * x + b) * x + d0) * x + g0 for x in s])
+        if low <= GRAZING * length:
+            out.append((int(i), float(max(low, 0.0) / length)))
+    return out
 
 
 def _jump(motion: _Motion, r: int, T, Q, V, L, gaps, gam, held, E, cols: Columns,
