@@ -91,6 +91,7 @@ def forward(maps, tangents, S0, out):
     S = S0.copy()
     out[0] = S
     dvf = np.empty((n, k))
+    dvn = np.empty((n, k))
     y = np.empty(k)
     j = 0
     for step in range(out.shape[0] - 1):
@@ -103,7 +104,7 @@ def forward(maps, tangents, S0, out):
                     dvf[a, c] = total
                 else:
                     dvf[a, c] = S[n + a, c]
-        dvn = dvf.copy()
+        dvn[:, :] = dvf
         if j < steps.size and steps[j] == step:
             lo, size, sq = offsets[j], offsets[j + 1] - offsets[j], squares[j]
             ga = np.zeros((size, k))

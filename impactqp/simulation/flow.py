@@ -61,14 +61,17 @@ class _Motion:
 
     def transition(self, tau: float, held: np.ndarray) -> np.ndarray:
         """The state transition matrix of an interval of length ``tau``."""
-        n = self.n
-        if not self.linear:
-            return np.block([[np.eye(n), tau * np.eye(n)], [np.zeros((n, n)), np.eye(n)]])
         key = (tau, held.tobytes())
         if key not in self._phi:
-            F = np.block([[np.zeros((n, n)), np.eye(n)],
-                          [-self.projection(held) @ self.Minv @ self.K, np.zeros((n, n))]])
-            self._phi[key] = sla.expm(F * tau)
+            n = self.n
+            if not self.linear:
+                self._phi[key] = np.block([[np.eye(n), tau * np.eye(n)],
+                                           [np.zeros((n, n)), np.eye(n)]])
+            else:
+                F = np.block([[np.zeros((n, n)), np.eye(n)],
+                              [-self.projection(held) @ self.Minv @ self.K,
+                               np.zeros((n, n))]])
+                self._phi[key] = sla.expm(F * tau)
         return self._phi[key]
 
 
@@ -95,8 +98,8 @@ def flow(system: LinearSystem, law: ImpactLaw, T: np.ndarray, Q: np.ndarray, V: 
     speed = max(float(np.abs(gam).max(initial=0.0)), rest, 1e-300)
     length = max(float(np.abs(gaps).max(initial=0.0)), gap_tol, 1e-300)
     at_rest = (gaps <= gap_tol) & (np.abs(gam) <= rest)
-    held = [at_rest[r] & at_rest[r + 1] if T[r + 1] > T[r] else at_rest[r] & False
-            for r in range(len(T) - 1)]
+    held = at_rest[:-1] & at_rest[1:] & (T[1:] > T[:-1])[:, None]
+    turning = ((gam[:-1] < 0.0) & (gam[1:] > 0.0) & ~held).any(axis=1)
     jumps: list[np.ndarray] = []
     params: list[np.ndarray] = []
     kinks: list[Kink] = []
@@ -104,7 +107,7 @@ def flow(system: LinearSystem, law: ImpactLaw, T: np.ndarray, Q: np.ndarray, V: 
     for r in range(len(T) - 1):
         if T[r + 1] > T[r]:
             for i, dist in _touches(float(T[r + 1] - T[r]), gaps[r:r + 2], gam[r:r + 2],
-                                    ~held[r], length):
+                                    ~held[r], length) if turning[r] else ():
                 kinks.append(Kink(float(T[r]), "grazing", (i,), dist))
                 margin = min(margin, dist)
             jumps.append(motion.transition(float(T[r + 1] - T[r]), held[r]))
