@@ -148,7 +148,7 @@ def tangent(G, lam, aset: ActiveSet, dG=None, dq=None) -> np.ndarray:
     """The derivative of λ on the fixed active set ``aset.active`` (docs/theory.md §18).
 
     Solves dλ_I = 0, (G dλ + dG λ + dq)_A = 0, the minimum-norm solution where G_AA is
-    singular. Degenerate contacts are held at dλ = 0 (the default element of §19).
+    singular. Degenerate contacts are held at dλ = 0 (the default element of docs/theory.md §19).
 
     Parameters
     ----------
