@@ -36,6 +36,9 @@ from . import (  # noqa: F401  (the public submodules, attributes of the package
     tables,
     verification,
 )
+from .derivatives.batch import derivative_batch
+from .derivatives.impact import ImpactDerivative
+from .derivatives.solve import derivative
 from .errors import (
     BackendUnsuitableError,
     CertificateError,
@@ -88,6 +91,8 @@ __all__ = [
     "solve", "moreau", "newton", "fremond", "sector_law", "reflection_law", "solve_batch",
     "moreau_batch", "sector_law_batch", "solve_lcp", "available_backends", "ImpactResult",
     "verify_law",
+    # derivatives
+    "derivative", "derivative_batch", "ImpactDerivative",
     # motion
     "LinearSystem", "LinearForce", "simulate", "Trajectory",
     # friction

@@ -32,6 +32,7 @@ __all__ = [
     "SectorInputError",
     "SectorTableTooLarge",
     "IntegrationBudgetError",
+    "DerivativeUnsupportedError",
 ]
 
 
@@ -124,3 +125,8 @@ class SectorTableTooLarge(InputError):
 class IntegrationBudgetError(CertificateError):
     """An integration (the LZB model's) would exceed or has spent its budget of steps; the
     message says which budget, why, and what option to change."""
+
+
+class DerivativeUnsupportedError(ImpactError):
+    """The law has no derivative (the LZB model, a user's law without a ``derivative``
+    hook; docs/theory.md §20): the message names the law."""

@@ -88,14 +88,51 @@ def _rhs(lam: np.ndarray, m: int, dG, dq) -> np.ndarray:
     return r
 
 
+RCOND = 1e-12
+"""Eigenvalues of G_AA below RCOND times its largest count as zero (redundant contacts)."""
+
+
+class Factor(NamedTuple):
+    """The pseudo-inverse of G restricted to a set of contacts, embedded in m × m
+    (docs/theory.md §18).
+
+    Attributes
+    ----------
+    K : (m, m) ndarray
+        K_AA = G_AA⁺ (the Moore–Penrose inverse), zero elsewhere.
+    rank : int
+        The rank of G_AA: Λ_A is unique when it equals |A|.
+    condition : float
+        Largest over smallest non-zero eigenvalue of G_AA (1 for an empty set).
+    """
+
+    K: np.ndarray
+    rank: int
+    condition: float
+
+
+def factor(G: np.ndarray, mask: np.ndarray) -> Factor:
+    """The :class:`Factor` of G on the contacts of ``mask`` (a symmetric eigen-decomposition:
+    the minimum-norm solution where G_AA is singular)."""
+    m = G.shape[0]
+    K = np.zeros((m, m))
+    idx = np.flatnonzero(mask)
+    if not idx.size:
+        return Factor(K, 0, 1.0)
+    vals, vecs = np.linalg.eigh(G[np.ix_(idx, idx)])
+    top = vals.max(initial=0.0)
+    keep = vals > RCOND * top
+    if not keep.any():
+        return Factor(K, 0, np.inf)
+    V = vecs[:, keep]
+    K[np.ix_(idx, idx)] = (V / vals[keep]) @ V.T
+    return Factor(K, int(keep.sum()), float(top / vals[keep].min()))
+
+
 def _solve_on(G: np.ndarray, mask: np.ndarray, r: np.ndarray) -> np.ndarray:
     """dλ with dλ off ``mask`` = 0 and (G dλ + r) on ``mask`` = 0, minimum-norm where
     G restricted to ``mask`` is singular."""
-    out = np.zeros_like(r)
-    idx = np.flatnonzero(mask)
-    if idx.size:
-        out[idx] = -np.linalg.lstsq(G[np.ix_(idx, idx)], r[idx], rcond=None)[0]
-    return out
+    return -(factor(G, mask).K @ r)
 
 
 def _check(G, lam) -> tuple[np.ndarray, np.ndarray]:
@@ -111,7 +148,7 @@ def tangent(G, lam, aset: ActiveSet, dG=None, dq=None) -> np.ndarray:
     """The derivative of λ on the fixed active set ``aset.active`` (docs/theory.md §18).
 
     Solves dλ_I = 0, (G dλ + dG λ + dq)_A = 0, the minimum-norm solution where G_AA is
-    singular. Degenerate contacts are held at dλ = 0 (the default element of §19).
+    singular. Degenerate contacts are held at dλ = 0 (the default element of docs/theory.md §19).
 
     Parameters
     ----------
