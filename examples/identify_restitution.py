@@ -11,7 +11,8 @@
    map at h = 1 ms sampled every 10th step.
 2. A three-ball cradle struck in several ways, its post-impact velocities measured, with
    Moreau's coefficient ε* = 0.6: u⁺ = z + ε(z − u⁻) is affine in ε, so one Gauss–Newton step
-   from ε = 0 finds ε* (∂u⁺/∂ε = z − u⁻, z = prox_{T_C}(u⁻) from each result, ``r.z``).
+   from ε = 0 finds ε*, with ∂u⁺/∂ε from each impact's ``r.derivative().jacobian("eps")``
+   (equal to z − u⁻, z = prox_{T_C}(u⁻), checked).
 
 The measurements are synthetic (impactqp's own runs at the true coefficients) and exact, so
 the fits must land on the true values to 1e-6; docs/theory.md §21 explains the two
@@ -73,8 +74,11 @@ def fit_cradle(eps: float) -> tuple[float, list[str]]:
         res, jac = [], []
         for u, measured in zip(strikes, truth):
             r = iq.solve(iq.chain([1.0, 1.0, 1.0], u), iq.Moreau(eps))
+            d = r.derivative()  # the certified derivative of this impact
+            dude = d.jacobian("eps")  # ∂u⁺/∂ε
+            assert np.allclose(dude, r.z - r.problem.u_minus)  # = z − u⁻ for Moreau's law
             res.append(r.u_plus - measured)
-            jac.append(r.z - r.problem.u_minus)  # ∂u⁺/∂ε, exact for Moreau's law
+            jac.append(dude)
         r, J = np.concatenate(res), np.concatenate(jac)
         log.append(f"  {it:2d}  ε = {eps:.9f}  ½‖r‖² = {0.5 * r @ r:.3e}")
         eps -= (J @ r) / (J @ J)

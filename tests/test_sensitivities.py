@@ -151,3 +151,16 @@ def test_callable_force_and_missing_sensitivities_are_refused():
     assert tr.sensitivity_kind is None
     with pytest.raises(InputError, match="no sensitivities"):
         tr.vjp(q=[1.0])
+
+
+def test_flow_jump_in_e_is_the_single_impact_derivative():
+    """Before the first impact nothing depends on e, so across it ∂v/∂e jumps by ∂u⁺/∂e of
+    that impact: the flow's LCP tangent against the impact's own certified derivative."""
+    tr = iq.simulate(iq.simulation.cradle_system(3), iq.Newton(0.8), 1.0,
+                     scheme="event-driven", h=0.01, sensitivities=("e",))
+    event = tr.events[0]
+    r = int(np.flatnonzero(tr.t == event.time)[-1])  # the post-impact record
+    assert tr.t[r - 1] == event.time and np.all(tr.sensitivity("e")[r - 1] == 0.0)
+    expected = event.result.derivative().jacobian("e")
+    assert np.allclose(tr.sensitivity("e")[r, 3:, 0], expected, rtol=1e-10, atol=1e-12)
+    assert np.abs(expected).max() > 0.1

@@ -18,7 +18,7 @@ from ..base.arrays import as_dense
 from ..derivatives.lcp import classify, tangent
 from ..kernels.sensitivity import StepMaps, StepTangents, adjoint, forward
 from ..laws.base import ImpactLaw
-from .sensitivity import Columns, Kink, Sensitivities, full_restitution
+from .sensitivity import Columns, Sensitivities, TrajectoryKink, full_restitution
 from .system import LinearSystem
 
 
@@ -83,11 +83,11 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
     closed = predicted <= 0.0
     length = max(float(np.abs(gaps).max(initial=0.0)),
                  h * float(np.abs(gam).max(initial=0.0)), 1e-300)
-    kinks: list[Kink] = []
+    kinks: list[TrajectoryKink] = []
     margin = float(np.abs(predicted).min(initial=np.inf)) / length
     near = np.argwhere(np.abs(predicted) <= tol * length)
     for k, i in near:
-        kinks.append(Kink(t0 + k * h, "activation", (int(i),),
+        kinks.append(TrajectoryKink(t0 + k * h, "activation", (int(i),),
                           float(abs(predicted[k, i])) / length))
     VF = free_velocities(system, What, K, h, theta, Qk, Vk)
     rows = _Rows(len(cols.pcols))
@@ -101,7 +101,7 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
         aset = classify(lam * np.diag(G), G @ lam + q_step, tol * speed)
         margin = min(margin, aset.margin / speed)
         if aset.degenerate.any():
-            kinks.append(Kink(t0 + (k + 1) * h, "degenerate",
+            kinks.append(TrajectoryKink(t0 + (k + 1) * h, "degenerate",
                               tuple(int(c) for c in C[aset.degenerate]), 0.0))
         if not aset.active.any():
             continue

@@ -27,7 +27,7 @@ from ..base.arrays import as_dense
 from ..derivatives.lcp import classify, tangent
 from ..laws.base import ImpactLaw
 from .discrete_map import step_maps
-from .sensitivity import Columns, Kink, Sensitivities, full_restitution
+from .sensitivity import Columns, Sensitivities, TrajectoryKink, full_restitution
 from .system import LinearSystem
 
 GRAZING = 1e-6
@@ -102,13 +102,13 @@ def flow(system: LinearSystem, law: ImpactLaw, T: np.ndarray, Q: np.ndarray, V: 
     turning = ((gam[:-1] < 0.0) & (gam[1:] > 0.0) & ~held).any(axis=1)
     jumps: list[np.ndarray] = []
     params: list[np.ndarray] = []
-    kinks: list[Kink] = []
+    kinks: list[TrajectoryKink] = []
     margin = np.inf
     for r in range(len(T) - 1):
         if T[r + 1] > T[r]:
             for i, dist in _touches(float(T[r + 1] - T[r]), gaps[r:r + 2], gam[r:r + 2],
                                     ~held[r], length) if turning[r] else ():
-                kinks.append(Kink(float(T[r]), "grazing", (i,), dist))
+                kinks.append(TrajectoryKink(float(T[r]), "grazing", (i,), dist))
                 margin = min(margin, dist)
             jumps.append(motion.transition(float(T[r + 1] - T[r]), held[r]))
             params.append(np.zeros((2 * n, p)))
@@ -156,7 +156,7 @@ def _touches(tau: float, g: np.ndarray, gamma: np.ndarray, free: np.ndarray,
 
 def _jump(motion: _Motion, r: int, T, Q, V, L, gaps, gam, held, E, cols: Columns,
           scales: tuple[float, float, float, float],
-          ) -> tuple[np.ndarray, np.ndarray, list[Kink], float]:
+          ) -> tuple[np.ndarray, np.ndarray, list[TrajectoryKink], float]:
     """(∂x⁺/∂x⁻, ∂x⁺/∂p, kinks, relative margin) of the event between records r and r + 1."""
     gap_tol, rest, speed, tol = scales
     n, t = motion.n, float(T[r])
@@ -165,7 +165,7 @@ def _jump(motion: _Motion, r: int, T, Q, V, L, gaps, gam, held, E, cols: Columns
     C = np.flatnonzero(closed)
     lam = L[r + 1, C]
     v_minus = V[r]
-    kinks: list[Kink] = []
+    kinks: list[TrajectoryKink] = []
     Rv, Pv = np.eye(n), np.zeros((n, p))
     v_plus = v_minus.copy()
     margin = np.inf
@@ -176,7 +176,7 @@ def _jump(motion: _Motion, r: int, T, Q, V, L, gaps, gam, held, E, cols: Columns
         aset = classify(lam * np.diag(G), G @ lam + q_imp, tol * speed)
         margin = aset.margin / speed
         if aset.degenerate.any():
-            kinks.append(Kink(t, "degenerate", tuple(int(c) for c in C[aset.degenerate]),
+            kinks.append(TrajectoryKink(t, "degenerate", tuple(int(c) for c in C[aset.degenerate]),
                               0.0))
         Tn = tangent(G, lam, aset, dq=np.eye(C.size))
         Rv = Rv + motion.MinvH[:, C] @ Tn @ (np.eye(C.size) + ECC) @ motion.Ht[C]
@@ -188,7 +188,7 @@ def _jump(motion: _Motion, r: int, T, Q, V, L, gaps, gam, held, E, cols: Columns
     Pi = np.eye(n)
     if settle.any() and not np.allclose(V[r + 1], v_plus, rtol=1e-12, atol=1e-12 * speed):
         Pi = motion.projection(settle)  # held at rest: the end of an accumulation
-        kinks.append(Kink(t, "zeno", tuple(int(c) for c in np.flatnonzero(settle)), 0.0))
+        kinks.append(TrajectoryKink(t, "zeno", tuple(int(c) for c in np.flatnonzero(settle)), 0.0))
         margin = 0.0
     R = np.block([[Pi, np.zeros((n, n))], [np.zeros((n, n)), Pi @ Rv]])
     P = np.vstack([np.zeros((n, p)), Pi @ Pv])
@@ -196,13 +196,13 @@ def _jump(motion: _Motion, r: int, T, Q, V, L, gaps, gam, held, E, cols: Columns
     opened = gaps[before] > gap_tol if before is not None else np.zeros_like(closed)
     trigger = np.flatnonzero(closed & opened & (gam[r] < 0.0))
     if trigger.size > 1:
-        kinks.append(Kink(t, "simultaneous", tuple(int(c) for c in trigger), 0.0))
+        kinks.append(TrajectoryKink(t, "simultaneous", tuple(int(c) for c in trigger), 0.0))
         margin = 0.0
     if trigger.size:
         i = int(trigger[np.argmin(gam[r, trigger])])
         approach = float(gam[r, i])
         if abs(approach) <= GRAZING * speed:
-            kinks.append(Kink(t, "grazing", (i,), abs(approach) / speed))
+            kinks.append(TrajectoryKink(t, "grazing", (i,), abs(approach) / speed))
             margin = min(margin, abs(approach) / speed)
         else:
             after = held[r + 1] if r + 1 < len(held) else np.zeros_like(closed)

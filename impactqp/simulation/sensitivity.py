@@ -28,7 +28,7 @@ LCP (Λᵢ = 0 = wᵢ), an impact with ∇g·f⁻ ≈ 0, an accumulation of impa
 contact, several contacts closing at one event."""
 
 
-class Kink(NamedTuple):
+class TrajectoryKink(NamedTuple):
     """A point of a run where the returned derivative is one element of a set of one-sided
     ones (docs/theory.md §21).
 
@@ -129,15 +129,15 @@ class Sensitivities:
         ∂(q, v)/∂(the asked names) at each record.
     adjoint : callable
         ``adjoint(cotangents (R, 2n)) -> (∂L/∂x₀ (2n,), ∂L/∂p (p,))``, the transposed chain.
-    kinks : list of Kink
+    kinks : list of TrajectoryKink
     margin : float
-        The smallest distance to a kink over the run, in the units of :class:`Kink`
+        The smallest distance to a kink over the run, in the units of :class:`TrajectoryKink`
         (+inf when nothing came near one).
     """
 
     def __init__(self, kind: str, cols: Columns, tangents: np.ndarray,
                  adjoint: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
-                 kinks: list[Kink], margin: float) -> None:
+                 kinks: list[TrajectoryKink], margin: float) -> None:
         self.kind, self.cols, self.tangents = kind, cols, tangents
         self._adjoint, self.kinks, self.margin = adjoint, kinks, margin
 

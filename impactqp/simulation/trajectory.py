@@ -17,7 +17,7 @@ from ..errors import InputError
 from ..laws.base import ImpactLaw
 from .friction_step import FrictionEvent
 from .impacts import ImpactEvent
-from .sensitivity import Kink, Sensitivities
+from .sensitivity import Sensitivities, TrajectoryKink
 from .system import LinearSystem
 
 FORMATS = (".npz", ".csv")
@@ -153,9 +153,9 @@ class Trajectory:
         return None if self.sensitivities is None else self.sensitivities.kind
 
     @property
-    def kinks(self) -> list[Kink]:
+    def kinks(self) -> list[TrajectoryKink]:
         """Where the derivative is one-sided: activation thresholds and degenerate contacts
-        of steps, grazing, Zeno and simultaneous impacts (each a :class:`Kink`)."""
+        of steps, grazing, Zeno and simultaneous impacts (each a :class:`TrajectoryKink`)."""
         return self._asked().kinks
 
     def sensitivity(self, wrt: str | None = None) -> np.ndarray:
