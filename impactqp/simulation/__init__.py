@@ -18,6 +18,7 @@ from .builders import (
 )
 from .friction_step import FrictionEvent
 from .impacts import ImpactEvent
+from .sensitivity import Sensitivities, TrajectoryKink
 from .simulate import simulate
 from .step_law import MoreauJeanStep
 from .system import LinearForce, LinearSystem
@@ -26,5 +27,5 @@ from .trajectory import Trajectory
 __all__ = [
     "LinearSystem", "LinearForce", "simulate", "Trajectory", "ImpactEvent", "FrictionEvent",
     "MoreauJeanStep", "bouncing_ball", "cradle_system", "bead_chain", "block_on_incline",
-    "rolling_sphere", "box_on_floor",
+    "rolling_sphere", "box_on_floor", "Sensitivities", "TrajectoryKink",
 ]

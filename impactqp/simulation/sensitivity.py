@@ -3,7 +3,7 @@ parameter (docs/theory.md §21): what the user asks for, the tangents at every r
 adjoint, and the kinks where a derivative holds on one side only.
 
 Two derivatives through time exist and a run says which one it holds
-(:attr:`Sensitivities.kind`): ``"discrete-map"`` for Moreau–Jean time-stepping, the exact
+(``Sensitivities.kind``): ``"discrete-map"`` for Moreau–Jean time-stepping, the exact
 derivative of the map that takes the initial data to the computed states (impact times are
 quantized to steps, so ∂q(T)/∂q₀ of a bouncing ball is 1), and ``"flow"`` for event-driven
 integration, the derivative of the motion itself (impact times move with the data; the
@@ -21,11 +21,7 @@ from ..errors import InputError, ShapeError
 from ..laws.base import ImpactLaw
 
 KINDS = ("discrete-map", "flow")
-KINK_KINDS = ("activation", "degenerate", "grazing", "zeno", "simultaneous")
-"""What makes a derivative one-sided: a contact on the Moreau–Jean activation threshold
-g + ½hγ = 0 (the discrete map jumps there), a degenerate contact of a step's or an impact's
-LCP (Λᵢ = 0 = wᵢ), an impact with ∇g·f⁻ ≈ 0, an accumulation of impacts settled into
-contact, several contacts closing at one event."""
+"""The two derivatives through time."""
 
 
 class TrajectoryKink(NamedTuple):
@@ -36,7 +32,11 @@ class TrajectoryKink(NamedTuple):
     ----------
     time : float
     kind : str
-        One of :data:`KINK_KINDS`.
+        ``"activation"`` (a contact on the Moreau–Jean threshold g + ½hγ = 0, where the
+        discrete map jumps), ``"degenerate"`` (Λᵢ = 0 = wᵢ in a step's or an impact's LCP),
+        ``"grazing"`` (an impact or a touch with ∇g·f⁻ ≈ 0), ``"zeno"`` (an accumulation
+        of impacts settled into contact) or ``"simultaneous"`` (contacts closing at one
+        event).
     contacts : tuple of int
     distance : float
         How far the run is from the kink, in the units of its test (a gap + ½hγ in length
@@ -138,6 +138,8 @@ class Sensitivities:
     def __init__(self, kind: str, cols: Columns, tangents: np.ndarray,
                  adjoint: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
                  kinks: list[TrajectoryKink], margin: float) -> None:
+        if kind not in KINDS:
+            raise InputError(f"kind must be one of {KINDS}, got {kind!r}")
         self.kind, self.cols, self.tangents = kind, cols, tangents
         self._adjoint, self.kinks, self.margin = adjoint, kinks, margin
 
