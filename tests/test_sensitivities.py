@@ -127,6 +127,9 @@ def test_activation_threshold_is_a_kink_of_the_discrete_map():
     tr = iq.simulate(_cradle(np.array([-0.1, 0.0, 0.0])), iq.Newton(0.8), 0.2, h=1e-3,
                      sensitivities=("q0",))
     assert any(k.kind == "activation" and k.contacts == (1,) for k in tr.kinks)
+    # and Λ₂ = 0 = w₂ in the step's LCP: a degenerate contact too
+    assert any(k.kind == "degenerate" and k.contacts == (1,) for k in tr.kinks)
+    assert all(type(k.time) is float for k in tr.kinks)
     assert tr.sensitivities.margin == 0.0
 
 
@@ -164,3 +167,13 @@ def test_flow_jump_in_e_is_the_single_impact_derivative():
     expected = event.result.derivative().jacobian("e")
     assert np.allclose(tr.sensitivity("e")[r, 3:, 0], expected, rtol=1e-10, atol=1e-12)
     assert np.abs(expected).max() > 0.1
+
+
+def test_a_contact_closed_at_the_start_is_a_kink_of_the_flow():
+    # balls 2 and 3 of the cradle touch at rest at t = 0
+    tr = iq.simulate(_cradle(np.array([-0.1, 0.0, 0.0])), iq.Newton(0.8), 1.0,
+                     scheme="event-driven", h=0.01, sensitivities=("q0",))
+    assert tr.kinks[0] == (0.0, "degenerate", (1,), 0.0)
+    assert tr.sensitivities.margin == 0.0 and np.isfinite(tr.sensitivity()).all()
+    kinds = {k.kind for k in tr.kinks}
+    assert kinds <= {"activation", "degenerate", "grazing", "zeno", "simultaneous"}

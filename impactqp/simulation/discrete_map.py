@@ -87,7 +87,7 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
     margin = float(np.abs(predicted).min(initial=np.inf)) / length
     near = np.argwhere(np.abs(predicted) <= tol * length)
     for k, i in near:
-        kinks.append(TrajectoryKink(t0 + k * h, "activation", (int(i),),
+        kinks.append(TrajectoryKink(float(t0 + k * h), "activation", (int(i),),
                           float(abs(predicted[k, i])) / length))
     VF = free_velocities(system, What, K, h, theta, Qk, Vk)
     rows = _Rows(len(cols.pcols))
@@ -101,7 +101,7 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
         aset = classify(lam * np.diag(G), G @ lam + q_step, tol * speed)
         margin = min(margin, aset.margin / speed)
         if aset.degenerate.any():
-            kinks.append(TrajectoryKink(t0 + (k + 1) * h, "degenerate",
+            kinks.append(TrajectoryKink(float(t0 + (k + 1) * h), "degenerate",
                               tuple(int(c) for c in C[aset.degenerate]), 0.0))
         if not aset.active.any():
             continue

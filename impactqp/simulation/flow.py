@@ -15,7 +15,10 @@ held, two contacts closing at one event a ``"simultaneous"`` kink.
 
 The run is read back from its records; a contact is taken as held over an interval when it
 is closed (g ≤ gap_tol) and at rest (|γ| ≤ rest_velocity) at both ends, as the integrator
-holds it.
+holds it. A contact closed and at rest at the start is a ``"degenerate"`` kink (the
+derivative with respect to data that would open or press it is one-sided). A held contact
+lifts off where its force passes through zero, so the vector field is continuous there and
+the tangent needs no jump.
 """
 
 from __future__ import annotations
@@ -104,6 +107,11 @@ def flow(system: LinearSystem, law: ImpactLaw, T: np.ndarray, Q: np.ndarray, V: 
     params: list[np.ndarray] = []
     kinks: list[TrajectoryKink] = []
     margin = np.inf
+    touching = np.flatnonzero(at_rest[0])
+    if touching.size:  # on the boundary at the start: moving q₀ or v₀ opens or presses them
+        kinks.append(TrajectoryKink(float(T[0]), "degenerate",
+                                    tuple(int(c) for c in touching), 0.0))
+        margin = 0.0
     for r in range(len(T) - 1):
         if T[r + 1] > T[r]:
             for i, dist in _touches(float(T[r + 1] - T[r]), gaps[r:r + 2], gam[r:r + 2],
