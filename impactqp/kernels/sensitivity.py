@@ -48,33 +48,29 @@ class StepMaps(NamedTuple):
 
 
 class StepTangents(NamedTuple):
-    """The steps whose LCP tangent is not zero, in order, with ragged flat storage.
+    """The steps whose LCP tangent is not zero, in order, each padded to the widest.
 
     Attributes
     ----------
     steps : (s,) int array
         Step numbers k (ascending).
-    offsets : (s + 1,) int array
-        Step j's contacts are ``contacts[offsets[j]:offsets[j + 1]]``.
-    contacts : int array
-        The closed contacts C of each step.
-    Ta, Tb : float arrays
-        T and T E_CC of each step, |C|² entries each, row-major, from ``offsets[j]²``
-        summed: step j starts at ``squares[j]``.
-    squares : (s + 1,) int array
-        Offsets into ``Ta`` and ``Tb``.
-    Tp : float array
-        T R of each step, |C|·p entries row-major, from ``offsets[j]·p``.
+    sizes : (s,) int array
+        |C|, the closed contacts of each step.
+    contacts : (s, c) int array
+        C of each step in its first |C| entries.
+    Ta, Tb : (s, c, c) float arrays
+        T and T E_CC of each step (the leading |C| × |C| block).
+    Tp : (s, c, p) float array
+        T R of each step: the LCP's right-hand side's derivative in the law's parameters.
     pcols : (p,) int array
         The tangent columns of the law's parameters.
     """
 
     steps: np.ndarray
-    offsets: np.ndarray
+    sizes: np.ndarray
     contacts: np.ndarray
     Ta: np.ndarray
     Tb: np.ndarray
-    squares: np.ndarray
     Tp: np.ndarray
     pcols: np.ndarray
 
@@ -84,7 +80,7 @@ def forward(maps, tangents, S0, out):
     """The tangents after every step into ``out`` ((steps + 1, 2n, k), ``out[0] = S0``) for
     the run's :class:`StepMaps` and :class:`StepTangents`."""
     Fq, Fv, linear, h, theta, MinvH, Ht = maps
-    steps, offsets, contacts, Ta, Tb, squares, Tp, pcols = tangents
+    steps, sizes, contacts, Ta, Tb, Tp, pcols = tangents
     n = Fq.shape[0]
     k = S0.shape[1]
     p = pcols.size
@@ -92,6 +88,9 @@ def forward(maps, tangents, S0, out):
     out[0] = S
     dvf = np.empty((n, k))
     dvn = np.empty((n, k))
+    width = contacts.shape[1]
+    ga = np.empty((width, k))
+    gb = np.empty((width, k))
     y = np.empty(k)
     j = 0
     for step in range(out.shape[0] - 1):
@@ -106,11 +105,9 @@ def forward(maps, tangents, S0, out):
                     dvf[a, c] = S[n + a, c]
         dvn[:, :] = dvf
         if j < steps.size and steps[j] == step:
-            lo, size, sq = offsets[j], offsets[j + 1] - offsets[j], squares[j]
-            ga = np.zeros((size, k))
-            gb = np.zeros((size, k))
+            size = sizes[j]
             for x in range(size):
-                i = contacts[lo + x]
+                i = contacts[j, x]
                 for c in range(k):
                     sa = 0.0
                     sb = 0.0
@@ -123,10 +120,10 @@ def forward(maps, tangents, S0, out):
                 for c in range(k):
                     y[c] = 0.0
                     for z in range(size):
-                        y[c] += Ta[sq + x * size + z] * ga[z, c] + Tb[sq + x * size + z] * gb[z, c]
+                        y[c] += Ta[j, x, z] * ga[z, c] + Tb[j, x, z] * gb[z, c]
                 for r in range(p):
-                    y[pcols[r]] += Tp[lo * p + x * p + r]
-                i = contacts[lo + x]
+                    y[pcols[r]] += Tp[j, x, r]
+                i = contacts[j, x]
                 for a in range(n):
                     for c in range(k):
                         dvn[a, c] += MinvH[a, i] * y[c]
@@ -145,14 +142,16 @@ def adjoint(maps, tangents, cotangents):
     transposed chain of :func:`forward`, from the last step back (p: the law's parameters,
     in the order of ``tangents.pcols``)."""
     Fq, Fv, linear, h, theta, MinvH, Ht = maps
-    steps, offsets, contacts, Ta, Tb, squares, Tp, pcols = tangents
-    n_params = pcols.size
+    steps, sizes, contacts, Ta, Tb, Tp, pcols = tangents
     n = Fq.shape[0]
+    n_params = pcols.size
     total_steps = cotangents.shape[0] - 1
     lam = cotangents[total_steps].copy()
     ap = np.zeros(n_params)
     advn = np.empty(n)
     advf = np.empty(n)
+    width = contacts.shape[1]
+    al = np.empty(width)
     j = steps.size - 1
     for step in range(total_steps - 1, -1, -1):
         aq = lam[:n].copy()
@@ -162,34 +161,34 @@ def adjoint(maps, tangents, cotangents):
             lam[n + a] = h * (1.0 - theta) * aq[a]  # ∂/∂v_k through q_{k+1}
             advf[a] = advn[a]
         if j >= 0 and steps[j] == step:
-            lo, size, sq = offsets[j], offsets[j + 1] - offsets[j], squares[j]
-            al = np.zeros(size)
+            size = sizes[j]
             for x in range(size):
-                i = contacts[lo + x]
+                i = contacts[j, x]
+                al[x] = 0.0
                 for a in range(n):
                     al[x] += MinvH[a, i] * advn[a]
             for z in range(size):
                 ta = 0.0
                 tb = 0.0
                 for x in range(size):
-                    ta += Ta[sq + x * size + z] * al[x]
-                    tb += Tb[sq + x * size + z] * al[x]
-                i = contacts[lo + z]
+                    ta += Ta[j, x, z] * al[x]
+                    tb += Tb[j, x, z] * al[x]
+                i = contacts[j, z]
                 for a in range(n):
                     advf[a] += Ht[i, a] * ta
                     lam[n + a] += Ht[i, a] * tb
             for x in range(size):
                 for r in range(n_params):
-                    ap[r] += Tp[lo * n_params + x * n_params + r] * al[x]
+                    ap[r] += Tp[j, x, r] * al[x]
             j -= 1
         for a in range(n):
             if linear:
-                sq_ = 0.0
+                sq = 0.0
                 sv = 0.0
                 for b in range(n):
-                    sq_ += Fq[b, a] * advf[b]
+                    sq += Fq[b, a] * advf[b]
                     sv += Fv[b, a] * advf[b]
-                lam[a] = aq[a] + sq_
+                lam[a] = aq[a] + sq
                 lam[n + a] += sv
             else:
                 lam[a] = aq[a]

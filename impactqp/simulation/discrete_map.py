@@ -15,7 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import as_dense
-from ..derivatives.lcp import classify, tangent
+from ..derivatives.lcp import ActiveSet, classify, tangent
 from ..kernels.sensitivity import StepMaps, StepTangents, adjoint, forward
 from ..laws.base import ImpactLaw
 from .sensitivity import Columns, Sensitivities, TrajectoryKink, full_restitution
@@ -83,71 +83,87 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
     closed = predicted <= 0.0
     length = max(float(np.abs(gaps).max(initial=0.0)),
                  h * float(np.abs(gam).max(initial=0.0)), 1e-300)
-    kinks: list[TrajectoryKink] = []
     margin = float(np.abs(predicted).min(initial=np.inf)) / length
     near = np.argwhere(np.abs(predicted) <= tol * length)
-    for k, i in near:
-        kinks.append(TrajectoryKink(float(t0 + k * h), "activation", (int(i),),
-                          float(abs(predicted[k, i])) / length))
+    found: list[tuple] = [(near[:, 0], near[:, 1], np.abs(predicted[near[:, 0], near[:, 1]])
+                           / length)]
     VF = free_velocities(system, What, K, h, theta, Qk, Vk)
-    rows = _Rows(len(cols.pcols))
-    for k in np.flatnonzero(closed.any(axis=1)):
-        C = np.flatnonzero(closed[k])
-        G = Gfull[np.ix_(C, C)]
-        lam = L[k + 1, C]
-        gamma_k = gam[k, C]
-        q_step = maps.Ht[C] @ VF[k] + E[np.ix_(C, C)] @ gamma_k
-        speed = max(float(np.abs(q_step).max()), float(np.abs(gamma_k).max()), 1e-300)
-        aset = classify(lam * np.diag(G), G @ lam + q_step, tol * speed)
-        margin = min(margin, aset.margin / speed)
-        if aset.degenerate.any():
-            kinks.append(TrajectoryKink(float(t0 + (k + 1) * h), "degenerate",
-                              tuple(int(c) for c in C[aset.degenerate]), 0.0))
-        if not aset.active.any():
-            continue
-        T = tangent(G, lam, aset, dq=np.eye(C.size))
-        R = np.stack([d[np.ix_(C, C)] @ gamma_k for d in cols.directions], axis=1) \
-            if cols.pcols.size else np.zeros((C.size, 0))
-        rows.add(k, C, T, T @ E[np.ix_(C, C)], T @ R)
-    tangents = rows.arrays(cols.pcols)
+    steps = np.flatnonzero(closed.any(axis=1))
+    parts = []
+    if steps.size:
+        patterns, which = np.unique(closed[steps], axis=0, return_inverse=True)
+        for g, mask in enumerate(patterns):  # the steps that close the same contacts
+            part, low, flat = _group(steps[which.ravel() == g], np.flatnonzero(mask), Gfull,
+                                     maps.Ht, E, cols, (L, gam, VF, tol))
+            parts.extend(part)
+            margin = min(margin, low)
+            found.append(flat)
+    tangents = _stack(parts, cols.pcols)
     out = np.empty((Q.shape[0],) + cols.S0.shape)
     forward(maps, tangents, np.ascontiguousarray(cols.S0), out)
 
     def transposed(cot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return adjoint(maps, tangents, np.ascontiguousarray(cot))
 
+    def kinks() -> list[TrajectoryKink]:
+        steps_, contacts_, distances = found[0]
+        out = [TrajectoryKink(float(t0 + k * h), "activation", (int(i),), float(d))
+               for k, i, d in zip(steps_, contacts_, distances)]
+        for K, C, degenerate in found[1:]:
+            out += [TrajectoryKink(float(t0 + (k + 1) * h), "degenerate",
+                                   tuple(int(c) for c in C[row]), 0.0)
+                    for k, row in zip(K, degenerate)]
+        return sorted(out, key=lambda kink: kink.time)
+
     return Sensitivities("discrete-map", cols, out, transposed, kinks, margin)
 
 
-class _Rows:
-    """The steps with a non-zero LCP tangent, gathered into :class:`StepTangents`."""
+def _group(K: np.ndarray, C: np.ndarray, Gfull: np.ndarray, Ht: np.ndarray, E: np.ndarray,
+           cols: Columns, run: tuple) -> tuple[list, float, tuple]:
+    """The LCP tangents of the steps K that close the contacts C, one per active set
+    (T depends on the active set only), the smallest relative margin and the degenerate
+    steps (steps, C, their degenerate masks)."""
+    L, gam, VF, tol = run
+    G, ECC = Gfull[np.ix_(C, C)], E[np.ix_(C, C)]
+    lam, gamma_k = L[K + 1][:, C], gam[K][:, C]
+    q_step = VF[K] @ Ht[C].T + gamma_k @ ECC.T
+    speed = np.maximum(np.maximum(np.abs(q_step).max(axis=1), np.abs(gamma_k).max(axis=1)),
+                       1e-300)[:, None]
+    # velocity units relative to each step's speed: ΛᵢGᵢᵢ and wᵢ
+    aset = classify((lam * np.diag(G)) / speed, (lam @ G + q_step) / speed, tol)
+    active = aset.active.reshape(lam.shape)
+    degenerate = aset.degenerate.reshape(lam.shape)
+    touching = degenerate.any(axis=1)
+    R = np.einsum("jab,sb->saj", cols.directions[:, C][:, :, C], gamma_k)
+    parts = []
+    pressed = active.any(axis=1)
+    if pressed.any():
+        sets, which = np.unique(active[pressed], axis=0, return_inverse=True)
+        for a, mask in enumerate(sets):
+            rows = np.flatnonzero(pressed)[which.ravel() == a]
+            T = tangent(G, lam[rows[0]], ActiveSet(mask, np.zeros_like(mask), aset.margin),
+                        dq=np.eye(C.size))
+            parts.append((K[rows], C, T, T @ ECC, np.einsum("ab,sbj->saj", T, R[rows])))
+    return parts, aset.margin, (K[touching], C, degenerate[touching])
 
-    def __init__(self, p: int) -> None:
-        self.p = p
-        self.steps: list[int] = []
-        self.contacts: list[np.ndarray] = []
-        self.Ta: list[np.ndarray] = []
-        self.Tb: list[np.ndarray] = []
-        self.Tp: list[np.ndarray] = []
 
-    def add(self, k: int, C: np.ndarray, Ta: np.ndarray, Tb: np.ndarray,
-            Tp: np.ndarray) -> None:
-        self.steps.append(int(k))
-        self.contacts.append(C)
-        self.Ta.append(Ta.ravel())
-        self.Tb.append(Tb.ravel())
-        self.Tp.append(Tp.ravel())
-
-    def arrays(self, pcols: np.ndarray) -> StepTangents:
-        sizes = np.array([c.size for c in self.contacts], dtype=np.int64)
-
-        def flat(parts: list[np.ndarray], dtype: type) -> np.ndarray:
-            return np.ascontiguousarray(np.concatenate(parts) if parts else np.zeros(0),
-                                        dtype=dtype)
-
-        return StepTangents(np.array(self.steps, dtype=np.int64),
-                            np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
-                            flat(self.contacts, np.int64), flat(self.Ta, float),
-                            flat(self.Tb, float),
-                            np.concatenate([[0], np.cumsum(sizes ** 2)]).astype(np.int64),
-                            flat(self.Tp, float), np.ascontiguousarray(pcols, dtype=np.int64))
+def _stack(parts: list, pcols: np.ndarray) -> StepTangents:
+    """The groups' tangents as one :class:`StepTangents`, in step order, padded."""
+    count = sum(p[0].size for p in parts)
+    width = max((p[1].size for p in parts), default=0)
+    steps = np.zeros(count, dtype=np.int64)
+    sizes = np.zeros(count, dtype=np.int64)
+    contacts = np.zeros((count, width), dtype=np.int64)
+    Ta, Tb = np.zeros((count, width, width)), np.zeros((count, width, width))
+    Tp = np.zeros((count, width, pcols.size))
+    row = 0
+    for K, C, T, TE, TR in parts:
+        rows, c = slice(row, row + K.size), C.size
+        steps[rows], sizes[rows], contacts[rows, :c] = K, c, C
+        Ta[rows, :c, :c], Tb[rows, :c, :c], Tp[rows, :c] = T, TE, TR
+        row += K.size
+    order = np.argsort(steps, kind="stable")
+    return StepTangents(steps[order], sizes[order], np.ascontiguousarray(contacts[order]),
+                        np.ascontiguousarray(Ta[order]), np.ascontiguousarray(Tb[order]),
+                        np.ascontiguousarray(Tp[order]),
+                        np.ascontiguousarray(pcols, dtype=np.int64))

@@ -129,7 +129,7 @@ class Sensitivities:
         ∂(q, v)/∂(the asked names) at each record.
     adjoint : callable
         ``adjoint(cotangents (R, 2n)) -> (∂L/∂x₀ (2n,), ∂L/∂p (p,))``, the transposed chain.
-    kinks : list of TrajectoryKink
+    kinks : list of TrajectoryKink, or a callable that builds it (called on first read)
     margin : float
         The smallest distance to a kink over the run, in the units of :class:`TrajectoryKink`
         (+inf when nothing came near one).
@@ -137,11 +137,19 @@ class Sensitivities:
 
     def __init__(self, kind: str, cols: Columns, tangents: np.ndarray,
                  adjoint: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
-                 kinks: list[TrajectoryKink], margin: float) -> None:
+                 kinks: list[TrajectoryKink] | Callable[[], list[TrajectoryKink]],
+                 margin: float) -> None:
         if kind not in KINDS:
             raise InputError(f"kind must be one of {KINDS}, got {kind!r}")
         self.kind, self.cols, self.tangents = kind, cols, tangents
-        self._adjoint, self.kinks, self.margin = adjoint, kinks, margin
+        self._adjoint, self._kinks, self.margin = adjoint, kinks, margin
+
+    @property
+    def kinks(self) -> list[TrajectoryKink]:
+        """Where the derivative is one-sided, in the order found."""
+        if callable(self._kinks):
+            self._kinks = self._kinks()
+        return self._kinks
 
     def of(self, wrt: str | None = None) -> np.ndarray:
         """(R, 2n, k): the tangents with respect to ``wrt`` (every asked name, in order,
