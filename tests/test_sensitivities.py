@@ -177,3 +177,16 @@ def test_a_contact_closed_at_the_start_is_a_kink_of_the_flow():
     assert tr.sensitivities.margin == 0.0 and np.isfinite(tr.sensitivity()).all()
     kinds = {k.kind for k in tr.kinks}
     assert kinds <= {"activation", "degenerate", "grazing", "zeno", "simultaneous"}
+
+
+@pytest.mark.parametrize("law", [iq.Newton([0.8, 0.6]), iq.Fremond([[0.8, 0.1], [0.05, 0.7]])])
+def test_both_loops_give_the_same_discrete_map_derivative(law):
+    """The compiled loop and the Python loop (a named backend) record the same steps, so the
+    derivative read back from either is the same."""
+    system = iq.simulation.cradle_system(3, amplitude=0.1)
+    wrt = ("q0", "v0", law.coefficient_key)
+    compiled = iq.simulate(system, law, 0.8, h=1e-3, sensitivities=wrt)
+    python = iq.simulate(system, law, 0.8, h=1e-3, sensitivities=wrt, backend="exact")
+    assert (compiled.settings["loop"], python.settings["loop"]) == ("compiled", "python")
+    assert np.allclose(compiled.sensitivity(), python.sensitivity(), rtol=1e-9, atol=1e-12)
+    assert np.abs(compiled.sensitivity(law.coefficient_key)).max() > 0.01
