@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import impactqp as iq
-from impactqp.errors import DerivativeUnsupportedError, InputError, ShapeError
 from impactqp.derivatives.certificate import random_direction
+from impactqp.errors import DerivativeUnsupportedError, InputError, ShapeError
 from impactqp.results import LinearPiece
 
 
