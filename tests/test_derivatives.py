@@ -283,3 +283,62 @@ def test_derivative_batch_kinks_other_laws_and_errors() -> None:
         iq.derivative_batch(p, iq.Moreau(0.0), U, jvp=np.ones((3, 3)))
     with pytest.raises(DerivativeUnsupportedError):
         iq.derivative_batch(p, iq.LZB(1e6), U)
+
+
+def ball_on_floor(vx: float) -> iq.ImpactProblem:
+    """A unit point mass hitting a floor (normal y, tangent x) at (vx, −1)."""
+    return iq.ImpactProblem(np.eye(2), np.array([[0.0, 1.0], [1.0, 0.0]]), [vx, -1.0],
+                            contact_dim=2)
+
+
+def test_coulomb_stick_and_slide_with_mu_derivative() -> None:
+    law = iq.Coulomb(0.5, 0.3)  # sticks for vx ≤ μ(1 + e) = 0.65
+    stick = iq.solve(ball_on_floor(0.3), law).derivative()
+    slide = iq.solve(ball_on_floor(0.9), law).derivative()
+    assert stick.status == slide.status == "smooth"
+    assert np.allclose(stick.jacobian("mu"), 0.0)  # exactly 0 while sticking
+    assert np.allclose(stick.jacobian(), [[0, 0], [0, -0.3]])
+    assert np.allclose(slide.jacobian(), [[1, 0.65], [0, -0.3]])
+    assert np.allclose(slide.jacobian("mu"), [-1.3, 0.0])
+    assert np.allclose(slide.jacobian("restitution"), [-0.5, 1.0])
+    for d, vx in ((stick, 0.3), (slide, 0.9)):
+        h = 1e-6
+        fd = (iq.solve(ball_on_floor(vx), iq.Coulomb(0.5 + h, 0.3)).u_plus
+              - iq.solve(ball_on_floor(vx), iq.Coulomb(0.5 - h, 0.3)).u_plus) / (2 * h)
+        assert np.allclose(d.jacobian("mu"), fd, atol=1e-7)
+        assert d.certificate.audit(4).ok
+    assert np.isclose(stick.certificate.margin * np.hypot(0.3, 1.0),
+                      0.35 / np.hypot(1.0, 0.65))  # the distance to the threshold
+
+
+def test_coulomb_threshold_both_sides() -> None:
+    r = iq.solve(ball_on_floor(0.65), iq.Coulomb(0.5, 0.3))
+    d = r.derivative()
+    assert d.status == "kink" and d.kink.contacts.tolist() == [0]
+    ex = np.array([1.0, 0.0])
+    assert np.allclose(d.directional(u_minus=ex).u_plus, [1, 0])  # starts to slide
+    assert np.allclose(d.directional(u_minus=-ex).u_plus, [0, 0])  # keeps sticking
+    for sign in (1.0, -1.0):
+        h = 1e-7
+        fd = (iq.solve(ball_on_floor(0.65 + sign * h), iq.Coulomb(0.5, 0.3)).u_plus
+              - r.u_plus) / h
+        assert np.allclose(fd, d.directional(u_minus=sign * ex).u_plus, atol=1e-6)
+    # along μ: more friction keeps it sticking (0), less lets it slide
+    assert np.allclose(d.directional(mu=1.0).u_plus, 0.0)
+    assert np.allclose(d.directional(mu=-1.0).u_plus, [1.3, 0.0])
+    J = d.limiting_jacobians()
+    assert len(J) == 2 and np.allclose(J[0], [[0, 0], [0, -0.3]])
+    assert np.allclose(J[1], [[1, 0.65], [0, -0.3]])
+
+
+def test_coulomb_in_space_against_finite_differences() -> None:
+    rng = np.random.default_rng(1)
+    W = rng.normal(size=(6, 6))
+    p = iq.ImpactProblem(2 * np.eye(6), W, rng.normal(size=6), contact_dim=3)
+    d = iq.solve(p, iq.Coulomb([0.3, 0.8], 0.5)).derivative()
+    assert d.status == "smooth" and d.certificate.ok
+    audit = d.certificate.audit(6)
+    assert audit.ok, audit.errors
+    t = {k: rng.normal(size=s) for k, s in d.inputs.items()}
+    tan, cot = d.jvp(**t), d.vjp(u_plus=np.ones(6))
+    assert np.isclose(np.ones(6) @ tan.u_plus, sum(np.sum(cot[k] * t[k]) for k in t))

@@ -108,7 +108,8 @@ class DerivativeCertificate(Certificate):
         for j in range(n):
             t = {}
             for name, value in base.items():
-                if kink and name in ("M", "W"):
+                if kink and name in ("M", "W") or (
+                        local.audit_inputs is not None and name not in local.audit_inputs):
                     continue
                 t[name] = random_direction(rng, name, value)
             plus = owner.evaluate({k: v + step * t.get(k, 0.0) for k, v in base.items()})

@@ -83,6 +83,23 @@ class ComplementarityMap(LocalMap):
 
     def __init__(self, M: Any, W: Any, u_minus: np.ndarray, impulses: np.ndarray,
                  parameter: Parameter, *, kink_tol: float) -> None:
+        s, V = self._setup(M, W, u_minus, impulses, parameter)
+        w = self.w
+        self.aset = self._absorb_redundant(lcp.classify(impulses * s / V, w / (s * V),
+                                                        kink_tol), s * V, kink_tol)
+        self._use(self.aset.active)
+        self.reach = self.margin  # the radius measured over the non-degenerate contacts
+        D = np.flatnonzero(self.aset.degenerate)
+        if D.size:
+            self.status = "kink"
+            self.kink = Kink(D, float(max(np.abs(impulses[D] * s[D] / V).max(),
+                                          np.abs(w[D] / (s[D] * V)).max())))
+            self.margin = 0.0
+
+    def _setup(self, M: Any, W: Any, u_minus: np.ndarray, impulses: np.ndarray,
+               parameter: Parameter) -> tuple[np.ndarray, float]:
+        """The operands every derivative reuses; returns the classification's units
+        (sᵢ = √Gᵢᵢ, V = ‖u⁻‖_M)."""
         self.M, self.W = _dense(M), _dense(W)
         self.u, self.lam, self.parameter = np.asarray(u_minus, float), impulses, parameter
         n, m = self.W.shape
@@ -96,21 +113,10 @@ class ComplementarityMap(LocalMap):
         self.gamma = self.W.T @ self.u
         self.IE = np.eye(m) + parameter.to_E(parameter.value)
         self.v = self.Y @ impulses
-        w = self.G @ impulses + self.IE @ self.gamma
-        s = np.sqrt(np.maximum(np.diag(self.G), 1e-300))
-        V = float(np.sqrt(max(self.u @ self.M @ self.u, 0.0))) or 1.0
         self.q = self.IE @ self.gamma
-        self.aset = self._absorb_redundant(lcp.classify(impulses * s / V, w / (s * V),
-                                                        kink_tol), s * V, kink_tol)
-        self.w = w
-        self._use(self.aset.active)
-        self.reach = self.margin  # the radius measured over the non-degenerate contacts
-        D = np.flatnonzero(self.aset.degenerate)
-        if D.size:
-            self.status = "kink"
-            self.kink = Kink(D, float(max(np.abs(impulses[D] * s[D] / V).max(),
-                                          np.abs(w[D] / (s[D] * V)).max())))
-            self.margin = 0.0
+        self.w = self.G @ impulses + self.q
+        s = np.sqrt(np.maximum(np.diag(self.G), 1e-300))
+        return s, float(np.sqrt(max(self.u @ self.M @ self.u, 0.0))) or 1.0
 
     def _absorb_redundant(self, aset: lcp.ActiveSet, scale: np.ndarray,
                           kink_tol: float) -> lcp.ActiveSet:

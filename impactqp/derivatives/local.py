@@ -69,6 +69,9 @@ class LocalMap(ABC):
     condition: float = 1.0
     impulses_unique: bool = True
     reach: float = np.inf
+    audit_inputs: tuple[str, ...] | None = None
+    """The inputs an audit perturbs (None: all); a parameter at the edge of its domain
+    (Coulomb's μ = 0) is left alone."""
 
     @abstractmethod
     def values(self) -> dict[str, Any]:
