@@ -44,6 +44,19 @@ class Audit(NamedTuple):
     one_sided: bool
 
 
+def random_direction(rng: np.random.Generator, name: str, value: np.ndarray) -> np.ndarray:
+    """A random direction of the size of ``value``; for M, symmetric and scaled like M
+    (D X D with D = diag(√Mᵢᵢ), ‖X‖ = 1), so that M + t·dM stays positive definite for
+    small t whatever the spread of the masses."""
+    d = rng.standard_normal(value.shape)
+    if name == "M":
+        D = np.sqrt(np.abs(np.diag(value)))
+        d = 0.5 * (d + d.T)
+        return D[:, None] * (d / np.linalg.norm(d)) * D[None, :]
+    size = float(np.linalg.norm(value)) or 1.0
+    return d * (size / (float(np.linalg.norm(d)) or 1.0))
+
+
 class DerivativeCertificate(Certificate):
     """What the library recomputes about a derivative (docs/theory.md §20).
 
@@ -87,7 +100,7 @@ class DerivativeCertificate(Certificate):
         local = owner.local
         base = {k: np.asarray(v, dtype=float) for k, v in local.values().items()}
         kink = owner.status == "kink"
-        step = min(KINK_STEP if kink else AUDIT_STEP, 0.25 * local.reach)
+        step = min(KINK_STEP if kink else AUDIT_STEP, 0.25 * local.reach) or KINK_STEP
         u0, l0 = owner.u_plus, owner.impulses
         scale_u = float(np.linalg.norm(base["u_minus"]) + np.linalg.norm(u0)) or 1.0
         scale_l = float(np.linalg.norm(l0)) or 1.0
@@ -95,13 +108,10 @@ class DerivativeCertificate(Certificate):
         for j in range(n):
             t = {}
             for name, value in base.items():
-                if kink and name in ("M", "W"):
+                if kink and name in ("M", "W") or (
+                        local.audit_inputs is not None and name not in local.audit_inputs):
                     continue
-                d = rng.standard_normal(value.shape)
-                if name == "M":
-                    d = 0.5 * (d + d.T)
-                size = float(np.linalg.norm(value)) or 1.0
-                t[name] = d * (size / (float(np.linalg.norm(d)) or 1.0))
+                t[name] = random_direction(rng, name, value)
             plus = owner.evaluate({k: v + step * t.get(k, 0.0) for k, v in base.items()})
             if kink:
                 fd_u, fd_l = (plus[0] - u0) / step, (plus[1] - l0) / step

@@ -83,6 +83,23 @@ class ComplementarityMap(LocalMap):
 
     def __init__(self, M: Any, W: Any, u_minus: np.ndarray, impulses: np.ndarray,
                  parameter: Parameter, *, kink_tol: float) -> None:
+        s, V = self._setup(M, W, u_minus, impulses, parameter)
+        w = self.w
+        self.aset = self._absorb_redundant(lcp.classify(impulses * s / V, w / (s * V),
+                                                        kink_tol), s * V, kink_tol)
+        self._use(self.aset.active)
+        self.reach = self.margin  # the radius measured over the non-degenerate contacts
+        D = np.flatnonzero(self.aset.degenerate)
+        if D.size:
+            self.status = "kink"
+            self.kink = Kink(D, float(max(np.abs(impulses[D] * s[D] / V).max(),
+                                          np.abs(w[D] / (s[D] * V)).max())))
+            self.margin = 0.0
+
+    def _setup(self, M: Any, W: Any, u_minus: np.ndarray, impulses: np.ndarray,
+               parameter: Parameter) -> tuple[np.ndarray, float]:
+        """The operands every derivative reuses; returns the classification's units
+        (sᵢ = √Gᵢᵢ, V = ‖u⁻‖_M)."""
         self.M, self.W = _dense(M), _dense(W)
         self.u, self.lam, self.parameter = np.asarray(u_minus, float), impulses, parameter
         n, m = self.W.shape
@@ -96,19 +113,26 @@ class ComplementarityMap(LocalMap):
         self.gamma = self.W.T @ self.u
         self.IE = np.eye(m) + parameter.to_E(parameter.value)
         self.v = self.Y @ impulses
-        w = self.G @ impulses + self.IE @ self.gamma
+        self.q = self.IE @ self.gamma
+        self.w = self.G @ impulses + self.q
         s = np.sqrt(np.maximum(np.diag(self.G), 1e-300))
-        V = float(np.sqrt(max(self.u @ self.M @ self.u, 0.0))) or 1.0
-        self.aset = lcp.classify(impulses * s / V, w / (s * V), kink_tol)
-        self.w = w
-        self._use(self.aset.active)
-        self.reach = self.margin  # the radius measured over the non-degenerate contacts
-        D = np.flatnonzero(self.aset.degenerate)
-        if D.size:
-            self.status = "kink"
-            self.kink = Kink(D, float(max(np.abs(impulses[D] * s[D] / V).max(),
-                                          np.abs(w[D] / (s[D] * V)).max())))
-            self.margin = 0.0
+        return s, float(np.sqrt(max(self.u @ self.M @ self.u, 0.0))) or 1.0
+
+    def _absorb_redundant(self, aset: lcp.ActiveSet, scale: np.ndarray,
+                          kink_tol: float) -> lcp.ActiveSet:
+        """A degenerate contact whose column of W is a combination of the active ones (a
+        redundant contact) is no kink of u⁺ when the minimum-norm impulses of A ∪ D are
+        positive: the answer is then inside the cell of A ∪ D, with non-unique Λ
+        (docs/theory.md §18)."""
+        if not aset.degenerate.any():
+            return aset
+        both = aset.active | aset.degenerate
+        if lcp.factor(self.G, both).rank != lcp.factor(self.G, aset.active).rank:
+            return aset
+        lam = -(lcp.factor(self.G, both).K @ self.q)
+        if not np.all(lam[both] * scale[both] > kink_tol):
+            return aset
+        return lcp.ActiveSet(both, np.zeros_like(both), aset.margin)
 
     def _use(self, active: np.ndarray) -> None:
         """Factor G on ``active`` and measure the cell, its residual and condition."""
@@ -124,7 +148,9 @@ class ComplementarityMap(LocalMap):
         self.residual = float(np.linalg.norm(self.G[np.ix_(A, A)] @ X - R[A]) / scale)
         dlam = -self.K @ R  # ∂Λ/∂u⁻ on this cell, and ∂w/∂u⁻ = G ∂Λ/∂u⁻ + R
         dw = self.G @ dlam + R
-        values = np.where(active, self.lam, self.w)
+        # Λ_A = −G_AA⁺q_A, the minimum-norm impulses (the solver's where unique): where Λ is
+        # not unique, the radius of the cell in which they stay ≥ 0 is a lower bound
+        values = np.where(active, -(self.K @ self.q), self.w)
         grads = np.linalg.norm(np.where(active[:, None], dlam, dw), axis=1)
         keep = ~self.aset.degenerate & (grads > 0)
         unorm = float(np.linalg.norm(self.u))

@@ -90,7 +90,9 @@ class ImpactDerivative:
         self.u_plus, self.impulses = u_plus, impulses
         self.local, self.reason, self.tol, self._solve = local, reason, tol, solve
         if isinstance(local, LinearPiece):
-            local.with_impulses(impulses.size)
+            dense = [np.asarray(A.toarray() if hasattr(A, "toarray") else A, dtype=float)
+                     for A in (problem.M, problem.W)]
+            local.with_problem(*dense)
 
     @property
     def status(self) -> str:

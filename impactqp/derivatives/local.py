@@ -69,6 +69,9 @@ class LocalMap(ABC):
     condition: float = 1.0
     impulses_unique: bool = True
     reach: float = np.inf
+    audit_inputs: tuple[str, ...] | None = None
+    """The inputs an audit perturbs (None: all); a parameter at the edge of its domain
+    (Coulomb's μ = 0) is left alone."""
 
     @abstractmethod
     def values(self) -> dict[str, Any]:
@@ -105,8 +108,8 @@ class LinearPiece(LocalMap):
     u_plus : dict of str to ndarray
         ∂u⁺/∂input for each input, shape (n, *shape of the input); ``"u_minus"`` at least.
     impulses : dict of str to ndarray, optional
-        ∂Λ/∂input likewise, shape (m, *shape); inputs missing here have zero impulse
-        derivative.
+        ∂Λ/∂input likewise, shape (m, *shape); where not given, recovered from the
+        momentum equation M du⁺ = M du⁻ + W dΛ (:meth:`with_problem`).
     values : dict of str to array_like
         The inputs' current values (their shapes define :attr:`inputs`).
     margin : float
@@ -129,9 +132,19 @@ class LinearPiece(LocalMap):
                                  f"{', '.join(map(str, self.inputs.get(name, ('?',))))})")
         self.margin = float(margin)
 
-    def with_impulses(self, m: int) -> LinearPiece:
-        """Itself, knowing that Λ has m entries (impulse derivatives zero where not given)."""
-        self._m = m
+    def with_problem(self, M: np.ndarray, W: np.ndarray) -> LinearPiece:
+        """Itself, with the impulse derivatives not given recovered from the momentum
+        equation M du⁺ = M du⁻ + W dΛ (the minimum-norm dΛ; unique when W has full
+        column rank)."""
+        self._m = W.shape[1]
+        pinv = np.linalg.pinv(W)
+        self.impulses_unique = bool(np.linalg.matrix_rank(W) == W.shape[1])
+        for name, J in self._ju.items():
+            if name not in self._jl:
+                jump = J.reshape(J.shape[0], -1).copy()
+                if name == "u_minus":
+                    jump -= np.eye(J.shape[0])
+                self._jl[name] = (pinv @ M @ jump).reshape(self._m, *self.inputs[name])
         return self
 
     def values(self) -> dict[str, Any]:
