@@ -83,6 +83,8 @@ def _friction() -> None:
 def _simulations() -> None:
     simulate(bouncing_ball(q0=0.1), Newton(0.5), 0.2, h=1e-2)
     simulate(cradle_system(3), Moreau(1.0), 0.05, h=1e-3)
+    simulate(bouncing_ball(q0=0.1), Newton(0.5), 0.2, h=1e-2,
+             sensitivities=("q0", "e")).vjp(q=[1.0])  # the discrete map and its adjoint
     simulate(block_on_incline(0.3, dim=2, speed=1.0), Coulomb(0.5, 0.0), 0.05, h=1e-2)
     simulate(box_on_floor(3, velocity=[1.0, 0.0]), Coulomb(0.3, 0.0), 0.05, h=1e-2)
 

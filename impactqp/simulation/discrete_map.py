@@ -17,6 +17,7 @@ import scipy.sparse as sp
 from ..base.arrays import as_dense
 from ..derivatives.lcp import ActiveSet, classify, tangent
 from ..kernels.sensitivity import StepMaps, StepTangents, adjoint, forward
+from ..kernels.step import activation, predicted_gap
 from ..laws.base import ImpactLaw
 from .sensitivity import Columns, Sensitivities, TrajectoryKink, full_restitution
 from .system import LinearSystem
@@ -79,8 +80,10 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
     Qk, Vk = Q[:-1], V[:-1]
     gaps = np.atleast_2d(system.gaps(Qk))
     gam = np.atleast_2d(system.contact_velocities(Vk))
-    predicted = gaps + (0.5 * h) * gam
-    closed = predicted <= 0.0
+    predicted = predicted_gap(gaps, gam, h)  # the activation rule's own quantity
+    closed = np.empty(gaps.size, dtype=bool)
+    activation(np.ascontiguousarray(gaps).ravel(), np.ascontiguousarray(gam).ravel(), h, closed)
+    closed = closed.reshape(gaps.shape)
     length = max(float(np.abs(gaps).max(initial=0.0)),
                  h * float(np.abs(gam).max(initial=0.0)), 1e-300)
     margin = float(np.abs(predicted).min(initial=np.inf)) / length
