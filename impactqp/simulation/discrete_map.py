@@ -27,10 +27,9 @@ def _dense(A) -> np.ndarray:
     return A.toarray() if sp.issparse(A) else np.asarray(A, dtype=float)
 
 
-def step_maps(system: LinearSystem, h: float, theta: float) -> tuple[StepMaps, np.ndarray,
-                                                                       np.ndarray]:
-    """(the shared parts of the step tangent, Ŵ = M + h²θ²K, K) for a constant or a linear
-    force (a callable one is refused by :func:`.through_time.check`)."""
+def step_maps(system: LinearSystem, h: float, theta: float) -> tuple[StepMaps, np.ndarray]:
+    """(the shared parts of the step tangent with Ŵ = M + h²θ²K, K) for a constant or a
+    linear force (a callable one is refused by :func:`.through_time.check`)."""
     n = system.n_dof
     M = as_dense(system.M)
     Hn = _dense(system.H)
@@ -43,18 +42,7 @@ def step_maps(system: LinearSystem, h: float, theta: float) -> tuple[StepMaps, n
     maps = StepMaps(np.ascontiguousarray(Fq), np.ascontiguousarray(Fv), lin is not None,
                     float(h), float(theta), np.ascontiguousarray(MinvH),
                     np.ascontiguousarray(Hn.T))
-    return maps, What, K
-
-
-def free_velocities(system: LinearSystem, What: np.ndarray, K: np.ndarray, h: float,
-                    theta: float, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
-    """v_free of every step from the rows (q_k, v_k) (docs/theory.md §14, step 2)."""
-    if system.linear_force is not None:
-        c = system.linear_force.constant
-        r = h * (Q @ K.T) + (h * h * theta) * (V @ K.T) - h * c
-    else:
-        r = np.broadcast_to(-h * system.constant_force, V.shape)
-    return V - np.linalg.solve(What, r.T).T
+    return maps, K
 
 
 def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndarray,
@@ -74,7 +62,7 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
         What the tangents are taken with respect to.
     """
     h, theta, tol, t0 = settings["h"], settings["theta"], settings["tol"], settings["t0"]
-    maps, What, K = step_maps(system, h, theta)
+    maps, _ = step_maps(system, h, theta)
     E = full_restitution(law, system.n_contacts)
     Gfull = maps.Ht @ maps.MinvH
     Qk, Vk = Q[:-1], V[:-1]
@@ -90,7 +78,7 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
     near = np.argwhere(np.abs(predicted) <= tol * length)
     found: list[tuple] = [(near[:, 0], near[:, 1], np.abs(predicted[near[:, 0], near[:, 1]])
                            / length)]
-    VF = free_velocities(system, What, K, h, theta, Qk, Vk)
+    VF = V[1:] - L[1:] @ maps.MinvH.T  # v_free = v_{k+1} − Ŵ⁻¹HΛ, as the step computed it
     steps = np.flatnonzero(closed.any(axis=1))
     parts = []
     if steps.size:

@@ -42,7 +42,7 @@ class _Motion:
     """M⁻¹, H, the force and the held projections of a system, dense."""
 
     def __init__(self, system: LinearSystem) -> None:
-        maps, _, K = step_maps(system, 1.0, 0.0)  # Ŵ = M: the products of the motion
+        maps, K = step_maps(system, 1.0, 0.0)  # Ŵ = M: the products of the motion
         self.system, self.n = system, system.n_dof
         self.Minv = np.linalg.inv(as_dense(system.M))
         self.MinvH, self.Ht, self.K = maps.MinvH, maps.Ht, K
