@@ -98,13 +98,13 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
 
     def kinks() -> list[TrajectoryKink]:
         steps_, contacts_, distances = found[0]
-        out = [TrajectoryKink(float(t0 + k * h), "activation", (int(i),), float(d))
-               for k, i, d in zip(steps_, contacts_, distances)]
+        listed = [TrajectoryKink(float(t0 + k * h), "activation", (int(i),), float(d))
+                  for k, i, d in zip(steps_, contacts_, distances)]
         for K, C, degenerate in found[1:]:
-            out += [TrajectoryKink(float(t0 + (k + 1) * h), "degenerate",
+            listed += [TrajectoryKink(float(t0 + (k + 1) * h), "degenerate",
                                    tuple(int(c) for c in C[row]), 0.0)
-                    for k, row in zip(K, degenerate)]
-        return sorted(out, key=lambda kink: kink.time)
+                       for k, row in zip(K, degenerate)]
+        return sorted(listed, key=lambda kink: kink.time)
 
     return Sensitivities("discrete-map", cols, out, transposed, kinks, margin)
 

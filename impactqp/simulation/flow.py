@@ -184,8 +184,8 @@ def _jump(motion: _Motion, r: int, T, Q, V, L, gaps, gam, held, E, cols: Columns
         aset = classify(lam * np.diag(G), G @ lam + q_imp, tol * speed)
         margin = aset.margin / speed
         if aset.degenerate.any():
-            kinks.append(TrajectoryKink(t, "degenerate", tuple(int(c) for c in C[aset.degenerate]),
-                              0.0))
+            kinks.append(TrajectoryKink(t, "degenerate",
+                                        tuple(int(c) for c in C[aset.degenerate]), 0.0))
         Tn = tangent(G, lam, aset, dq=np.eye(C.size))
         Rv = Rv + motion.MinvH[:, C] @ Tn @ (np.eye(C.size) + ECC) @ motion.Ht[C]
         if p:
@@ -196,7 +196,8 @@ def _jump(motion: _Motion, r: int, T, Q, V, L, gaps, gam, held, E, cols: Columns
     Pi = np.eye(n)
     if settle.any() and not np.allclose(V[r + 1], v_plus, rtol=1e-12, atol=1e-12 * speed):
         Pi = motion.projection(settle)  # held at rest: the end of an accumulation
-        kinks.append(TrajectoryKink(t, "zeno", tuple(int(c) for c in np.flatnonzero(settle)), 0.0))
+        kinks.append(TrajectoryKink(t, "zeno", tuple(int(c) for c in np.flatnonzero(settle)),
+                                    0.0))
         margin = 0.0
     R = np.block([[Pi, np.zeros((n, n))], [np.zeros((n, n)), Pi @ Rv]])
     P = np.vstack([np.zeros((n, p)), Pi @ Pv])

@@ -39,8 +39,9 @@ class TrajectoryKink(NamedTuple):
         event).
     contacts : tuple of int
     distance : float
-        How far the run is from the kink, in the units of its test (a gap + ½hγ in length
-        units, Λ and w of a step in velocity units, ∇g·f⁻ in velocity units; 0 for Zeno).
+        How far the run is from the kink, relative to the run's scale: |g + ½hγ| over its
+        length scale (activation), ∇g·f⁻ or the least gap over its velocity or length
+        scale (grazing); 0 where the run sits on the kink (degenerate, Zeno, simultaneous).
     """
 
     time: float
@@ -131,8 +132,9 @@ class Sensitivities:
         ``adjoint(cotangents (R, 2n)) -> (∂L/∂x₀ (2n,), ∂L/∂p (p,))``, the transposed chain.
     kinks : list of TrajectoryKink, or a callable that builds it (called on first read)
     margin : float
-        The smallest distance to a kink over the run, in the units of :class:`TrajectoryKink`
-        (+inf when nothing came near one).
+        The smallest relative distance to a kink over the run (that of
+        :class:`TrajectoryKink`, and the LCPs' margins over each step's speed; +inf when
+        nothing came near one).
     """
 
     def __init__(self, kind: str, cols: Columns, tangents: np.ndarray,
