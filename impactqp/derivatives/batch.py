@@ -2,10 +2,12 @@
 (docs/theory.md §18–§20).
 
 Dense impacts of a compiled complementarity family (Moreau, local Newton, Frémond; where the
-compiled single impact applies, short chains included) run the compiled kernel :func:`impactqp.kernels.derivative.derivative_rows` in the chunks of
+compiled single impact applies) run the compiled kernel
+:func:`impactqp.kernels.derivative.derivative_rows` in the chunks of
 :func:`impactqp.solve_batch`: each row is solved, certified and differentiated on its active
-set with one factor of G_AA. Other laws, and rows the kernel does not certify, go one by one
-through :func:`impactqp.solve` and ``result.derivative()``.
+set with one factor of G_AA (short chains are solved by :func:`impactqp.solve_batch`'s
+column path first, then only differentiated). Other laws, and rows the kernel does not
+certify, go one by one through :func:`impactqp.solve` and ``result.derivative()``.
 """
 
 from __future__ import annotations
