@@ -20,9 +20,13 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from ..errors import DerivativeUnsupportedError
 from ..qp.lcp import solve_lcp
 from . import lcp
 from .local import Kink, LocalMap
+
+DENSE_LIMIT = 2000
+"""Most degrees of freedom of a derivative: its operands (M⁻¹, the Jacobians) are dense."""
 
 
 class Parameter(NamedTuple):
@@ -112,6 +116,10 @@ class ComplementarityMap(LocalMap):
                parameter: Parameter) -> tuple[np.ndarray, float]:
         """The operands every derivative reuses; returns the classification's units
         (sᵢ = √Gᵢᵢ, V = ‖u⁻‖_M)."""
+        if M.shape[0] > DENSE_LIMIT:
+            raise DerivativeUnsupportedError(
+                f"the derivative of an impact with n = {M.shape[0]} degrees of freedom: "
+                f"derivatives are formed densely, up to n = {DENSE_LIMIT}")
         self.M, self.W = _dense(M), _dense(W)
         self.u, self.lam, self.parameter = np.asarray(u_minus, float), impulses, parameter
         n, m = self.W.shape
