@@ -18,6 +18,7 @@ import numba
 import numpy as np
 
 from . import kernels
+from .derivatives.batch import derivative_batch
 from .kernels.jit import cache_dir
 from .laws.batch import solve_batch
 from .laws.complementarity import Fremond, Newton
@@ -54,6 +55,7 @@ def _batches() -> None:
     U = np.random.default_rng(0).standard_normal((64, 3))
     solve_batch(p, Moreau(0.5), U)
     solve_batch(p, Newton([1.0, 0.5]), U)
+    derivative_batch(p, Moreau(0.5), U, jvp=U, vjp=U)
 
 
 def _chains() -> None:

@@ -238,6 +238,9 @@ def test_bad_input_is_named() -> None:
         d.jvp(e=0.1)
     with pytest.raises(InputError, match="kink_tol"):
         three_balls().derivative(kink_tol=-1.0)
+    long_chain = iq.chain(np.ones(2500), np.r_[1.0, np.zeros(2499)])
+    with pytest.raises(DerivativeUnsupportedError, match="densely"):
+        iq.moreau(long_chain, 0.0).derivative()
 
 
 def test_redundant_contacts_give_minimum_norm_impulses() -> None:

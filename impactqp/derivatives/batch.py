@@ -1,11 +1,13 @@
 """Derivatives of many impacts of one structure: :func:`derivative_batch`
 (docs/theory.md §18–§20).
 
-Dense impacts of a compiled complementarity family (Moreau, local Newton, Frémond) run the
-compiled kernel :func:`impactqp.kernels.derivative.derivative_rows` in the chunks of
+Dense impacts of a compiled complementarity family (Moreau, local Newton, Frémond; where the
+compiled single impact applies) run the compiled kernel
+:func:`impactqp.kernels.derivative.derivative_rows` in the chunks of
 :func:`impactqp.solve_batch`: each row is solved, certified and differentiated on its active
-set with one factor of G_AA. Other laws, and rows the kernel does not certify, go one by one
-through :func:`impactqp.solve` and ``result.derivative()``.
+set with one factor of G_AA (short chains are solved by :func:`impactqp.solve_batch`'s
+column path first, then only differentiated). Other laws, and rows the kernel does not
+certify, go one by one through :func:`impactqp.solve` and ``result.derivative()``.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from ..errors import DerivativeUnsupportedError, ShapeError
 from ..kernels import derivative as compiled
 from ..laws import small
 from ..laws.base import MOREAU_FAMILY
-from ..laws.batch import _in_chunks, as_rows
+from ..laws.batch import _in_chunks, as_rows, solve_batch
 from ..laws.pipeline import solve
 from ..laws.planner import plan, validate
 from .impact import KINK_TOL
@@ -76,11 +78,15 @@ def _compiled(problem, law, U, dU, Ubar, tol, kink_tol, n_jobs):
     E = small.restitution_for(law, m)
     IE = np.eye(m) + (law.eps * np.eye(m) if moreau else E)
     spec = compiled.Law(E, law.eps if moreau else 0.0, moreau, IE)
-    settings = compiled.Settings(tol, kink_tol, dU is not None, Ubar is not None)
+    solved = plan(problem, law, "auto", mode="batch").path == "chain"
+    settings = compiled.Settings(tol, kink_tol, dU is not None, Ubar is not None, solved)
     dUp, Uout = np.empty((k, n)) if dU is not None else None, \
         np.empty((k, n)) if Ubar is not None else None
     out = compiled.Rows(np.empty((k, n)), np.empty((k, m)), np.empty((k, 6)),
                         dUp, Uout, np.empty(k, dtype=np.int64), np.empty(k))
+    if solved:  # a short chain: its columns solve faster than rows; differentiate after
+        done = solve_batch(problem, law, U, tol=tol, n_jobs=n_jobs)
+        out.Up[:], out.Lam[:] = done.u_plus, done.impulses
     placeholder = np.zeros((1, n))
 
     def work(a: int, b: int) -> np.ndarray:
@@ -135,7 +141,7 @@ def derivative_batch(problem: Any, law: Any, U_minus: Any, *, jvp: Any = None,
     k, n = U.shape
     dU, Ubar = _directions("jvp", jvp, (k, n)), _directions("vjp", vjp, (k, n))
     kink_tol = float(kink_tol)
-    if plan(problem, law, "auto", mode="batch").path == "compiled":
+    if small.applies(problem, law, "auto", "auto"):
         out, rows = _compiled(problem, law, U, dU, Ubar, tol, kink_tol, n_jobs)
         Up, Lam, dUp, Uout, codes, margin = out.Up, out.Lam, out.dUp, out.Ubar, \
             out.status, out.margin

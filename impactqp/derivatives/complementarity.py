@@ -15,13 +15,18 @@ same few products (docs/theory.md §18).
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import cached_property
 from typing import Any, NamedTuple
 
 import numpy as np
 
+from ..errors import DerivativeUnsupportedError
 from ..qp.lcp import solve_lcp
 from . import lcp
 from .local import Kink, LocalMap
+
+DENSE_LIMIT = 2000
+"""Most degrees of freedom of a derivative: its operands (M⁻¹, the Jacobians) are dense."""
 
 
 class Parameter(NamedTuple):
@@ -88,18 +93,33 @@ class ComplementarityMap(LocalMap):
         self.aset = self._absorb_redundant(lcp.classify(impulses * s / V, w / (s * V),
                                                         kink_tol), s * V, kink_tol)
         self._use(self.aset.active)
-        self.reach = self.margin  # the radius measured over the non-degenerate contacts
         D = np.flatnonzero(self.aset.degenerate)
         if D.size:
             self.status = "kink"
             self.kink = Kink(D, float(max(np.abs(impulses[D] * s[D] / V).max(),
                                           np.abs(w[D] / (s[D] * V)).max())))
-            self.margin = 0.0
+
+    @property
+    def margin(self) -> float:  # type: ignore[override]
+        return 0.0 if self.status == "kink" else self._measures[1]
+
+    @property
+    def reach(self) -> float:  # type: ignore[override]
+        """The radius over the non-degenerate contacts (the margin off a kink)."""
+        return self._measures[1]
+
+    @property
+    def residual(self) -> float:  # type: ignore[override]
+        return self._measures[0]
 
     def _setup(self, M: Any, W: Any, u_minus: np.ndarray, impulses: np.ndarray,
                parameter: Parameter) -> tuple[np.ndarray, float]:
         """The operands every derivative reuses; returns the classification's units
         (sᵢ = √Gᵢᵢ, V = ‖u⁻‖_M)."""
+        if M.shape[0] > DENSE_LIMIT:
+            raise DerivativeUnsupportedError(
+                f"the derivative of an impact with n = {M.shape[0]} degrees of freedom: "
+                f"derivatives are formed densely, up to n = {DENSE_LIMIT}")
         self.M, self.W = _dense(M), _dense(W)
         self.u, self.lam, self.parameter = np.asarray(u_minus, float), impulses, parameter
         n, m = self.W.shape
@@ -135,17 +155,24 @@ class ComplementarityMap(LocalMap):
         return lcp.ActiveSet(both, np.zeros_like(both), aset.margin)
 
     def _use(self, active: np.ndarray) -> None:
-        """Factor G on ``active`` and measure the cell, its residual and condition."""
+        """Factor G on ``active`` (the cell's measures follow when first read)."""
         self.active = active
         f = lcp.factor(self.G, active)
         self.K = f.K
         self.condition = f.condition
         self.impulses_unique = f.rank == int(active.sum())
+        self.__dict__.pop("_measures", None)
+
+    @cached_property
+    def _measures(self) -> tuple[float, float]:
+        """(residual of the solves, radius of the cell relative to ‖u⁻‖), measured when
+        first read: a JVP or VJP does not pay for them (docs/theory.md §20)."""
+        active = self.active
         R = self.IE @ self.W.T  # ∂q/∂u⁻
         A = np.flatnonzero(active)
         X = self.K[np.ix_(A, A)] @ R[A]
         scale = np.linalg.norm(R[A]) or 1.0
-        self.residual = float(np.linalg.norm(self.G[np.ix_(A, A)] @ X - R[A]) / scale)
+        residual = float(np.linalg.norm(self.G[np.ix_(A, A)] @ X - R[A]) / scale)
         dlam = -self.K @ R  # ∂Λ/∂u⁻ on this cell, and ∂w/∂u⁻ = G ∂Λ/∂u⁻ + R
         dw = self.G @ dlam + R
         # Λ_A = −G_AA⁺q_A, the minimum-norm impulses (the solver's where unique): where Λ is
@@ -155,8 +182,8 @@ class ComplementarityMap(LocalMap):
         keep = ~self.aset.degenerate & (grads > 0)
         unorm = float(np.linalg.norm(self.u))
         radii = values[keep] / grads[keep]
-        self.margin = float(radii.min()) / unorm if radii.size and unorm > 0 else \
-            (np.inf if not radii.size else 0.0)
+        return residual, (float(radii.min()) / unorm if radii.size and unorm > 0 else
+                          (np.inf if not radii.size else 0.0))
 
     def values(self) -> dict[str, Any]:
         return {"u_minus": self.u, "M": self.M, "W": self.W,
@@ -210,7 +237,7 @@ class ComplementarityMap(LocalMap):
             piece.__dict__.update(self.__dict__)
             piece.aset = lcp.ActiveSet(mask, np.zeros_like(mask), 0.0)
             piece._use(mask)
-            piece.status, piece.kink, piece.margin = "smooth", None, 0.0
+            piece.status, piece.kink = "smooth", None
             out.append(piece)
         return out
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -76,11 +77,9 @@ class CoulombMap(ComplementarityMap):
             self.audit_inputs = tuple(k for k in self.inputs if k != "mu")
         self.modes, self.options = self._classify(kink_tol)
         self._use_modes(self.modes)
-        self.reach = self.margin
         if self.options:
             self.status = "kink"
             self.kink = Kink(np.array(sorted(self.options)), 0.0)
-            self.margin = 0.0
 
     def _parts(self, c: int) -> tuple[float, np.ndarray, float, np.ndarray]:
         """(Λ_n, Λ_T, U_n, U_T) of contact c."""
@@ -139,10 +138,16 @@ class CoulombMap(ComplementarityMap):
         self.Kmu = np.linalg.solve(J, Fmu)
         self.condition = float(np.linalg.cond(J))
         self.impulses_unique = True
+        self._J, self._FU = J, FU
+        self.__dict__.pop("_measures", None)
+
+    @cached_property
+    def _measures(self) -> tuple[float, float]:
         R = self.IE @ self.W.T
-        scale = np.linalg.norm(FU @ R) or 1.0
-        self.residual = float(np.linalg.norm(J @ (self.K @ R) - FU @ R) / scale)
-        self.margin = self._radius(modes, -(self.K @ R))
+        FR = self._FU @ R
+        scale = np.linalg.norm(FR) or 1.0
+        return (float(np.linalg.norm(self._J @ (self.K @ R) - FR) / scale),
+                self._radius(self.modes, -(self.K @ R)))
 
     def _radius(self, modes: list[int], dlam: np.ndarray) -> float:
         """First-order distance, relative to ‖u⁻‖, to the nearest change of mode: each

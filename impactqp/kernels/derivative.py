@@ -19,7 +19,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .active_set import _append, _solve_factored
+from .active_set import _append, cholesky_solve
 from .impact import _solve_into, _unpack, workspace
 from .jit import kernel
 
@@ -39,12 +39,15 @@ class Law(NamedTuple):
 
 class Settings(NamedTuple):
     """Tolerances and what to compute: the certificate's ``tol``, the degeneracy
-    ``kink_tol`` (docs/theory.md §19), and whether JVP and VJP rows are asked for."""
+    ``kink_tol`` (docs/theory.md §19), whether JVP and VJP rows are asked for, and whether
+    the rows come solved and certified (U⁺ and Λ already in the outputs, from another fast
+    path of the batch) so that only their derivatives are computed."""
 
     tol: float
     kink_tol: float
     jvp: bool
     vjp: bool
+    solved: bool
 
 
 class Rows(NamedTuple):
@@ -61,7 +64,7 @@ class Rows(NamedTuple):
 
 
 @kernel
-def _active_factor(G, IE, Wt, M, um, lam, kink_tol, L, idx, w, active):
+def _active_factor(G, IE, Wt, M, um, lam, kink_tol, L, idx, w, active, gamma):
     """w = GΛ + q for the row, the factor of G_AA on the active contacts (in L, idx) and
     the row's status. Returns (k, status)."""
     m, n = Wt.shape
@@ -70,13 +73,15 @@ def _active_factor(G, IE, Wt, M, um, lam, kink_tol, L, idx, w, active):
         for j in range(n):
             V += um[i] * M[i, j] * um[j]
     V = np.sqrt(V) if V > 0.0 else 1.0
+    for j in range(m):
+        g = 0.0
+        for c in range(n):
+            g += Wt[j, c] * um[c]
+        gamma[j] = g
     for i in range(m):
         total = 0.0
         for j in range(m):
-            g = 0.0
-            for c in range(n):
-                g += Wt[j, c] * um[c]
-            total += IE[i, j] * g + G[i, j] * lam[j]
+            total += IE[i, j] * gamma[j] + G[i, j] * lam[j]
         w[i] = total
     k, status = 0, SMOOTH
     for i in range(m):
@@ -93,11 +98,23 @@ def _active_factor(G, IE, Wt, M, um, lam, kink_tol, L, idx, w, active):
 
 
 @kernel
+def _solve_active(L, idx, k, rhs, out, y):
+    """out[idx[:k]] = G_AA⁻¹ rhs[idx[:k]] with G_AA = LLᵀ, in the scratch y (no allocation
+    per call: this runs several times per row)."""
+    for a in range(k):
+        y[a] = rhs[idx[a]]
+    cholesky_solve(L, k, y)
+    for a in range(k):
+        out[idx[a]] = y[a]
+
+
+@kernel
 def _margin(G, IE, Wt, um, lam, w, L, idx, k, active, buf):
     """The cell's radius relative to ‖u⁻‖ (docs/theory.md §20): min over contacts of the
     value (Λᵢ active, wᵢ inactive) over the norm of its gradient in u⁻."""
     m, n = Wt.shape
-    R, dlam, grad = buf[:m], buf[m:2 * m], np.zeros(m)
+    R, dlam, grad = buf[:m], buf[m:2 * m], buf[2 * m:3 * m]
+    grad[:] = 0.0
     unorm = 0.0
     for c in range(n):
         unorm += um[c] * um[c]
@@ -107,7 +124,7 @@ def _margin(G, IE, Wt, um, lam, w, L, idx, k, active, buf):
                 total += IE[i, j] * Wt[j, c]
             R[i] = total
             dlam[i] = 0.0
-        _solve_factored(L, idx, k, R, dlam)
+        _solve_active(L, idx, k, R, dlam, buf[4 * m:5 * m])
         for i in range(m):
             if active[i]:  # an active contact dropped as dependent keeps a zero gradient
                 grad[i] += dlam[i] * dlam[i]
@@ -139,7 +156,7 @@ def _jvp_vjp(IE, Wt, MinvW, L, idx, k, du, ubar, dup, uout, settings, buf):
                 total += IE[i, j] * g
             r[i] = total
             x[i] = 0.0
-        _solve_factored(L, idx, k, r, x)
+        _solve_active(L, idx, k, r, x, buf[4 * m:5 * m])
         for c in range(n):
             total = du[c]
             for a in range(k):
@@ -152,7 +169,7 @@ def _jvp_vjp(IE, Wt, MinvW, L, idx, k, du, ubar, dup, uout, settings, buf):
                 total += MinvW[c, i] * ubar[c]
             r[i] = total
             x[i] = 0.0
-        _solve_factored(L, idx, k, r, x)
+        _solve_active(L, idx, k, r, x, buf[4 * m:5 * m])
         for c in range(n):
             total = ubar[c]
             for i in range(m):
@@ -173,15 +190,16 @@ def derivative_rows(packed, Um, dU, Ubar, law, settings, passive, out):
     M, Wt, MinvW, G, s = _unpack(packed, n, m)
     work = workspace(n, m)
     L, idx = np.empty((m, m)), np.empty(m, dtype=np.int64)
-    w, buf, active = np.empty(m), np.empty(2 * m), np.empty(m, dtype=np.bool_)
+    w, buf, active = np.empty(m), np.empty(5 * m), np.empty(m, dtype=np.bool_)
     for r in range(k_rows):
-        if not _solve_into(M, Wt, MinvW, G, s, Um[r], law.E, law.eps, law.moreau,
-                           settings.tol, passive, out.Up[r], out.Lam[r], out.Res[r], work):
+        if not settings.solved and not _solve_into(
+                M, Wt, MinvW, G, s, Um[r], law.E, law.eps, law.moreau, settings.tol, passive,
+                out.Up[r], out.Lam[r], out.Res[r], work):
             out.status[r] = UNCERTIFIED
             out.margin[r] = np.nan
             continue
         k, status = _active_factor(G, law.IE, Wt, M, Um[r], out.Lam[r], settings.kink_tol,
-                                   L, idx, w, active)
+                                   L, idx, w, active, buf[3 * m:])
         out.status[r] = status
         out.margin[r] = 0.0 if status == KINK else _margin(
             G, law.IE, Wt, Um[r], out.Lam[r], w, L, idx, k, active, buf)
