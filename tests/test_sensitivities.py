@@ -193,3 +193,14 @@ def test_both_loops_give_the_same_discrete_map_derivative(law):
     assert (compiled.settings["loop"], python.settings["loop"]) == ("compiled", "python")
     assert np.allclose(compiled.sensitivity(), python.sensitivity(), rtol=1e-9, atol=1e-12)
     assert np.abs(compiled.sensitivity(law.coefficient_key)).max() > 0.01
+
+
+def test_the_cost_benchmark_runs():
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from benchmarks.sensitivities import timings
+
+    result = timings("moreau-jean", 200, 2)
+    assert result["ratio (medians)"] > 0 and result["plain fastest s"] > 0

@@ -82,9 +82,9 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
     steps = np.flatnonzero(closed.any(axis=1))
     parts = []
     if steps.size:
-        patterns, which = np.unique(closed[steps], axis=0, return_inverse=True)
+        patterns, which = _patterns(closed[steps])
         for g, mask in enumerate(patterns):  # the steps that close the same contacts
-            part, low, flat = _group(steps[which.ravel() == g], np.flatnonzero(mask), Gfull,
+            part, low, flat = _group(steps[which == g], np.flatnonzero(mask), Gfull,
                                      maps.Ht, E, cols, (L, gam, VF, tol))
             parts.extend(part)
             margin = min(margin, low)
@@ -129,13 +129,24 @@ def _group(K: np.ndarray, C: np.ndarray, Gfull: np.ndarray, Ht: np.ndarray, E: n
     parts = []
     pressed = active.any(axis=1)
     if pressed.any():
-        sets, which = np.unique(active[pressed], axis=0, return_inverse=True)
+        sets, which = _patterns(active[pressed])
         for a, mask in enumerate(sets):
-            rows = np.flatnonzero(pressed)[which.ravel() == a]
+            rows = np.flatnonzero(pressed)[which == a]
             T = tangent(G, lam[rows[0]], ActiveSet(mask, np.zeros_like(mask), aset.margin),
                         dq=np.eye(C.size))
             parts.append((K[rows], C, T, T @ ECC, np.einsum("ab,sbj->saj", T, R[rows])))
     return parts, aset.margin, (K[touching], C, degenerate[touching])
+
+
+def _patterns(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(the distinct rows of a boolean (s, m) array, the index of each row among them), by
+    each row's bits as one integer when m ≤ 62."""
+    if rows.shape[1] > 62:
+        patterns, which = np.unique(rows, axis=0, return_inverse=True)
+        return patterns, which.ravel()
+    codes = rows @ (np.int64(1) << np.arange(rows.shape[1], dtype=np.int64))
+    _, first, which = np.unique(codes, return_index=True, return_inverse=True)
+    return rows[first], which.ravel()
 
 
 def _stack(parts: list, pcols: np.ndarray) -> StepTangents:
