@@ -121,6 +121,10 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "read (for j = 0, row −1 is row n − 1, rewritten with the same value later), and row "
         "j rewrites L[j, j] as d/√d, which is √d to one rounding",
     ("impactqp/kernels/impact.py", "core/NumberReplacer",
+     "return (np.empty(2 * n + 5 * m), np.empty((m, m)), np.empty(m, dtype=np.int64),",
+     "return (np.empty( 3 * n + 5 * m), np.empty((m, m)), np.empty(m, dtype=np.int64),"):
+        "a larger scratch array: the solve and the residuals use its first 2n + 5m floats only",
+    ("impactqp/kernels/impact.py", "core/NumberReplacer",
      "w = floats[m:2 * m]", "w = floats[m: 3 * m]"):
         "the search reads and writes w[:m] only, the same cells",
     ("impactqp/kernels/impact.py", "core/NumberReplacer",

@@ -1,4 +1,9 @@
-"""Run the smoke benchmark suite from Python into a folder and print the head of its summary.
+"""Running the benchmarks from Python
+==================================
+
+Run the smoke benchmark suite from Python into a folder and print the head of its summary.
+
+Run it as::
 
     python examples/benchmark_run.py                 # into a new temporary folder
     python examples/benchmark_run.py --out DIR       # into DIR (created if needed)

@@ -1,4 +1,7 @@
-"""Newton's cradle with three balls: solve it with Moreau's law (ε = 0 and ε = 1) and with
+"""Newton's cradle: Moreau's law and the sector law
+================================================
+
+Newton's cradle with three balls: solve it with Moreau's law (ε = 0 and ε = 1) and with
 the sector law, verify each answer against the admissible set S, classify it, print a table.
 
 Run: python examples/cradle.py

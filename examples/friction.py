@@ -1,5 +1,10 @@
-"""Frictional impacts: a sphere hitting the floor obliquely under Coulomb's law, and an FCLib
+"""Frictional impacts: stick, slip and an FCLib problem
+====================================================
+
+Frictional impacts: a sphere hitting the floor obliquely under Coulomb's law, and an FCLib
 problem solved with its certificate.
+
+Run it as::
 
     python examples/friction.py              # prints the tables, writes nothing
     python examples/friction.py --out DIR    # also writes the sphere's problem file into DIR

@@ -1,4 +1,7 @@
-"""Identify restitution coefficients from measurements with impactqp's derivatives.
+"""Identifying restitution with derivatives through time
+=====================================================
+
+Identify restitution coefficients from measurements with impactqp's derivatives.
 
     python examples/identify_restitution.py              # prints the fits, writes nothing
     python examples/identify_restitution.py --out DIR    # also writes fit.json into DIR

@@ -1,5 +1,10 @@
-"""Rigid impact laws against the dispersive LZB model on chains of steel balls, and the
+"""Rigid laws against the dispersive LZB model
+===========================================
+
+Rigid impact laws against the dispersive LZB model on chains of steel balls, and the
 gallery's figure.
+
+Run it as::
 
     python examples/lzb_comparison.py                # into a new temporary folder
     python examples/lzb_comparison.py --out DIR      # into DIR (created if needed)

@@ -1,4 +1,9 @@
-"""Simulate a bouncing ball and Newton's cradle with impactqp and draw the gallery's figures.
+"""Motion: the bouncing ball and the cradle on pendulums
+=====================================================
+
+Simulate a bouncing ball and Newton's cradle with impactqp and draw the gallery's figures.
+
+Run it as::
 
     python examples/simulate_cradle.py               # into a new temporary folder
     python examples/simulate_cradle.py --out DIR     # into DIR (created if needed)

@@ -1,4 +1,7 @@
-"""Verify an impact law of your own with impactqp.verify_law.
+"""Verifying a law of your own
+===========================
+
+Verify an impact law of your own with impactqp.verify_law.
 
 The law here resolves a simultaneous impact as a sequence of single elastic collisions: while
 some contact approaches (γᵢ < 0), the most strongly approaching one bounces (Newton's law

@@ -107,7 +107,32 @@ class NoSolutionError(ImpactError):
 
 
 class CertificateError(SolverError):
-    """No backend produced an answer within the certificate's tolerance."""
+    """No backend produced an answer within the certificate's tolerance.
+
+    Attributes
+    ----------
+    best : object or None
+        The best answer that was found and failed its certificate, where the caller can use
+        or inspect it (:func:`impactqp.solve_friction` sets a result whose ``status`` is
+        ``"not certified"``, with its ABH ``error`` and certificate); None otherwise.
+    attempts : list of str
+        What was tried, in order (empty where the raiser did not record it).
+    """
+
+    def __init__(self, message: str, *, best: object = None,
+                 attempts: list[str] | None = None) -> None:
+        super().__init__(message)
+        self.best = best
+        self.attempts = list(attempts or [])
+
+    def __reduce__(self):  # keyword attributes survive pickling (dask workers, processes)
+        return (_rebuild_certificate_error,
+                (type(self), str(self), self.best, self.attempts))
+
+
+def _rebuild_certificate_error(cls: type, message: str, best: object,
+                               attempts: list[str]) -> CertificateError:
+    return cls(message, best=best, attempts=attempts)
 
 
 class SectorLawError(InputError):

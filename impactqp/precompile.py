@@ -80,6 +80,7 @@ def _friction() -> None:
     problem = FrictionContactProblem(W, q, 0.3)
     for backend in ("auto", "nsgs", "newton"):
         solve_friction(problem, backend=backend)
+    solve_friction(FrictionContactProblem(W[:9, :9], q[:9], 0.3))  # a few contacts: one call
 
 
 def _simulations() -> None:

@@ -11,6 +11,9 @@ import pytest
 import impactqp as iq
 import impactqp.qp.backends.isotonic as isotonic_backend
 
+COMPILED = "kernel (compiled): certified"
+"""The attempt of an impact answered by the compiled single-impact path."""
+
 
 def dense_problem() -> iq.ImpactProblem:
     """Four bodies with a full mass matrix and three contacts, all active (its own structure:
@@ -77,3 +80,62 @@ def test_a_wrong_chain_projection_is_not_certified(monkeypatch):
     fallback = iq.moreau(p, 0.5)
     assert fallback.backend != "isotonic" and fallback.certificate.ok
     np.testing.assert_allclose(fallback.u_plus, good.u_plus, atol=1e-7 * np.abs(good.u_plus).max())
+
+
+def test_the_compiled_path_measures_momentum_with_its_own_operand():
+    # the compiled single-impact path recovers u⁺ with the pack's Cholesky-based M⁻¹W; plant
+    # N with WᵀN = 0 there: its candidate satisfies every contact condition and the impact
+    # equation as measured with the planted operand, so only the pack's own LU-solved M⁻¹W
+    # (docs/theory.md §8, "Independence") refuses it; the general path then answers right
+    from impactqp.laws import small
+
+    p = dense_problem()
+    st = p.structure
+    law = iq.Newton(0.5)
+    right = iq.solve(p, law, backend="nnls")
+    n, m = st.n, st.m
+    W = np.asarray(p.W)
+    N = (np.eye(n) - W @ np.linalg.pinv(W)) @ np.full((n, m), 0.05)
+    packed = st.kernel_pack.copy()
+    start = n * n + m * n
+    recovery = packed[start:start + n * m].reshape(n, m)
+    np.testing.assert_allclose(recovery, np.linalg.solve(p.M, W), rtol=1e-12)
+    recovery += N
+    st.__dict__["kernel_pack"] = packed
+    try:
+        assert small.solve_small(p, law, 1e-9, 0.0) is None
+        r = iq.solve(p, law)
+        assert r.certificate.ok and r.attempts[-1] != COMPILED
+        np.testing.assert_allclose(r.u_plus, right.u_plus, atol=1e-9)
+    finally:
+        del st.__dict__["kernel_pack"]
+    assert iq.solve(p, law).attempts == [COMPILED]
+
+
+def test_a_wrong_sparse_operand_is_not_certified():
+    # sparse problems: the impact equation is formed as M(u⁺ − u⁻) − WΛ from the given M
+    # and W and only its size is measured through the factor; an error N in the structure's
+    # M⁻¹W (WᵀN = 0) that the recovery used shows there
+    import scipy.sparse as sp
+
+    p = dense_problem()
+    law = iq.Newton(0.5)
+    right = iq.solve(p, law, backend="nnls")
+    ps = iq.ImpactProblem(sp.csc_matrix(p.M), sp.csc_matrix(p.W), p.u_minus)
+    st = ps.structure
+    assert st.sparse and not st.diagonal_mass
+    W = np.asarray(p.W)
+    N = (np.eye(5) - W @ np.linalg.pinv(W)) @ np.full((5, 3), 0.05)
+    wrong_u = p.u_minus + (np.asarray(st.Minv_W) + N) @ right.impulses
+    good = law.certificate(ps, iq.Answer(right.u_plus, right.impulses), 1e-9)
+    assert good.ok
+    st.__dict__["Minv_W"] = np.asarray(st.Minv_W) + N
+    try:
+        bad = law.certificate(ps, iq.Answer(wrong_u, right.impulses), 1e-9)
+        d = N @ right.impulses
+        V = np.sqrt(p.u_minus @ np.asarray(p.M) @ p.u_minus)
+        assert not bad.ok
+        assert bad.momentum == pytest.approx(np.sqrt(d @ np.asarray(p.M) @ d) / V, rel=1e-6)
+        assert bad.law_feasibility <= 1e-12
+    finally:
+        st.__dict__.pop("Minv_W")

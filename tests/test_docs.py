@@ -1,15 +1,21 @@
-"""Every public name has a numpydoc docstring with the sections it needs, and the API page
-of the documentation lists every public name."""
+"""Every public name has a numpydoc docstring with the sections it needs, the API page of the
+documentation lists every public name, the gallery has every example, and the built site
+shows what it promises: typeset formulas, section links that resolve, the examples run with
+their figures."""
 
 from __future__ import annotations
 
 import argparse
 import ast
 import builtins
+import html
 import importlib
 import importlib.util
 import inspect
+import os
 import re
+import subprocess
+import sys
 import warnings
 from pathlib import Path
 
@@ -179,9 +185,34 @@ def _included(page: str) -> set[str]:
     return set(re.findall(r"^\.\. literalinclude:: \.\./(\S+)$", text, flags=re.M))
 
 
-def test_gallery_shows_every_example_script() -> None:
-    scripts = {f"examples/{p.name}" for p in (DOCS.parent / "examples").glob("*.py")}
-    assert _included("gallery.rst") == scripts
+EXAMPLES = DOCS.parent / "examples"
+NOT_RUN = {"benchmark_run.py"}  # the gallery shows it without running it (a benchmark suite)
+
+
+def _gallery_conf() -> dict:
+    """``sphinx_gallery_conf`` of docs/conf.py, read without importing Sphinx."""
+    tree = ast.parse((DOCS / "conf.py").read_text(encoding="utf-8"))
+    node = next(n for n in tree.body if isinstance(n, ast.Assign)
+                and getattr(n.targets[0], "id", "") == "sphinx_gallery_conf")
+    return ast.literal_eval(node.value)
+
+
+def test_every_example_is_a_gallery_page_and_all_but_the_benchmark_run() -> None:
+    """sphinx-gallery makes a page of every script of examples/ whose docstring opens with a
+    reST title (its first line, underlined by as many "="), and runs those its
+    filename_pattern matches: all but the benchmark run."""
+    conf = _gallery_conf()
+    assert (conf["examples_dirs"], conf["gallery_dirs"]) == ("../examples", "auto_examples")
+    scripts = sorted(EXAMPLES.glob("*.py"))
+    assert scripts
+    for script in scripts:
+        doc = ast.get_docstring(ast.parse(script.read_text(encoding="utf-8")), clean=False)
+        assert doc is not None, script.name
+        title, underline, blank, *_ = doc.split("\n")
+        assert title.strip() and underline == "=" * len(title) and not blank, script.name
+        runs = re.search(conf["filename_pattern"], str(script)) is not None
+        assert runs == (script.name not in NOT_RUN), script.name
+    assert (EXAMPLES / "GALLERY_HEADER.rst").is_file()
 
 
 def test_file_formats_page_shows_every_sample_file() -> None:
@@ -211,3 +242,125 @@ def test_command_line_page_shows_the_help_of_every_subcommand() -> None:
     text = (DOCS / "cli.rst").read_text(encoding="utf-8")
     shown = {m.strip() for m in re.findall(r"^\.\. impactqp-help::(.*)$", text, flags=re.M)}
     assert shown == commands(build_parser(), "")
+
+
+# The built site. CI's docs step builds it (nitpicky, warnings as errors, offline) and runs
+# these tests on that build (IMPACTQP_DOCS_HTML); run without it, they build the site into a
+# temporary folder the same way (needs the docs extra).
+@pytest.fixture(scope="module")
+def site(tmp_path_factory) -> Path:
+    given = os.environ.get("IMPACTQP_DOCS_HTML")
+    if given:
+        return Path(given).resolve()
+    pytest.importorskip("sphinx_gallery", reason="the docs extra is not installed")
+    out = tmp_path_factory.mktemp("html")
+    done = subprocess.run([sys.executable, "-m", "sphinx", "-n", "-W", "--keep-going", "-q",
+                           "-b", "html", "-d", str(tmp_path_factory.mktemp("doctrees")),
+                           str(DOCS), str(out)], capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stderr
+    return out
+
+
+def _page(site: Path, name: str) -> str:
+    return (site / name).read_text(encoding="utf-8")
+
+
+def _ids(html: str) -> set[str]:
+    return set(re.findall(r'\bid="([^"]+)"', html))
+
+
+def test_site_has_the_theme_and_a_copy_button(site: Path) -> None:
+    index = _page(site, "index.html")
+    assert "pydata-sphinx-theme" in index and "copybutton.js" in index
+
+
+THEORY_SOURCE = DOCS / "theory.md"
+SECTION_SIGN = "\u00a7"  # spelled so, tests/test_citations.py does not read it as a citation
+
+
+def test_theory_page_typesets_every_displayed_formula(site: Path) -> None:
+    """Every $$…$$ block of the note is a math block of the page, which loads MathJax; no
+    dollar sign is left over as text."""
+    source = THEORY_SOURCE.read_text(encoding="utf-8")
+    fences = [line for line in source.splitlines() if line.strip() == "$$"]
+    assert len(fences) % 2 == 0 and len(fences) // 2 >= 45
+    html = _page(site, "theory.html")
+    assert re.search(r'<script[^>]+src="[^"]*mathjax[^"]*"', html, flags=re.I)
+    blocks = re.findall(r'<div class="math notranslate nohighlight">\s*\\\[(.*?)\\\]\s*</div>',
+                        html, flags=re.S)
+    assert len(blocks) == len(fences) // 2
+    assert r"\Lambda" in blocks[0] and "$$" not in html
+
+
+def test_theory_sections_have_stable_anchors_and_every_section_link_resolves(site: Path) -> None:
+    """Section N of the note is the element with id sec-N; every link into the theory page,
+    from any page, names an id it has; the API page shows no citation as plain text, and links
+    every section the public docstrings cite."""
+    numbers = {int(n) for n in re.findall(r"^## (\d+)\. ", THEORY_SOURCE.read_text(
+        encoding="utf-8"), flags=re.M)}
+    theory = _page(site, "theory.html")
+    ids = _ids(theory)
+    assert {f"sec-{n}" for n in numbers} <= ids
+    assert all(re.search(rf'<section id="sec-{n}"', theory) for n in numbers)
+    links = 0
+    for page in site.rglob("*.html"):
+        for anchor in re.findall(r'href="(?:\.\./)*theory\.html#([^"]+)"',
+                                 page.read_text(encoding="utf-8")):
+            assert anchor in ids, (page.name, anchor)
+            links += 1
+    api = _page(site, "api.html")
+    assert f"docs/theory.md {SECTION_SIGN}" not in re.sub(r"<a [^>]*>.*?</a>", "", api,
+                                                          flags=re.S)
+    linked = {int(n) for n in re.findall(r'href="theory\.html#sec-(\d+)"', api)}
+    cited = {int(n) for where, name in DOCUMENTED
+             for n in re.findall(r"docs/theory\.md\s+\u00a7(\d+)", inspect.getdoc(
+                 getattr(importlib.import_module(where), name)) or "")}
+    assert cited and cited <= linked and links > len(cited)
+
+
+def test_gallery_runs_the_examples_and_shows_their_figures(site: Path) -> None:
+    """A page per script with its thumbnail and downloads; a script that was run shows what
+    it printed, and every image it writes (tests/test_examples.py) as a figure, the first as
+    its own thumbnail; the benchmark run is shown unrun, with the placeholder."""
+    from test_examples import EXPECTED, WRITES
+
+    gallery = site / "auto_examples"
+    images = site / "_images"
+    placeholder = (images / "sphx_glr_benchmark_run_thumb.png").read_bytes()
+    downloads = {p.name for p in (site / "_downloads").rglob("*")}
+    for script in sorted(EXAMPLES.glob("*.py")):
+        name = script.stem
+        page = (gallery / f"{name}.html").read_text(encoding="utf-8")
+        thumb = images / f"sphx_glr_{name}_thumb.png"
+        assert thumb.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
+        assert {f"{name}.py", f"{name}.ipynb"} <= downloads, name
+        if script.name in NOT_RUN:
+            assert "sphx-glr-script-out" not in page
+            continue
+        expected = EXPECTED[script.name][0]
+        assert html.escape(expected, quote=False) in page, (name, expected)
+        drawn = sorted(f for f in WRITES.get(script.name, ())
+                       if f.endswith((".png", ".gif")))
+        shown = sorted(set(re.findall(rf'src="\.\./_images/(sphx_glr_{name}_\d+\.(?:png|gif))"',
+                                      page)))
+        assert len(shown) == len(drawn), (name, shown, drawn)
+        assert all((images / f).stat().st_size > 1000 for f in shown)
+        assert (thumb.read_bytes() != placeholder) == bool(drawn), name
+
+
+def test_citations_become_links_to_their_sections() -> None:
+    """The docstring rewrite of docs/_ext/theory_links.py: every section of a citation group,
+    across a line break too, is a reference to its section's label; nothing else changes."""
+    sys.path.insert(0, str(DOCS / "_ext"))
+    try:
+        from theory_links import link_citations
+    finally:
+        sys.path.remove(str(DOCS / "_ext"))
+    s = SECTION_SIGN
+    note = "docs/theory.md"
+    text = f"exact ({note} {s}14 and {s}15); see {note}\n    {s}3, {s}5 – but not {s}7 alone."
+    assert link_citations(text) == (
+        f"exact (:ref:`{note} {s}14 <theory-sec-14>` and :ref:`{s}15 <theory-sec-15>`); see "
+        f":ref:`{note}\n    {s}3 <theory-sec-3>`, :ref:`{s}5 <theory-sec-5>` – but not {s}7 "
+        "alone.")
+    assert link_citations(f"no citation here, {s} 3") == f"no citation here, {s} 3"

@@ -113,7 +113,8 @@ def test_random_problems_two_methods_agree(d: int, mu: float, skew: float) -> No
         assert res.certificate.ok, (b, res.certificate.summary())
         assert res.error <= 1e-8
         again = certify_friction(problem, res.r, res.u, tol=1e-8)
-        assert again.ok and again.error == pytest.approx(res.error, rel=1e-6, abs=1e-18)
+        # the compiled route of a few contacts sums W̃r̂ in its own order: equal to rounding
+        assert again.ok and again.error == pytest.approx(res.error, rel=1e-6, abs=1e-15)
         np.testing.assert_allclose(res.u, problem.W @ res.r + problem.q, atol=1e-12 * qn)
     np.testing.assert_allclose(results["clarabel"].u, results["nsgs"].u, atol=1e-6 * qn)
 

@@ -104,7 +104,7 @@ def chain_matrices(masses, left_wall, right_wall):
 @pytest.mark.parametrize("n, m", [(1, 1), (3, 2), (4, 3), (5, 5)])
 def test_pack_holds_the_operators_numpy_computes(n: int, m: int) -> None:
     _, M, W = _problem(n * 10 + m, n, m)
-    Mv, Wt, MinvW, G, s = _unpack(pack(M, W), n, m)
+    Mv, Wt, MinvW, G, s, check = _unpack(pack(M, W), n, m)
     MinvW_ref = np.linalg.solve(M, W)
     G_ref = W.T @ MinvW_ref
     np.testing.assert_allclose(Mv, M, rtol=0, atol=0)
@@ -112,7 +112,8 @@ def test_pack_holds_the_operators_numpy_computes(n: int, m: int) -> None:
     np.testing.assert_allclose(MinvW, MinvW_ref, rtol=1e-12, atol=1e-14)
     np.testing.assert_allclose(G, G_ref, rtol=1e-12, atol=1e-14)
     np.testing.assert_allclose(s, np.sqrt(np.diag(G_ref)), rtol=1e-12)
-    assert pack(M, W).size == n * n + 2 * m * n + m * m + m
+    np.testing.assert_allclose(check, MinvW_ref, rtol=1e-12, atol=1e-14)
+    assert pack(M, W).size == n * n + 3 * m * n + m * m + m
 
 
 # ------------------------------------------------------------------ residuals
@@ -125,7 +126,7 @@ def test_dense_residuals_are_the_formulas(moreau: bool, seed: int) -> None:
     lam = rng.normal(size=m)
     E = rng.normal(size=(m, m))
     eps = 0.3 + 0.1 * seed
-    Mv, Wt, MinvW, G, s = _unpack(pack(M, W), n, m)
+    Mv, Wt, MinvW, G, s, check = _unpack(pack(M, W), n, m)
     out = np.empty(6)
     work = np.empty(2 * n + 2 * m)
     dense_residuals(Mv, Wt, MinvW, s, um, up, lam, E, eps, moreau, out, work)
@@ -145,7 +146,7 @@ def test_dense_residuals_do_not_depend_on_the_units(scale: float) -> None:
     rng, M, W = _problem(7)
     n, m = W.shape
     um, up, lam = rng.normal(size=n), rng.normal(size=n), rng.normal(size=m)
-    Mv, Wt, MinvW, G, s = _unpack(pack(M, W), n, m)
+    Mv, Wt, MinvW, G, s, check = _unpack(pack(M, W), n, m)
     base, out = np.empty(6), np.empty(6)
     work = np.empty(2 * n + 2 * m)
     dense_residuals(Mv, Wt, MinvW, s, um, up, lam, np.empty((0, 0)), 0.5, True, base, work)
@@ -159,7 +160,7 @@ def test_the_velocity_unit_of_a_body_at_rest() -> None:
     # answer's own size in those units, at least 1
     rng, M, W = _problem(3)
     n, m = W.shape
-    Mv, Wt, MinvW, G, s = _unpack(pack(M, W), n, m)
+    Mv, Wt, MinvW, G, s, check = _unpack(pack(M, W), n, m)
     out = np.empty(6)
     work = np.empty(2 * n + 2 * m)
     for size in (1e-3, 10.0, 1e70):

@@ -104,6 +104,39 @@ def _norm(x):
     return np.sqrt(total)
 
 
+FRICTION_FIGURES = ("natural_map", "velocity", "cone", "dual_cone", "complementarity",
+                    "siconos_error", "penetration")
+"""The order of :func:`friction_figures`' output: the five residuals of a local problem's
+certificate, then the two figures it reports beside them."""
+
+
+@kernel
+def friction_figures(r, u, q, mu, d, residual, out):
+    """The figures of a local frictional problem's certificate in contact units
+    (:data:`FRICTION_FIGURES`, defined in :func:`impactqp.model.friction.certify_friction`,
+    docs/theory.md §15) into ``out``, from the reaction r̂, the velocity û = W̃r̂ + q̂
+    recomputed by the caller, q̂, μ, d and ``residual`` = (‖F‖, ‖û_given − û‖): the norm of
+    the natural map F(r̂, û) (:func:`impactqp.kernels.friction.natural_map`, which the caller
+    evaluates: the solvers share it, the figures computed here do not) and the mismatch of a
+    given velocity (0 when none was given)."""
+    f_norm, mismatch = residual
+    q_norm = _norm(q)
+    q_scale = q_norm if q_norm > 0.0 else 1.0
+    r_norm = _norm(r)
+    cone, dual, comp = coulomb_violation_sums(r, u, mu, d)
+    penetration = 0.0
+    for c in range(mu.size):
+        below = 0.0 if u[c * d] >= 0.0 else u[c * d]  # keeps a NaN
+        penetration += below * below
+    out[0] = certificate_ratio(f_norm, q_scale)
+    out[1] = certificate_ratio(mismatch, q_scale)
+    out[2] = certificate_ratio(np.sqrt(cone), max(q_scale, r_norm))
+    out[3] = certificate_ratio(np.sqrt(dual), q_scale)
+    out[4] = certificate_ratio(np.sqrt(comp), q_scale)
+    out[5] = certificate_ratio(f_norm, max(q_norm, r_norm, _norm(u)))
+    out[6] = certificate_ratio(np.sqrt(penetration), q_scale)
+
+
 @kernel
 def coulomb_residuals(system, local, answer, out):
     """The five residuals of :data:`COULOMB_RESIDUALS` into ``out``; False (``out``

@@ -8,7 +8,9 @@ diagonal; Frémond: full), :func:`solve_impact`
 2. solves the impulse-form LCP ``0 ≤ Λ ⟂ GΛ + q ≥ 0`` by the active-set search of
    :mod:`impactqp.kernels.active_set` (warm-started from the support of the previous solve),
 3. recovers u⁺ and recomputes every residual of the certificate by
-   :func:`impactqp.kernels.residuals.dense_residuals`,
+   :func:`impactqp.kernels.residuals.dense_residuals`, with the impact equation measured by
+   an M⁻¹W of the certificate's own (Gaussian elimination of M, not the Cholesky factor
+   the recovery uses: docs/theory.md §8, "Independence"),
 
 and says whether every residual is within the tolerance; the caller returns the answer only
 then. The structure's operators travel as one packed array (:func:`pack`): one argument
@@ -17,19 +19,72 @@ instead of five keeps the call's own cost small.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from .active_set import SOLVED, lcp_psd_work
-from .jit import kernel
+from .jit import inline_kernel, kernel
 from .residuals import dense_residuals
+
+
+class Operators(NamedTuple):
+    """The views of a :func:`pack`-ed structure.
+
+    Attributes
+    ----------
+    M : (n, n) float array
+    Wt : (m, n) float array
+        Wᵀ.
+    MinvW : (n, m) float array
+        M⁻¹W from the Cholesky factor of M: the recovery u⁺ = u⁻ + M⁻¹WΛ.
+    G : (m, m) float array
+        The Delassus matrix WᵀM⁻¹W.
+    s : (m,) float array
+        The contact scales sᵢ = √Gᵢᵢ.
+    check : (n, m) float array
+        M⁻¹W solved by Gaussian elimination: the certificate's impact equation.
+    """
+
+    M: np.ndarray
+    Wt: np.ndarray
+    MinvW: np.ndarray
+    G: np.ndarray
+    s: np.ndarray
+    check: np.ndarray
+
+
+@inline_kernel
+def lu_solve_columns(M, W, X):
+    """X = M⁻¹W by Gaussian elimination on a copy of M (M = LU, L unit lower triangular):
+    an M⁻¹W that shares nothing with the Cholesky-based one of :func:`pack`
+    (docs/theory.md §8). M is symmetric positive definite, so every pivot is positive
+    without row exchanges."""
+    n, m = W.shape
+    A = M.copy()
+    X[:, :] = W
+    for k in range(n):
+        for i in range(k + 1, n):
+            f = A[i, k] / A[k, k]
+            for j in range(k + 1, n):
+                A[i, j] -= f * A[k, j]
+            for c in range(m):
+                X[i, c] -= f * X[k, c]
+    for c in range(m):
+        for i in range(n - 1, -1, -1):
+            v = X[i, c]
+            for j in range(i + 1, n):
+                v -= A[i, j] * X[j, c]
+            X[i, c] = v / A[i, i]
 
 
 @kernel
 def pack(M, W):
-    """M (n × n), Wᵀ (m × n), M⁻¹W (n × m), G = WᵀM⁻¹W (m × m) and sᵢ = √Gᵢᵢ in one flat
-    array, from M = LLᵀ and B = L⁻¹W: G = BᵀB, M⁻¹W = L⁻ᵀB (docs/theory.md §1). Plain loops:
-    no inverse, no eigen-decomposition, no BLAS call for the small M of one impact.
-    M must be symmetric positive definite (the structure has checked it)."""
+    """M (n × n), Wᵀ (m × n), M⁻¹W (n × m), G = WᵀM⁻¹W (m × m), sᵢ = √Gᵢᵢ and the
+    certificate's M⁻¹W (n × m, :func:`lu_solve_columns`) in one flat array (views:
+    :class:`Operators`), from M = LLᵀ and B = L⁻¹W: G = BᵀB, M⁻¹W = L⁻ᵀB (docs/theory.md §1).
+    Plain loops: no inverse, no eigen-decomposition, no BLAS call for the small M of one
+    impact. M must be symmetric positive definite (the structure has checked it)."""
     n, m = W.shape
     L = np.zeros((n, n))
     for j in range(n):
@@ -55,7 +110,7 @@ def pack(M, W):
             for k in range(i + 1, n):
                 v -= L[k, i] * X[k, c]
             X[i, c] = v / L[i, i]
-    out = np.empty(n * n + 2 * m * n + m * m + m)
+    out = np.empty(n * n + 3 * m * n + m * m + m)
     out[:n * n] = M.ravel()
     a = n * n
     for c in range(m):
@@ -70,18 +125,21 @@ def pack(M, W):
                 v += B[i, r] * B[i, c]
             out[d + r * m + c] = v
         out[d + m * m + r] = np.sqrt(out[d + r * m + r])
+    lu_solve_columns(M, W, out[d + m * m + m:].reshape((n, m)))
     return out
 
 
 @kernel
 def _unpack(packed, n, m):
-    """The views (M, Wᵀ, M⁻¹W, G, s) of a :func:`pack`-ed array."""
+    """The views (:class:`Operators`) of a :func:`pack`-ed array."""
     a = n * n
     b = a + m * n
     c = b + n * m
     d = c + m * m
-    return (packed[:a].reshape((n, n)), packed[a:b].reshape((m, n)),
-            packed[b:c].reshape((n, m)), packed[c:d].reshape((m, m)), packed[d:d + m])
+    e = d + m
+    return Operators(packed[:a].reshape((n, n)), packed[a:b].reshape((m, n)),
+                     packed[b:c].reshape((n, m)), packed[c:d].reshape((m, m)), packed[d:e],
+                     packed[e:e + n * m].reshape((n, m)))
 
 
 @kernel
@@ -93,8 +151,10 @@ def workspace(n, m):
 
 
 @kernel
-def _solve_into(M, Wt, MinvW, G, s, um, E, eps, moreau, tol, passive, up, lam, res, work):
-    """Solve and certify one impact into (u⁺, Λ, residuals); True when certified."""
+def _solve_into(ops, um, E, eps, moreau, tol, passive, up, lam, res, work):
+    """Solve and certify one impact of the structure ``ops`` (:class:`Operators`) into
+    (u⁺, Λ, residuals); True when certified."""
+    M, Wt, MinvW, G, s, check = ops
     n, m = um.size, passive.size
     floats, L, idx, blocked = work
     q = floats[:m]
@@ -120,7 +180,7 @@ def _solve_into(M, Wt, MinvW, G, s, um, E, eps, moreau, tol, passive, up, lam, r
         for j in range(m):
             total += MinvW[i, j] * lam[j]
         up[i] = total
-    dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, res, floats[3 * m:])
+    dense_residuals(M, Wt, check, s, um, up, lam, E, eps, moreau, res, floats[3 * m:])
     count = 6 if moreau else 4
     for i in range(count):
         if not res[i] <= tol:  # NaN fails
@@ -159,8 +219,7 @@ def solve_impact(packed, um, E, eps, moreau, tol, passive, out):
         Whether the answer is certified.
     """
     n, m = um.size, passive.size
-    M, Wt, MinvW, G, s = _unpack(packed, n, m)
-    return _solve_into(M, Wt, MinvW, G, s, um, E, eps, moreau, tol, passive, out[:n],
+    return _solve_into(_unpack(packed, n, m), um, E, eps, moreau, tol, passive, out[:n],
                        out[n:n + m], out[n + m:n + m + 6], workspace(n, m))
 
 
@@ -172,13 +231,13 @@ def solve_impact_rows(packed, Um, E, eps, moreau, tol, passive):
     """
     k, n = Um.shape
     m = passive.size
-    M, Wt, MinvW, G, s = _unpack(packed, n, m)
+    ops = _unpack(packed, n, m)
     Up = np.empty((k, n))
     Lam = np.empty((k, m))
     Res = np.empty((k, 6))
     ok = np.empty(k, dtype=np.bool_)
     work = workspace(n, m)
     for r in range(k):
-        ok[r] = _solve_into(M, Wt, MinvW, G, s, Um[r], E, eps, moreau, tol, passive, Up[r],
-                            Lam[r], Res[r], work)
+        ok[r] = _solve_into(ops, Um[r], E, eps, moreau, tol, passive, Up[r], Lam[r], Res[r],
+                            work)
     return Up, Lam, Res, ok

@@ -19,16 +19,20 @@ from collections.abc import Callable
 import numpy as np
 
 from ..base.arrays import check_tol
-from ..errors import InputError, OutOfRangeError
+from ..errors import CertificateError, InputError, OutOfRangeError
+from ..kernels.friction_tiny import CERTIFIED, FRICTION_FIGURES, TinyLimits, solve_tiny
 from ..model.friction import (
     ContactUnits,
     FrictionCertificate,
     FrictionContactProblem,
     certify_friction,
+    friction_certificate,
 )
 from ..qp import backends
 from ..qp.certified import Outcome, solve_certified
 from ..qp.friction import FrictionSolution
+from ..qp.friction.methods import NSGS_LOCAL, NSGS_SHORT, SMALL_CONTACTS
+from ..qp.friction.newton import NEWTON_STEPS
 from .planner import plan_friction
 from .result import FrictionResult
 
@@ -70,7 +74,10 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
         A backend that does not solve frictional problems, or not this one (the message says
         why).
     CertificateError
-        No method reached the tolerance; the message gives each attempt.
+        No method reached the tolerance; the message gives each attempt, and the
+        exception's ``best`` is the answer that came closest: a :class:`FrictionResult`
+        with ``status == "not certified"``, its ABH ``error`` and its certificate (None
+        when no method answered at all), ``attempts`` the attempts.
     OutOfRangeError
         The answer is beyond what floats hold in the problem's units.
     """
@@ -79,11 +86,44 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
                          f"{type(problem).__name__}")
     tol = check_tol(tol)
     start = time.perf_counter()
+    if backend in ("auto", "kernel"):
+        tiny = _tiny(problem, tol, start)
+        if tiny is not None:
+            return tiny
     # units and the registry's plan, in one Route
     route = plan_friction(problem, backend, lambda units: _finisher(problem, units, tol))
-    out = solve_certified(route.programs, named=backend != "auto", tol=tol)
     note = () if route.units is None else (f"solved in its contacts' units (2^{route.units.k})",)
+    try:
+        out = solve_certified(route.programs, named=backend != "auto", tol=tol)
+    except CertificateError as exc:
+        if not isinstance(exc.best, Outcome):
+            raise
+        best = _result(exc.best, time.perf_counter() - start, note)
+        raise CertificateError(f"{exc} (the best answer found, error {best.error:.2e}, is "
+                               "the exception's .best)", best=best,
+                               attempts=exc.attempts) from None
     return _result(out, time.perf_counter() - start, note)
+
+
+def _tiny(problem: FrictionContactProblem, tol: float, start: float) -> FrictionResult | None:
+    """The ``"kernel"`` method's answer by the route of a few dense contacts in one compiled
+    call (:func:`impactqp.kernels.friction_tiny.solve_tiny`: units, solve, answer as given
+    and its certificate), or None where that route does not apply or its answer fails: the
+    general route then runs (and tries the method again among the others)."""
+    if problem.n_contacts > SMALL_CONTACTS or not isinstance(problem.W, np.ndarray):
+        return None
+    size = problem.q.size
+    r, u, figures = np.empty(size), np.empty(size), np.empty(len(FRICTION_FIGURES))
+    its, outcome, scaled = solve_tiny(np.ascontiguousarray(problem.W), problem.q, problem.mu,
+                                      problem.contact_dim,
+                                      TinyLimits(tol, NEWTON_STEPS, NSGS_SHORT, NSGS_LOCAL),
+                                      r, u, figures)
+    if outcome != CERTIFIED:
+        return None
+    cert = friction_certificate(figures, tol)
+    note = ["solved in its contacts' units (2^0)"] if scaled else []
+    return FrictionResult(r, u, cert.error, cert, int(its), time.perf_counter() - start,
+                          "kernel", [*note, "kernel (friction): certified"])
 
 
 def _finisher(problem: FrictionContactProblem, units: ContactUnits | None,

@@ -26,10 +26,11 @@ class CertifiedResult:
     A result is only returned when its certificate passes, so ``status`` is ``"solved"`` and
     ``ok`` and ``success`` are True (as scipy's ``OptimizeResult`` and cvxpy's status say
     so); ``backend`` is the registry name of what produced the numbers, one the caller may
-    pass back as ``backend=``; ``attempts`` lists what was tried, in order.
+    pass back as ``backend=``; ``attempts`` lists what was tried, in order. The best answer
+    a :class:`~impactqp.errors.CertificateError` carries (its ``best``) is the one result
+    that is not returned: its ``status`` is ``"not certified"``.
     """
 
-    status = "solved"
     backend: str
     attempts: list[str]
     solve_time: float
@@ -39,6 +40,11 @@ class CertifiedResult:
     def ok(self) -> bool:
         """The certificate's verdict (True for every returned result)."""
         return self.certificate.ok
+
+    @property
+    def status(self) -> str:
+        """``"solved"``, or ``"not certified"`` for an error's best answer."""
+        return "solved" if self.ok else "not certified"
 
     @property
     def success(self) -> bool:
@@ -218,7 +224,8 @@ class FrictionResult(CertifiedResult):
 
     @property
     def message(self) -> str:
-        return (f"frictional contact problem solved by {self.backend} in {self.iterations} "
+        verb = "solved" if self.ok else "NOT certified (the best answer found)"
+        return (f"frictional contact problem {verb} by {self.backend} in {self.iterations} "
                 f"iterations, {self.solve_time * 1e3:.3g} ms; certificate "
                 f"{self.certificate.summary()}")
 

@@ -20,9 +20,9 @@ import scipy.sparse as sp
 from ..base.arrays import as_array, as_count, as_matrix, check_tol
 from ..base.checks import Certificate
 from ..errors import InputError, OutOfRangeError, ShapeError
-from ..kernels.coulomb_certificate import certificate_ratio
-from ..kernels.coulomb_conditions import coulomb_violation_sums
+from ..kernels.coulomb_certificate import FRICTION_FIGURES, friction_figures
 from ..kernels.friction import natural_map
+from ..kernels.friction_tiny import LOG2_RANGE
 from ..kernels.units import contact_units
 
 __all__ = ["ContactUnits", "FrictionCertificate", "FrictionContactProblem", "certify_friction",
@@ -32,7 +32,6 @@ QUANTITY_RANGE = (1e-100, 1e100)
 """max|q̃ᵢ| (q in contact units) within which a problem is solved and judged as posed; beyond
 it, in units of a power of two near max|q̃ᵢ| (docs/theory.md §15)."""
 
-_LOG2_RANGE = (math.log2(QUANTITY_RANGE[0]), math.log2(QUANTITY_RANGE[1]))
 
 
 def friction_coefficients(value: Any, n_contacts: int, name: str = "mu") -> np.ndarray:
@@ -206,7 +205,7 @@ def _units_of(problem: FrictionContactProblem, s: np.ndarray) -> ContactUnits:
     ms, es = np.frexp(s)
     exponents = (eq - es)[q != 0.0]
     top = int(exponents.max()) if exponents.size else 0  # max|qᵢ/sᵢ| in [2^(top−2), 2^top)
-    k = 0 if _LOG2_RANGE[0] < top < _LOG2_RANGE[1] else top
+    k = 0 if LOG2_RANGE[0] < top < LOG2_RANGE[1] else top
     ones = bool(np.all(s == 1.0))
     if ones and k == 0:
         return ContactUnits(problem, s, 0)
@@ -254,11 +253,6 @@ Reported beside them (``reported``), not part of the verdict: ``siconos_error``
 ‖F‖/max(‖q̂‖, ‖r̂‖, ‖û‖) and ``penetration`` ‖(−û_n)₊‖/‖q̂‖; ``extras["error"]`` is the
 acceptance figure.
 """
-
-
-# num/den for the certificate (0 when num is 0, NaN as +inf): the compiled certificate's one
-# definition, called here as plain Python (a compiled call per figure would cost more)
-_ratio = getattr(certificate_ratio, "py_func", certificate_ratio)
 
 
 def _norm(x: np.ndarray) -> float:
@@ -322,26 +316,20 @@ def certify_friction(problem: FrictionContactProblem, r, u=None, *,
     units = problem.in_contact_units()
     unit = units.problem
     r = units.unit_reaction(r)
-    q = unit.q
     with np.errstate(over="ignore", invalid="ignore"):
-        u_w = np.asarray(unit.W @ r).ravel() + q
-        qn = _norm(q)
-        q_scale = qn if qn > 0.0 else 1.0
-        consistency = 0.0
-        if u is not None:
-            consistency = _ratio(_norm(units.unit_velocity(u) - u_w), q_scale)
-        F = natural_map(r, u_w, unit.mu, unit.contact_dim)
-        fn = _norm(F)
-        rn = _norm(r)
-        un = _norm(u_w)
-    cone, dual, comp = coulomb_violation_sums(r, u_w, unit.mu, unit.contact_dim)
-    values = {"natural_map": _ratio(fn, q_scale), "velocity": consistency,
-              "cone": _ratio(math.sqrt(cone), max(q_scale, rn)),
-              "dual_cone": _ratio(math.sqrt(dual), q_scale),
-              "complementarity": _ratio(math.sqrt(comp), q_scale)}
-    with np.errstate(invalid="ignore"):
-        penetration = _norm(np.maximum(-u_w[::unit.contact_dim], 0.0))
-    reported = {"siconos_error": _ratio(fn, max(qn, rn, un)),
-                "penetration": _ratio(penetration, q_scale)}
+        u_w = np.asarray(unit.W @ r).ravel() + unit.q
+        mismatch = 0.0 if u is None else _norm(units.unit_velocity(u) - u_w)
+        f_norm = _norm(natural_map(r, u_w, unit.mu, unit.contact_dim))
+    figures = np.empty(len(FRICTION_FIGURES))
+    friction_figures(r, u_w, unit.q, unit.mu, unit.contact_dim, (f_norm, mismatch), figures)
+    return friction_certificate(figures, tol)
+
+
+def friction_certificate(figures: np.ndarray, tol: float) -> Certificate:
+    """The :class:`~impactqp.results.Certificate` of the figures of
+    :func:`impactqp.kernels.coulomb_certificate.friction_figures` (order
+    :data:`~impactqp.kernels.coulomb_certificate.FRICTION_FIGURES`)."""
+    values = dict(zip(FRICTION_CHECKS, figures[:5].tolist()))
+    reported = {"siconos_error": float(figures[5]), "penetration": float(figures[6])}
     return Certificate(values, tol, reported=reported, names=FRICTION_CHECKS,
                        extras={"error": values["natural_map"]})

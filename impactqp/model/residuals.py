@@ -93,6 +93,22 @@ def certificate_operand(structure: ImpactStructure) -> np.ndarray:
     return op
 
 
+def momentum_defect(structure: ImpactStructure, Um: np.ndarray, Up: np.ndarray,
+                    Lam: np.ndarray) -> np.ndarray:
+    """Rows of M⁻¹(M(u⁺ − u⁻) − WΛ), whose kinetic norms measure the impact equation
+    (docs/theory.md §8, "Independence").
+
+    The defect M(u⁺ − u⁻) − WΛ is formed from the given M and W; the factor of M only
+    measures its size, so an error in the M⁻¹W the solver recovered u⁺ with cannot hide in
+    it. A chain's rows use its ball-by-ball formula (no matrix is formed for a chain).
+    """
+    st = structure
+    if st.chain is not None:
+        return Up - Um - st.impulse_velocity(Lam)
+    force = st.mass_rows(Up - Um) - np.asarray(st.W @ Lam.T).T
+    return np.asarray(st.solve_mass(np.ascontiguousarray(force.T))).T
+
+
 def _restitute(E: np.ndarray, gamma: np.ndarray) -> np.ndarray:
     """Eγ for every row of γ: εγ, eᵢγᵢ or the matrix product, without forming εI or diag(e)."""
     return E * gamma if E.ndim < 2 else gamma @ E.T
@@ -126,7 +142,7 @@ def law_residuals(structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.nd
         with np.errstate(over="ignore", invalid="ignore"):
             Um, Up, L = normalized_rows(Um, Up, L)
             V, _ = impact_residuals(st, Um, Up, L)
-            norms = kinetic_norms(st, Up - Um - st.impulse_velocity(L))
+            norms = kinetic_norms(st, momentum_defect(st, Um, Up, L))
             W = st.Wt_times(Up) + _restitute(E, st.Wt_times(Um)) if st.m else \
                 np.zeros_like(L)
             z = (Up + e * Um) / (1.0 + e)

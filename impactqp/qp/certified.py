@@ -201,12 +201,15 @@ def solve_certified(planned: Plan, *, named: bool, tol: float = 1e-10,
     NoSolutionError
         The impulse-form LCP has no feasible point (the law has no solution).
     CertificateError
-        No backend produced an answer within the certificate's tolerance.
+        No backend produced an answer within the certificate's tolerance; its ``best`` is
+        the :class:`Outcome` whose certificate came closest (None if no backend answered)
+        and ``attempts`` every attempt.
     """
     form, program, finish = planned.form, planned.program, planned.finish
     log: list[str] = []
     kind = kind_of(form)
     warm, warm_value = None, math.inf  # the best uncertified answer, where a method starts
+    best: Outcome | None = None  # and as the caller will see it, if nothing certifies
     for name in planned.backends:
         entry, sub = backends.parse_backend(name)
         try:
@@ -256,6 +259,10 @@ def solve_certified(planned: Plan, *, named: bool, tol: float = 1e-10,
             worst, value = cert.worst
             if value < warm_value:
                 warm, warm_value = sol, value
+                best = Outcome(answer, cert, sol, sol.backend, form, log)
             _note(log, f"{name} ({form}, tol {attempt_tol:.0e}): certificate failed, "
                        f"{worst} = {value:.1e}")
-    raise kind.failure(program, log)
+    failure = kind.failure(program, log)
+    if isinstance(failure, CertificateError):
+        failure.best, failure.attempts = best, list(log)
+    raise failure

@@ -39,7 +39,7 @@ class TrajectoryKink(NamedTuple):
         event).
     contacts : tuple of int
     distance : float
-        How far the run is from the kink, relative to the run's scale: |g + ½hγ| over its
+        How far the run is from the kink, relative to the run's scale: abs(g + ½hγ) over its
         length scale (activation), ∇g·f⁻ or the least gap over its velocity or length
         scale (grazing); 0 where the run sits on the kink (degenerate, Zeno, simultaneous).
     """
