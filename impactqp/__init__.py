@@ -39,6 +39,9 @@ from . import (  # noqa: F401  (the public submodules, attributes of the package
     tables,
     verification,
 )
+from .derivatives.batch import derivative_batch
+from .derivatives.impact import ImpactDerivative
+from .derivatives.solve import derivative
 from .errors import (
     BackendUnsuitableError,
     CertificateError,
@@ -93,6 +96,8 @@ __all__ = [
     "solve", "moreau", "newton", "fremond", "sector_law", "reflection_law", "solve_batch",
     "moreau_batch", "sector_law_batch", "solve_lcp", "available_backends", "ImpactResult",
     "verify_law", "compare_backends",
+    # derivatives
+    "derivative", "derivative_batch", "ImpactDerivative",
     # motion
     "LinearSystem", "LinearForce", "simulate", "Trajectory",
     # figures (the plot extra)

@@ -33,6 +33,7 @@ __all__ = [
     "SectorTableTooLarge",
     "IntegrationBudgetError",
     "UndrawableSystemError",
+    "DerivativeUnsupportedError",
 ]
 
 
@@ -155,3 +156,8 @@ class SectorTableTooLarge(InputError):
 class IntegrationBudgetError(CertificateError):
     """An integration (the LZB model's) would exceed or has spent its budget of steps; the
     message says which budget, why, and what option to change."""
+
+
+class DerivativeUnsupportedError(ImpactError):
+    """The law has no derivative (the LZB model, a user's law without a ``derivative``
+    hook; docs/theory.md §20): the message names the law."""

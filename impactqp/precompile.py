@@ -18,6 +18,7 @@ import numba
 import numpy as np
 
 from . import kernels
+from .derivatives.batch import derivative_batch
 from .kernels.jit import cache_dir
 from .laws.batch import solve_batch
 from .laws.complementarity import Fremond, Newton
@@ -54,6 +55,7 @@ def _batches() -> None:
     U = np.random.default_rng(0).standard_normal((64, 3))
     solve_batch(p, Moreau(0.5), U)
     solve_batch(p, Newton([1.0, 0.5]), U)
+    derivative_batch(p, Moreau(0.5), U, jvp=U, vjp=U)
 
 
 def _chains() -> None:
@@ -84,6 +86,8 @@ def _friction() -> None:
 def _simulations() -> None:
     simulate(bouncing_ball(q0=0.1), Newton(0.5), 0.2, h=1e-2)
     simulate(cradle_system(3), Moreau(1.0), 0.05, h=1e-3)
+    simulate(bouncing_ball(q0=0.1), Newton(0.5), 0.2, h=1e-2,
+             sensitivities=("q0", "e")).vjp(q=[1.0])  # the discrete map and its adjoint
     simulate(block_on_incline(0.3, dim=2, speed=1.0), Coulomb(0.5, 0.0), 0.05, h=1e-2)
     simulate(box_on_floor(3, velocity=[1.0, 0.0]), Coulomb(0.3, 0.0), 0.05, h=1e-2)
 

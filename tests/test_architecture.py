@@ -23,7 +23,7 @@ LAYERS = {
     "qp": 1,
     "model": 2,
     "tables": 3,
-    "laws": 4,
+    "laws": 4, "derivatives": 4,
     "verification": 5, "simulation": 5,
     "io": 6, "figures": 6,
     "cli": 7,

@@ -24,6 +24,10 @@ EXPECTED = {
     "simulate_cradle.py": ["cradle.gif"],
     "figures.py": ["the sphere rolls from t = 0.195 s (2v₀/(7μg) = 0.194 s)",
                    "S of the heavy 4-ball cradle: 3 contacts", "sectors_4_balls.png"],
+    "identify_restitution.py": ["event-driven, Gauss–Newton from e = 0.5",
+                                "moreau-jean, Gauss–Newton from e = 0.5",
+                                "  e = 0.730000000, |e - e*|", "(flow, 0 kinks)",
+                                "(discrete-map, 0 kinks)", "  ε = 0.600000000, |ε - ε*|"],
     "friction.py": ["sphere on the floor", " 0.05  slip ", "  0.3  stick ",
                     "FCLib LMGC_GlobalFrictionContactProblem00046.hdf5: 9 contacts, d = 3",
                     "certificate ok at tol 1e-08"],
@@ -111,3 +115,16 @@ def test_friction_example_agrees_with_its_closed_form_and_writes_only_when_told(
     content = iq.load_problem(tmp_path / "out" / "sphere_on_plane.toml")
     assert content.law == "coulomb" and content.coefficients == (0.3, 0.5)
     assert content.problem.contact_dim == 2
+
+
+def test_identification_example_writes_its_fit_only_when_told(tmp_path):
+    """``--out`` writes fit.json (the three identified coefficients) and nothing else."""
+    import json
+
+    done = _run("identify_restitution.py", tmp_path, "--out", "out")
+    assert _printed_folder(done.stdout) == Path("out")
+    fits = json.loads((tmp_path / "out" / "fit.json").read_text())
+    assert fits["event-driven"] == pytest.approx(0.73, abs=1e-6)
+    assert fits["moreau-jean"] == pytest.approx(0.73, abs=1e-6)
+    assert fits["cradle eps"] == pytest.approx(0.6, abs=1e-6)
+    assert [p.name for p in (tmp_path / "out").iterdir()] == ["fit.json"]

@@ -130,12 +130,19 @@ def linear_gaps(ptr, idx, val, b, d, q, v, g, gamma):
 
 
 @inline_kernel
+def predicted_gap(g, gamma, h):
+    """gᵢ + ½h γᵢ, the gap predicted half a step ahead (docs/theory.md §14), of one contact
+    or elementwise of arrays: :func:`activation` closes a contact where it is ≤ 0."""
+    return g + (0.5 * h) * gamma
+
+
+@inline_kernel
 def activation(g, gamma, h, closed):
-    """The contacts the step closes, closed[i] = gᵢ + ½h γᵢ ≤ 0 (the gap predicted half a
-    step ahead; docs/theory.md §14); returns how many."""
+    """The contacts the step closes, closed[i] = gᵢ + ½h γᵢ ≤ 0 (:func:`predicted_gap`;
+    docs/theory.md §14); returns how many."""
     count = 0
     for i in range(g.size):
-        closed[i] = g[i] + (0.5 * h) * gamma[i] <= 0.0
+        closed[i] = predicted_gap(g[i], gamma[i], h) <= 0.0
         count += closed[i]
     return count
 

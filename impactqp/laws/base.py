@@ -16,6 +16,7 @@ from typing import Any, ClassVar, NamedTuple
 import numpy as np
 
 from ..base.arrays import as_vector
+from ..derivatives.local import LocalMap
 from ..errors import InputError
 from ..model.admissible import AdmissibleSet, best_impulses
 from ..model.problem import ImpactProblem
@@ -284,6 +285,15 @@ class ImpactLaw(ABC):
             row = problem.with_u_minus(u)
             U_plus[i], impulses[i] = self.answer_of(row, self.closed_form(row))[:2]
         return U_plus, impulses
+
+    def derivative(self, problem: ImpactProblem, answer: Any, *,
+                   kink_tol: float) -> LocalMap | None:
+        """The law's map (u⁻, M, W, parameter) ↦ (u⁺, Λ) near ``answer`` (an :class:`Answer`
+        or a result on ``problem``), for ``result.derivative()`` (docs/theory.md §18–§20):
+        a :class:`~impactqp.derivatives.local.LocalMap` (a user's law may return a
+        :class:`~impactqp.derivatives.local.LinearPiece`). None, the default: the law has no
+        derivative, and its derivative says ``"unsupported"`` by name."""
+        return None
 
     def admissible_set(self, problem: ImpactProblem) -> AdmissibleSet:
         """The admissible set the law's answers on ``problem`` are judged against

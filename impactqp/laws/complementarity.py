@@ -13,6 +13,13 @@ from typing import Any
 import numpy as np
 
 from ..base.arrays import as_array
+from ..derivatives.complementarity import (
+    ComplementarityMap,
+    Parameter,
+    diagonal,
+    full_matrix,
+    scalar_times_identity,
+)
 from ..errors import RestitutionError, ShapeError
 from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
@@ -59,6 +66,18 @@ class _ComplementarityLaw(ImpactLaw):
     def recover(self, problem: ImpactProblem, form: str, solution: QPSolution) -> Answer:
         lam = solution.x
         return Answer(problem.u_minus + problem.structure.impulse_velocity(lam), lam)
+
+    @abstractmethod
+    def parameter(self, m: int) -> Parameter:
+        """The law's coefficients as the differentiable parameter of its E (docs/theory.md
+        §18)."""
+
+    def derivative(self, problem: ImpactProblem, answer: Any, *,
+                   kink_tol: float) -> ComplementarityMap:
+        """The LCP's local map, differentiable in u⁻, M, W and the law's coefficients
+        (docs/theory.md §18–§19)."""
+        return ComplementarityMap(problem.M, problem.W, problem.u_minus, answer.impulses,
+                                  self.parameter(problem.n_contacts), kink_tol=kink_tol)
 
     def linear_terms(self, problem: ImpactProblem, U_minus: np.ndarray,
                      form: str) -> np.ndarray:
@@ -113,6 +132,10 @@ class Newton(_ComplementarityLaw):
     def restitution(self, m: int) -> np.ndarray:
         return np.full(m, self.e[0]) if self._scalar else self.e
 
+    def parameter(self, m: int) -> Parameter:
+        return scalar_times_identity("e", self.e[0], m) if self._scalar else \
+            diagonal("e", self.e)
+
     def coefficients_for(self, problem: ImpactProblem) -> np.ndarray:
         return self.restitution(problem.n_contacts)
 
@@ -163,6 +186,9 @@ class Fremond(_ComplementarityLaw):
 
     def restitution(self, m: int) -> np.ndarray:
         return self.E
+
+    def parameter(self, m: int) -> Parameter:
+        return full_matrix("E", self.E)
 
     def check(self, problem: ImpactProblem) -> None:
         check_restitution("E", self.E, problem.n_contacts, matrix=True)

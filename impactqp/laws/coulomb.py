@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..base.arrays import as_array
+from ..derivatives.coulomb import coulomb_map
 from ..errors import InputError, NonFiniteError, RestitutionError
 from ..kernels.coulomb_certificate import (
     COULOMB_RESIDUALS,
@@ -158,14 +159,9 @@ class Coulomb(ImpactLaw):
     # --- coefficients -----------------------------------------------------------------
     @classmethod
     def from_coefficients(cls, coefficients: Any = None) -> Coulomb:
-        """Coulomb's law named in a file or on the command line: ``coefficients`` is the pair
-        (μ, e) of :attr:`coefficients` (the keys ``mu`` and ``e``), e None for the default 0.
-
-        Raises
-        ------
-        InputError, NonFiniteError, RestitutionError
-            No pair, or coefficients the law refuses.
-        """
+        """The law named in a file or on the command line by the pair (μ, e) of
+        :attr:`coefficients` (keys ``mu`` and ``e``; e None for 0); InputError (or
+        NonFiniteError, RestitutionError) for no pair or refused coefficients."""
         if not isinstance(coefficients, tuple) or len(coefficients) != 2:
             raise InputError("law 'coulomb' needs its coefficients as the pair (mu, e): mu "
                              f"required, e optional (default 0); got {coefficients!r}")
@@ -252,6 +248,10 @@ class Coulomb(ImpactLaw):
         impulses = solution.r / self._local(problem.structure, problem.u_minus)[1]
         u_plus = problem.u_minus + problem.structure.impulse_velocity(impulses)
         return Answer(u_plus, impulses, None)
+
+    def derivative(self, problem: ImpactProblem, answer: Any, *, kink_tol: float) -> Any:
+        """Per-contact modes and the implicit function theorem (docs/theory.md §18–§19)."""
+        return coulomb_map(self, problem, answer, kink_tol)
 
     # --- certificate ------------------------------------------------------------------
     def residuals(self, structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..base.arrays import as_real
+from ..derivatives.complementarity import ComplementarityMap, scalar_times_identity
 from ..errors import RestitutionError
 from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
@@ -102,6 +103,14 @@ class Moreau(ImpactLaw):
             return Answer(u_plus, (1.0 + e) * solution.y, z)
         u = u_m + problem.structure.impulse_velocity(solution.x)
         return Answer(u, solution.x, self.projection(problem, u))
+
+    def derivative(self, problem: ImpactProblem, answer: Any, *,
+                   kink_tol: float) -> ComplementarityMap:
+        """The LCP's local map with E = εI, differentiable in ``"eps"`` (docs/theory.md §18):
+        ∂u⁺/∂u⁻ = I − (1 + ε)P_A, ∂u⁺/∂ε = z − u⁻."""
+        return ComplementarityMap(problem.M, problem.W, problem.u_minus, answer.impulses,
+                                  scalar_times_identity("eps", self.eps, problem.n_contacts),
+                                  kink_tol=kink_tol)
 
     def linear_terms(self, problem: ImpactProblem, U_minus: np.ndarray,
                      form: str) -> np.ndarray:

@@ -166,6 +166,21 @@ class ImpactResult(CertifiedResult):
         """Intensity, topology, angle α and dissipation of u⁺ (docs/theory.md §4)."""
         return classify(self.problem, self.u_plus)
 
+    def derivative(self, *, kink_tol: float = 1e-9) -> Any:
+        """The derivative of the law's map at this answer, an
+        :class:`~impactqp.derivatives.impact.ImpactDerivative` (docs/theory.md §18–§20):
+        Jacobians, JVPs and VJPs in u⁻, M, W and the law's parameter, the status
+        (``"smooth"``, ``"kink"``, ``"unsupported"``) and a certificate.
+
+        Parameters
+        ----------
+        kink_tol : float
+            Contacts whose scaled impulse and gap velocity are both at most this (relative
+            to ‖u⁻‖) count as degenerate: the answer is then on a kink.
+        """
+        from ..derivatives.impact import derivative_of
+        return derivative_of(self, kink_tol=kink_tol)
+
     def __repr__(self) -> str:
         return (f"ImpactResult(law={self.law!r}, backend={self.backend!r}, "
                 f"u_plus={np.array2string(self.u_plus, precision=6)}, "

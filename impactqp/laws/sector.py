@@ -11,6 +11,7 @@ import numpy as np
 
 from ..base.checks import DEFAULT_TOL
 from ..base.rowwise import row_max, row_min
+from ..derivatives.sort import SortMap
 from ..errors import SectorLawError
 from ..model.builders import require_chain
 from ..model.problem import ImpactProblem
@@ -141,6 +142,13 @@ class SectorLaw(ImpactLaw):
     def closed_form_rows(self, problem: ImpactProblem,
                          U_minus: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return sector_answer(check_sector_problem(problem), U_minus)
+
+    def derivative(self, problem: ImpactProblem, answer: object, *,
+                   kink_tol: float) -> SortMap:
+        """The sorting permutation, and at ties the sorts of the tied blocks
+        (docs/theory.md §19); differentiable in u⁻ only (the law is defined on chains of
+        equal masses)."""
+        return SortMap(check_sector_problem(problem), problem.u_minus, kink_tol=kink_tol)
 
     def residuals(self, structure: ImpactStructure, U_minus: np.ndarray, U_plus: np.ndarray,
                   impulses: np.ndarray) -> dict[str, np.ndarray]:

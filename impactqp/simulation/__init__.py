@@ -20,6 +20,7 @@ from .contact_states import contact_states
 from .coordinates import Coordinate, Scene
 from .friction_step import FrictionEvent
 from .impacts import ImpactEvent
+from .sensitivity import Sensitivities, TrajectoryKink
 from .simulate import simulate
 from .step_law import MoreauJeanStep
 from .system import LinearForce, LinearSystem
@@ -29,4 +30,5 @@ __all__ = [
     "LinearSystem", "LinearForce", "simulate", "Trajectory", "ImpactEvent", "FrictionEvent",
     "MoreauJeanStep", "bouncing_ball", "cradle_system", "bead_chain", "block_on_incline",
     "rolling_sphere", "box_on_floor", "Coordinate", "Scene", "contact_states",
+    "Sensitivities", "TrajectoryKink",
 ]

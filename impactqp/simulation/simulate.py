@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -17,6 +17,7 @@ from .event_driven import event_driven
 from .friction_step import check_friction_backend, coulomb_coefficients
 from .routing import check_frictionless
 from .system import LinearSystem
+from .through_time import check, differentiate
 from .time_stepping import moreau_jean
 from .trajectory import Trajectory
 
@@ -55,7 +56,8 @@ def _options(scheme: str, options: dict[str, Any]) -> dict[str, Any]:
 def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
              scheme: str = "moreau-jean", h: float | None = None, theta: float = 0.5, *,
              t0: float = 0.0, backend: str = "auto", tol: float = DEFAULT_TOL,
-             progress: Callable[[float], None] | None = None, **options: Any) -> Trajectory:
+             progress: Callable[[float], None] | None = None,
+             sensitivities: Sequence[str] | None = None, **options: Any) -> Trajectory:
     """Simulate a system with unilateral contacts and any impact law (docs/theory.md §14).
 
     Parameters
@@ -86,6 +88,14 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
         :func:`impactqp.solve_friction`: ``"auto"``, ``"clarabel"`` or ``"nsgs"``).
     progress : callable, optional
         Called with the simulated time now and then.
+    sensitivities : sequence of str, optional
+        Differentiate the run with respect to these (docs/theory.md §21): ``"q0"``,
+        ``"v0"`` and the law's parameter (``"eps"`` for Moreau, ``"e"`` for Newton, ``"E"``
+        for Frémond). Moreau–Jean gives the derivative of its discrete map
+        (``trajectory.sensitivity_kind == "discrete-map"``), event-driven integration the
+        derivative of the motion (``"flow"``, saltation at each impact); read them with
+        ``trajectory.sensitivity(...)``, ``trajectory.vjp(...)`` and ``trajectory.kinks``.
+        Frictionless complementarity laws under a constant or linear force only.
     **options
         Moreau–Jean: ``record_every`` (int), ``keep_events`` (bool). Event-driven:
         ``gap_tol`` (1e-10 of the system's length scale), ``rest_velocity`` (1e-7 of its
@@ -144,6 +154,7 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
     if progress is not None and not callable(progress):
         raise InputError(f"progress must be a callable, got {type(progress).__name__}")
     opts = _options(scheme, options)
+    cols = None if sensitivities is None else check(system, law, scheme, sensitivities, opts)
     if scheme == "moreau-jean":
         trajectory = moreau_jean(system, law, t_end, h, theta, t0=t0, backend=backend,
                                  tol=tol, progress=progress, **opts)
@@ -151,6 +162,8 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
         trajectory = event_driven(system, law, t_end, h, t0=t0, backend=backend, tol=tol,
                                   progress=progress, **opts)
     check_finite_states(trajectory.t, trajectory.q, trajectory.v)
+    if cols is not None:
+        trajectory.sensitivities = differentiate(trajectory, cols)
     return trajectory
 
 

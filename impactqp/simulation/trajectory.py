@@ -17,6 +17,7 @@ from ..errors import InputError
 from ..laws.base import ImpactLaw
 from .friction_step import FrictionEvent
 from .impacts import ImpactEvent
+from .sensitivity import Sensitivities, TrajectoryKink
 from .system import LinearSystem
 
 FORMATS = (".npz", ".csv")
@@ -61,7 +62,12 @@ class Trajectory:
         callable that builds the list: it is called on first read).
     settings : dict
         The integrator's parameters.
+    sensitivities : Sensitivities or None
+        The derivatives asked for with ``simulate(..., sensitivities=...)`` (read them with
+        :meth:`sensitivity`, :meth:`vjp`, :attr:`sensitivity_kind` and :attr:`kinks`).
     """
+
+    sensitivities: Sensitivities | None = None
 
     def __init__(self, system: LinearSystem, law: ImpactLaw, scheme: str, t: np.ndarray,
                  q: np.ndarray, v: np.ndarray, impulses: np.ndarray,
@@ -176,6 +182,38 @@ class Trajectory:
     def __repr__(self) -> str:
         return (f"Trajectory(scheme={self.scheme!r}, records={self.t.size}, "
                 f"events={len(self.events)})")
+
+    # --- derivatives through time (docs/theory.md §21) ----------------------------------
+    def _asked(self) -> Sensitivities:
+        if self.sensitivities is None:
+            raise InputError("this run has no sensitivities: pass simulate(..., "
+                             "sensitivities=('q0', 'v0', ...))")
+        return self.sensitivities
+
+    @property
+    def sensitivity_kind(self) -> str | None:
+        """``"discrete-map"`` (Moreau–Jean: the derivative of the computed map, impact times
+        quantized to steps), ``"flow"`` (event-driven: the derivative of the motion), or
+        None without sensitivities."""
+        return None if self.sensitivities is None else self.sensitivities.kind
+
+    @property
+    def kinks(self) -> list[TrajectoryKink]:
+        """Where the derivative is one-sided: activation thresholds and degenerate contacts
+        of steps, grazing, Zeno and simultaneous impacts (each a :class:`TrajectoryKink`)."""
+        return self._asked().kinks
+
+    def sensitivity(self, wrt: str | None = None) -> np.ndarray:
+        """∂(q, v)/∂``wrt`` at every record, shape (records, 2n, k): rows [:n] the
+        positions', [n:] the velocities'; k = n for ``"q0"``/``"v0"``, one column per
+        coefficient of the law's parameter; every asked name side by side when None."""
+        return self._asked().of(wrt)
+
+    def vjp(self, q: Any = None, v: Any = None) -> dict[str, Any]:
+        """The gradient of a loss L from ∂L/∂q and ∂L/∂v, each (n,) (a loss on the final
+        state) or (records, n) (a loss on samples), by the adjoint (transposed) chain:
+        a dict from each asked name to its cotangent."""
+        return self._asked().vjp(q, v)
 
     # --- saving --------------------------------------------------------------------------
     def plot(self, kind: str = "positions", path: str | Path | None = None, *,
