@@ -115,11 +115,6 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ("impactqp/base/checks.py", "core/NumberReplacer",
      "UNIT_RANGE = (1e-100, 1e100)", "UNIT_RANGE = (1e-100, 1e+100)"):
         "1e100 ± 1 rounds to the float 1e100: the constant is unchanged",
-    ("impactqp/kernels/impact.py", "core/ReplaceBinaryOperator_Add_Sub",
-     "for i in range(j + 1, n):", "for i in range(j - 1, n):"):
-        "to one rounding: the extra row j − 1 writes L[j−1, j], above the diagonal and never "
-        "read (for j = 0, row −1 is row n − 1, rewritten with the same value later), and row "
-        "j rewrites L[j, j] as d/√d, which is √d to one rounding",
     ("impactqp/kernels/impact.py", "core/NumberReplacer",
      "return (np.empty(2 * n + 5 * m), np.empty((m, m)), np.empty(m, dtype=np.int64),",
      "return (np.empty( 3 * n + 5 * m), np.empty((m, m)), np.empty(m, dtype=np.int64),"):

@@ -1,5 +1,8 @@
-"""Figures of any system: a sphere's motion by kind of coordinate, its contact states and its
-animation; S of a 4-ball cradle with a heavy ball; the sector law's cones of four balls.
+"""Figures of any system
+=====================
+
+A sphere's motion by kind of coordinate, its contact states and its animation; S of a 4-ball
+cradle with a heavy ball; the sector law's cones of four balls.
 
     python examples/figures.py               # into a new temporary folder
     python examples/figures.py --out DIR     # into DIR (created if needed)

@@ -63,8 +63,9 @@ def test_no_suite_time_is_advertised() -> None:
 
 
 def test_readme_names_every_example() -> None:
+    # every script and file of examples/ (GALLERY_HEADER.rst is the gallery's own page text)
     missing = [p.name for p in (ROOT / "examples").iterdir()
-               if p.is_file() and p.name not in README]
+               if p.is_file() and p.name != "GALLERY_HEADER.rst" and p.name not in README]
     assert missing == []
 
 

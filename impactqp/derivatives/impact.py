@@ -170,10 +170,10 @@ class ImpactDerivative:
         return arr
 
     def jacobian(self, wrt: str = "u_minus", of: str = "u_plus") -> np.ndarray:
-        """The dense Jacobian ∂(of)/∂(wrt), shape (size of ``of``, *shape of ``wrt``): the
+        """The dense Jacobian ∂(of)/∂(wrt), shape (size of ``of``, ``*wrt.shape``): the
         map's derivative where smooth, the default element at a kink. With ``of =
         "impulses"`` where Λ is not unique, the minimum-norm element
-        (:attr:`impulses_unique` says so)."""
+        (``impulses_unique`` says so)."""
         self.require()
         size = self._output(of)
         self._shape_of(wrt)

@@ -84,7 +84,7 @@ class LocalMap(ABC):
     @abstractmethod
     def vjp(self, u_bar: np.ndarray, lam_bar: np.ndarray) -> dict[str, np.ndarray]:
         """Cotangents of every input for rows of cotangents ``u_bar`` (k, n) and
-        ``lam_bar`` (k, m): each (k, *shape)."""
+        ``lam_bar`` (k, m): each (k, ``*shape``)."""
 
     def directional(self, tangents: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """The one-sided derivative along ``tangents`` (the JVP where smooth)."""
@@ -106,12 +106,13 @@ class LinearPiece(LocalMap):
     Parameters
     ----------
     u_plus : dict of str to ndarray
-        ∂u⁺/∂input for each input, shape (n, *shape of the input); ``"u_minus"`` at least.
+        ∂u⁺/∂input for each input, shape (n, ``*shape``) for an input of shape ``shape``;
+        ``"u_minus"`` at least.
     impulses : dict of str to ndarray, optional
-        ∂Λ/∂input likewise, shape (m, *shape); where not given, recovered from the
+        ∂Λ/∂input likewise, shape (m, ``*shape``); where not given, recovered from the
         momentum equation M du⁺ = M du⁻ + W dΛ (:meth:`with_problem`).
     values : dict of str to array_like
-        The inputs' current values (their shapes define :attr:`inputs`).
+        The inputs' current values (their shapes define ``inputs``).
     margin : float
         Distance, relative to ‖u⁻‖, within which the piece holds (+inf by default).
     """

@@ -187,14 +187,15 @@ def derivative_rows(packed, Um, dU, Ubar, law, settings, passive, out):
     answers it on its own)."""
     k_rows, n = Um.shape
     m = passive.size
-    M, Wt, MinvW, G, s = _unpack(packed, n, m)
+    ops = _unpack(packed, n, m)
+    M, Wt, MinvW, G = ops.M, ops.Wt, ops.MinvW, ops.G
     work = workspace(n, m)
     L, idx = np.empty((m, m)), np.empty(m, dtype=np.int64)
     w, buf, active = np.empty(m), np.empty(5 * m), np.empty(m, dtype=np.bool_)
     for r in range(k_rows):
         if not settings.solved and not _solve_into(
-                M, Wt, MinvW, G, s, Um[r], law.E, law.eps, law.moreau, settings.tol, passive,
-                out.Up[r], out.Lam[r], out.Res[r], work):
+                ops, Um[r], law.E, law.eps, law.moreau, settings.tol, passive, out.Up[r],
+                out.Lam[r], out.Res[r], work):
             out.status[r] = UNCERTIFIED
             out.margin[r] = np.nan
             continue

@@ -43,7 +43,7 @@ def contact_states(trajectory: Any, tol: float = STATE_TOL) -> tuple[np.ndarray,
     codes : (k, m) ndarray of int
         Index into ``names`` per record and contact.
     names : tuple of str
-        :data:`FRICTIONLESS_STATES` or :data:`FRICTION_STATES`.
+        ``FRICTIONLESS_STATES`` or ``FRICTION_STATES``.
     """
     tol = check_tol(tol)
     system = trajectory.system

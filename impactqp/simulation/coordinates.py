@@ -129,7 +129,7 @@ class Scene:
     Attributes
     ----------
     kind : str
-        One of :data:`SCENES`.
+        One of ``SCENES``.
     sizes : mapping of str to float or tuple
         The builder's lengths the drawing needs (``radius``, ``length``, ``angle``,
         ``half_sizes``, ``dim`` …).

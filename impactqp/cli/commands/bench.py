@@ -11,13 +11,12 @@ from __future__ import annotations
 import argparse
 
 from ...base.checks import DEFAULT_TOL
-from ...io.file_laws import LAWS
 from ...io.files import load_problem
 from ...laws.catalogue import law_named
 from ...verification.bench import compare_backends
 from ..progress import progress
 from ..report import to_json
-from .solve import choose_law
+from .solve import add_law_arguments, choose_law
 
 
 def run(args: argparse.Namespace) -> int:
@@ -40,14 +39,7 @@ def run(args: argparse.Namespace) -> int:
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("bench", help="compare every backend on a problem file (.json/.toml)")
     p.add_argument("file", help="problem file (.json or .toml)")
-    p.add_argument("--law", choices=LAWS, help="impact law (default: the file's, else moreau, "
-                                               "or coulomb for frictional contacts)")
-    p.add_argument("--eps", help="Moreau's restitution ε in [0, 1]")
-    p.add_argument("--e", help="Newton's coefficients (and the normal restitution of coulomb): "
-                               "one number or one per contact, e.g. 0.5,0.8")
-    p.add_argument("--E", help="Frémond's matrix, rows separated by ';', e.g. '0.5,0;0,0.5'")
-    p.add_argument("--mu", help="Coulomb's friction coefficients ≥ 0: one number or one per "
-                                "contact")
+    add_law_arguments(p)
     p.add_argument("--backends", help="comma-separated backends to compare, e.g. "
                                       "'exact,clarabel,cvxpy:SCS' (default: every backend "
                                       "that serves the law; `impactqp backends` lists them)")

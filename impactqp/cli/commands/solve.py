@@ -114,9 +114,9 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("solve", help="apply an impact law to a problem file (.json/.toml)")
-    p.add_argument("file", help="problem file (.json or .toml)")
+def add_law_arguments(p: argparse.ArgumentParser) -> None:
+    """The flags that choose the law and its coefficients (read by :func:`choose_law`):
+    ``solve`` and ``bench`` take the same."""
     p.add_argument("--law", choices=LAWS, help="impact law (default: the file's, else moreau, "
                                                "or coulomb for frictional contacts)")
     p.add_argument("--eps", help="Moreau's restitution ε in [0, 1]")
@@ -130,6 +130,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                                        "required): one number or one per contact, e.g. 1e7")
     p.add_argument("--exponent", help="the LZB model's force exponents η in [1, 3] (lzb, "
                                       "default 1.5, Hertz)")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("solve", help="apply an impact law to a problem file (.json/.toml)")
+    p.add_argument("file", help="problem file (.json or .toml)")
+    add_law_arguments(p)
     p.add_argument("--backend", default="auto",
                    help="backend of the registry (default auto): a "
                         "QP backend, or for coulomb a friction method: "
