@@ -23,6 +23,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # document the source tree, installed or not
 sys.path.insert(0, str(ROOT / "docs" / "_ext"))  # this site's own extensions
 
+from offline_intersphinx import exists  # noqa: E402
+
 import impactqp  # noqa: E402
 
 project = "impactqp"
@@ -180,27 +182,9 @@ def _public_reference(app, env, node, contnode):
         if name in domain.objects:
             return domain.resolve_xref(env, node["refdoc"], app.builder, node["reftype"], name,
                                        node, contnode)
-    if target.startswith("impactqp.") and _importable(target):
+    if target.startswith("impactqp.") and exists(target):
         return contnode  # an internal object the page does not document: its name, unlinked
     return None
-
-
-def _importable(dotted: str) -> bool:
-    """Does ``impactqp.a.b`` name an importable module or an attribute chain below one?"""
-    import importlib
-
-    parts = dotted.split(".")
-    for cut in range(len(parts), 0, -1):
-        try:
-            obj = importlib.import_module(".".join(parts[:cut]))
-        except ImportError:
-            continue
-        for name in parts[cut:]:
-            if not hasattr(obj, name):
-                return False
-            obj = getattr(obj, name)
-        return True
-    return False
 
 
 def setup(app):

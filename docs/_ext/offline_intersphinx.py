@@ -29,7 +29,7 @@ def _offline(env) -> set[str]:
     return {name for name in MODULES if not any(named.get(name, {}).values())}
 
 
-def _exists(dotted: str) -> bool:
+def exists(dotted: str) -> bool:
     """Does ``a.b.c`` name an importable module or an attribute chain below one?"""
     parts = dotted.split(".")
     for cut in range(len(parts), 0, -1):
@@ -59,11 +59,11 @@ def unlinked_offline(app, env, node, contnode):
         return None
     target = target.lstrip("~.")
     top = target.split(".")[0]
-    if top in {MODULES[p] for p in offline} and _exists(target):
+    if top in {MODULES[p] for p in offline} and exists(target):
         return contnode
     if "python" in offline and "." not in target and hasattr(builtins, target):
         return contnode
-    if "python" in offline and top in sys.stdlib_module_names and _exists(target):
+    if "python" in offline and top in sys.stdlib_module_names and exists(target):
         return contnode  # the standard library: pathlib.Path
     return None
 

@@ -74,7 +74,13 @@ def _refactor(L, idx, k, G, x):
 @kernel
 def _solve_factored(L, idx, k, rhs, out):
     """out[idx[:k]] = G_PP⁻¹ rhs[idx[:k]] with G_PP = LLᵀ."""
-    y = np.empty(k)
+    solve_factored_into(L, idx, k, rhs, out, np.empty(k))
+
+
+@kernel
+def solve_factored_into(L, idx, k, rhs, out, y):
+    """:func:`_solve_factored` in the scratch y of at least k floats (no allocation: the
+    derivative kernels call it several times per row)."""
     for a in range(k):
         y[a] = rhs[idx[a]]
     cholesky_solve(L, k, y)

@@ -19,7 +19,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .active_set import _append, cholesky_solve
+from .active_set import _append, solve_factored_into
 from .impact import _solve_into, _unpack, workspace
 from .jit import kernel
 
@@ -98,17 +98,6 @@ def _active_factor(G, IE, Wt, M, um, lam, kink_tol, L, idx, w, active, gamma):
 
 
 @kernel
-def _solve_active(L, idx, k, rhs, out, y):
-    """out[idx[:k]] = G_AA⁻¹ rhs[idx[:k]] with G_AA = LLᵀ, in the scratch y (no allocation
-    per call: this runs several times per row)."""
-    for a in range(k):
-        y[a] = rhs[idx[a]]
-    cholesky_solve(L, k, y)
-    for a in range(k):
-        out[idx[a]] = y[a]
-
-
-@kernel
 def _margin(G, IE, Wt, um, lam, w, L, idx, k, active, buf):
     """The cell's radius relative to ‖u⁻‖ (docs/theory.md §20): min over contacts of the
     value (Λᵢ active, wᵢ inactive) over the norm of its gradient in u⁻."""
@@ -124,7 +113,7 @@ def _margin(G, IE, Wt, um, lam, w, L, idx, k, active, buf):
                 total += IE[i, j] * Wt[j, c]
             R[i] = total
             dlam[i] = 0.0
-        _solve_active(L, idx, k, R, dlam, buf[4 * m:5 * m])
+        solve_factored_into(L, idx, k, R, dlam, buf[4 * m:5 * m])
         for i in range(m):
             if active[i]:  # an active contact dropped as dependent keeps a zero gradient
                 grad[i] += dlam[i] * dlam[i]
@@ -156,7 +145,7 @@ def _jvp_vjp(IE, Wt, MinvW, L, idx, k, du, ubar, dup, uout, settings, buf):
                 total += IE[i, j] * g
             r[i] = total
             x[i] = 0.0
-        _solve_active(L, idx, k, r, x, buf[4 * m:5 * m])
+        solve_factored_into(L, idx, k, r, x, buf[4 * m:5 * m])
         for c in range(n):
             total = du[c]
             for a in range(k):
@@ -169,7 +158,7 @@ def _jvp_vjp(IE, Wt, MinvW, L, idx, k, du, ubar, dup, uout, settings, buf):
                 total += MinvW[c, i] * ubar[c]
             r[i] = total
             x[i] = 0.0
-        _solve_active(L, idx, k, r, x, buf[4 * m:5 * m])
+        solve_factored_into(L, idx, k, r, x, buf[4 * m:5 * m])
         for c in range(n):
             total = ubar[c]
             for i in range(m):
