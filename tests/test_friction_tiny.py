@@ -79,3 +79,14 @@ def test_the_kernel_outcomes() -> None:
     bad_q[1] = np.nan
     _, outcome, _ = solve_tiny(p.W, bad_q, p.mu, 3, limits, r, u, fig)
     assert outcome == NOT_CERTIFIED
+
+
+def test_a_sparse_w_of_a_few_contacts_takes_the_same_call() -> None:
+    import scipy.sparse as sp
+
+    dense = problem(9, 5)
+    sparse = iq.FrictionContactProblem(sp.csc_matrix(dense.W), dense.q, dense.mu)
+    a, b = iq.solve_friction(dense, tol=1e-10), iq.solve_friction(sparse, tol=1e-10)
+    assert b.backend == "kernel" and b.attempts == a.attempts
+    np.testing.assert_array_equal(a.r, b.r)
+    assert certify_friction(sparse, b.r, b.u, tol=1e-10).ok

@@ -30,8 +30,8 @@ from ..model.friction import (
 )
 from ..qp import backends
 from ..qp.certified import Outcome, solve_certified
-from ..qp.friction import FrictionSolution
-from ..qp.friction.methods import NSGS_LOCAL, NSGS_SHORT, SMALL_CONTACTS
+from ..qp.friction import FrictionSolution, methods
+from ..qp.friction.methods import NSGS_LOCAL, NSGS_SHORT
 from ..qp.friction.newton import NEWTON_STEPS
 from .planner import plan_friction
 from .result import FrictionResult
@@ -110,11 +110,12 @@ def _tiny(problem: FrictionContactProblem, tol: float, start: float) -> Friction
     call (:func:`impactqp.kernels.friction_tiny.solve_tiny`: units, solve, answer as given
     and its certificate), or None where that route does not apply or its answer fails: the
     general route then runs (and tries the method again among the others)."""
-    if problem.n_contacts > SMALL_CONTACTS or not isinstance(problem.W, np.ndarray):
+    if problem.n_contacts > methods.SMALL_CONTACTS:  # the "kernel" method's own limit
         return None
     size = problem.q.size
     r, u, figures = np.empty(size), np.empty(size), np.empty(len(FRICTION_FIGURES))
-    its, outcome, scaled = solve_tiny(np.ascontiguousarray(problem.W), problem.q, problem.mu,
+    W = np.ascontiguousarray(problem.dense_W(), dtype=float)  # a sparse W of a few contacts too
+    its, outcome, scaled = solve_tiny(W, problem.q, problem.mu,
                                       problem.contact_dim,
                                       TinyLimits(tol, NEWTON_STEPS, NSGS_SHORT, NSGS_LOCAL),
                                       r, u, figures)
