@@ -175,3 +175,16 @@ def test_reflection_law_cones_and_a_refusal(tmp_path):
         iq.plot_sectors("s.png")
     with pytest.raises(iq.InputError, match="at least 3 positive"):
         iq.plot_sectors(masses=[1.0, -1.0, 1.0])
+
+
+def test_s_draws_itself_as_plot_admissible_does(tmp_path):
+    S = HEAVY.admissible_set()
+    by_method = S.plot(tmp_path / "m.png", laws=("sector",))
+    by_function = iq.plot_admissible(S, tmp_path / "f.png", laws=("sector",))
+    (a,), (b,) = by_method.axes, by_function.axes
+    assert [t.get_text() for t in a.get_legend().get_texts()] == \
+        [t.get_text() for t in b.get_legend().get_texts()]
+    assert len(a.lines) == len(b.lines) > 0
+    for la, lb in zip(a.lines, b.lines):
+        np.testing.assert_array_equal(la.get_xydata(), lb.get_xydata())
+    assert (tmp_path / "m.png").read_bytes()[:4] == b"\x89PNG"

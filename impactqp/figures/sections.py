@@ -24,6 +24,7 @@ from ..laws.base import ImpactLaw
 from ..laws.pipeline import solve
 from ..laws.reflection import ReflectionLaw
 from ..laws.sector import MASS_RTOL, SectorLaw
+from ..model import admissible
 from ..model.admissible import AdmissibleSet
 from ..model.builders import chain, newtons_cradle, require_chain
 from ..model.problem import ImpactProblem
@@ -285,3 +286,6 @@ def plot_sectors(problem: ImpactProblem | None = None, path: str | Path | None =
     if path is not None:
         save_figure(fig, path)
     return fig
+
+
+admissible.DRAWING[0] = plot_admissible  # S.plot(...) draws by it

@@ -75,6 +75,11 @@ def _best_impulses_unit(problem: Any, du: np.ndarray) -> tuple[np.ndarray, float
     return lam, problem.norm(du - st.impulse_velocity(lam))
 
 
+DRAWING: list = [None]
+"""How S is drawn: :func:`impactqp.figures.sections.plot_admissible`, registered there (the
+model layer does not import the figures' layer)."""
+
+
 class AdmissibleSet:
     """The admissible set S of one impact problem (docs/theory.md §2), with friction cones
     for frictional contacts (docs/theory.md §16).
@@ -145,6 +150,11 @@ class AdmissibleSet:
         out = solve_in_forms([(f, build[f], finish_for(f)) for f in preferred_forms(p)],
                              "auto")
         return out.answer, u - out.answer
+
+    def plot(self, path: Any = None, **options: Any) -> Any:
+        """Draw a section of S through u⁻ (the plot extra): the same as
+        ``iq.plot_admissible(S, path, **options)``, which says what ``options`` take."""
+        return DRAWING[0](self, path, **options)
 
     # --- exact membership -------------------------------------------------------------
     def contains(self, u: Any, method: str = "exact", tol: float | None = None) -> Membership:
