@@ -56,21 +56,27 @@ class Operators(NamedTuple):
 
 
 def pack(M: np.ndarray, W: np.ndarray) -> np.ndarray:
-    """M (n × n), Wᵀ (m × n), M⁻¹W (n × m), G = WᵀM⁻¹W (m × m), sᵢ = √Gᵢᵢ and the
-    certificate's M⁻¹W (n × m) in one flat array (views: :class:`Operators`), by LAPACK once
-    per structure: M = LLᵀ and B = L⁻¹W give G = BᵀB and M⁻¹W = L⁻ᵀB (docs/theory.md §1);
-    the certificate's M⁻¹W is solved apart, by LU with partial pivoting (``gesv``), so that
-    it shares nothing with the Cholesky factor the recovery uses (docs/theory.md §8). M must
-    be symmetric positive definite (the structure has checked it). Plain Python: nothing to
-    compile for a call made once per structure."""
+    """:func:`pack_operators` of M and W, the operators computed here by LAPACK: M = LLᵀ and
+    B = L⁻¹W give G = BᵀB and M⁻¹W = L⁻ᵀB (docs/theory.md §1), and the certificate's M⁻¹W is
+    solved apart by LU with partial pivoting (``gesv``). M must be symmetric positive
+    definite. (A structure packs the operators it has already computed.)"""
     M = np.ascontiguousarray(M, dtype=float)
     W = np.ascontiguousarray(W, dtype=float)
     L, _ = lapack.dpotrf(M, lower=1, clean=1)
     B = lapack.dtrtrs(L, W, lower=1)[0]
-    X = lapack.dtrtrs(L, B, lower=1, trans=1)[0]
-    G = B.T @ B
-    return np.concatenate((M.ravel(), W.T.ravel(), X.ravel(), G.ravel(),
-                           np.sqrt(np.diag(G)), np.linalg.solve(M, W).ravel()))
+    return pack_operators(M, W, lapack.dtrtrs(L, B, lower=1, trans=1)[0], B.T @ B,
+                          np.linalg.solve(M, W))
+
+
+def pack_operators(M: np.ndarray, W: np.ndarray, MinvW: np.ndarray, G: np.ndarray,
+                   check: np.ndarray) -> np.ndarray:
+    """M (n × n), Wᵀ (m × n), M⁻¹W (n × m), G = WᵀM⁻¹W (m × m), sᵢ = √Gᵢᵢ and the
+    certificate's M⁻¹W (n × m) in one flat array (views: :class:`Operators`). ``MinvW`` is
+    the recovery's (from the Cholesky factor of M), ``check`` one that shares nothing with
+    it (docs/theory.md §8, "Independence"). Plain Python: nothing to compile for a call made
+    once per structure."""
+    return np.concatenate((np.ravel(M), np.ravel(np.transpose(W)), np.ravel(MinvW),
+                           np.ravel(G), np.sqrt(np.diag(G)), np.ravel(check))).astype(float)
 
 
 @kernel

@@ -9,8 +9,6 @@ scale; u⁻ = 0 is measured against the answer's own size (any non-zero u⁺ the
 
 from __future__ import annotations
 
-import weakref
-
 import numpy as np
 
 from ..base.rowwise import row_max, row_min, row_sum
@@ -75,22 +73,16 @@ more go through numpy products that apply a scalar or per-contact E without form
 _EMPTY = np.zeros((0, 0))
 
 
-_OPERANDS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
 def certificate_operand(structure: ImpactStructure) -> np.ndarray:
-    """M⁻¹W of a dense structure for the certificate's impact equation, solved here from the
-    given M and W by LU (LAPACK's gesv), once per structure.
+    """M⁻¹W of a dense structure for the certificate's impact equation
+    (:attr:`~impactqp.model.structure.ImpactStructure.certificate_Minv_W`: solved from the
+    given M and W by LU, once per structure).
 
     The solvers recover u⁺ = u⁻ + M⁻¹WΛ from an impulse-form answer with the structure's own
     M⁻¹W (from the Cholesky factor of M); measuring the impact equation with that same
     operand would certify any error in it that Wᵀ does not see (docs/theory.md §8,
     "Independence")."""
-    op = _OPERANDS.get(structure)
-    if op is None:
-        op = np.ascontiguousarray(np.linalg.solve(structure.dense_mass, structure.dense_Wt.T))
-        _OPERANDS[structure] = op
-    return op
+    return structure.certificate_Minv_W
 
 
 def momentum_defect(structure: ImpactStructure, Um: np.ndarray, Up: np.ndarray,

@@ -20,7 +20,7 @@ from scipy.linalg import lapack
 from ..base.arrays import Matrix, as_count, as_dense, as_matrix
 from ..base.rowwise import row_max, row_sum
 from ..errors import InputError, MassMatrixError, ShapeError
-from ..kernels.impact import pack
+from ..kernels.impact import pack_operators
 from ..kernels.units import contact_units
 
 
@@ -248,7 +248,13 @@ class ImpactStructure:
     def kernel_pack(self) -> np.ndarray:
         """M, Wᵀ, M⁻¹W, G and the contact scales packed for the compiled impact solve
         (:func:`!impactqp.kernels.impact.pack`; dense problems)."""
-        return pack(self.dense_mass, np.ascontiguousarray(as_dense(self.W), dtype=float))
+        return pack_operators(self.dense_mass, self.dense_Wt.T, self.dense_Minv_W,
+                              as_dense(self.delassus), self.certificate_Minv_W)
+
+    @cached_property
+    def certificate_Minv_W(self) -> np.ndarray:
+        """M⁻¹W for certificates, by LU of M: not the solvers' (docs/theory.md §8)."""
+        return np.ascontiguousarray(np.linalg.solve(self.dense_mass, self.dense_Wt.T))
 
     @cached_property
     def warm_support(self) -> np.ndarray:
