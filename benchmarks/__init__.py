@@ -11,3 +11,10 @@ fc3d solvers, :mod:`.friction`, :mod:`.friction_data`; frictional impacts of sph
 :mod:`.friction_report`, :mod:`.perf_profile`), the driver (:mod:`.runner`) and the
 reports (:mod:`.report`).
 """
+
+import os
+
+# Benchmarks time machine code: no call of theirs runs a kernel's Python text, as a small first
+# call of a cold process otherwise would (impactqp/kernels/first_calls.py). The first-hour
+# probes of :mod:`.startup` set the variable themselves.
+os.environ.setdefault("IMPACTQP_INTERPRETED_SECONDS", "0")

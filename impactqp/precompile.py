@@ -19,6 +19,7 @@ import numpy as np
 
 from . import kernels
 from .derivatives.batch import derivative_batch
+from .kernels.first_calls import compiling
 from .kernels.jit import cache_dir
 from .laws.batch import solve_batch
 from .laws.complementarity import Fremond, Newton
@@ -152,10 +153,11 @@ def compile_kernels(progress: Callable[[str, int, int], None] | None = None) -> 
     CompileReport
     """
     start = time.perf_counter()
-    for i, (name, stage) in enumerate(STAGES):
-        if progress is not None:
-            progress(name, i, len(STAGES))
-        stage()
+    with compiling():  # small first calls would otherwise run as Python (kernels/first_calls)
+        for i, (name, stage) in enumerate(STAGES):
+            if progress is not None:
+                progress(name, i, len(STAGES))
+            stage()
     if progress is not None:
         progress("done", len(STAGES), len(STAGES))
     found = _kernels()

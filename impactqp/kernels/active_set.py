@@ -61,7 +61,7 @@ def _append(L, idx, k, G, j):
 def _refactor(L, idx, k, G, x):
     """Factor G_PP anew for P = idx[:k]; variables whose columns turn out dependent leave P
     (with x = 0). Returns the new size of P."""
-    kept = 0
+    kept = np.int64(0)
     for a in range(k):
         j = idx[a]
         if _append(L, idx, kept, G, j):
@@ -158,7 +158,7 @@ def _to_minimizer(L, idx, k, G, q, x, s, joined):
                 if step < alpha:
                     alpha = step
                     stop = i
-        kept = 0
+        kept = np.int64(0)
         for a in range(k):
             i = idx[a]
             x[i] += alpha * (s[i] - x[i])
@@ -206,7 +206,7 @@ def _final_solve(L, idx, k, G, q, x, w, s):
             s[idx[a]] += x[idx[a]]
 
 
-@kernel
+@kernel(interpretable=True)
 def lcp_psd(G, q, passive, x, w, max_iter):
     """Solve ``0 ≤ x ⟂ Gx + q ≥ 0`` for a symmetric positive semidefinite G.
 
@@ -247,14 +247,14 @@ def lcp_psd_work(G, q, passive, x, w, max_iter, L, idx, s, blocked):
         qmax = max(qmax, abs(q[i]))
         for j in range(m):
             gmax = max(gmax, abs(G[i, j]))
-    k = 0
+    k = np.int64(0)  # not a literal: callees compile for int64 only (one signature)
     for j in range(m):
         if passive[j] and _append(L, idx, k, G, j):
             k += 1
     restore = k > 0  # a warm start first moves to the minimizer on its passive set
     status = ITERATION_LIMIT
     for _ in range(max_iter):
-        joined = -1
+        joined = np.int64(-1)
         if not restore:
             _gradient(G, q, x, w)
             xmax = 0.0

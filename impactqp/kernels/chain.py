@@ -58,7 +58,7 @@ def _forward(m, u, z, L, a, b):
         L[j + 1] = s + c
 
 
-@kernel
+@kernel(interpretable=True)
 def project(m, u, left, right, z, L, starts, weight):
     """z = prox_{T_C}(u⁻) and the impulses L (N + 1 entries: L_j left of ball j, L_0 and L_N
     the walls' impulses, 0 where there is no wall) of one chain, into ``z`` and ``L``.

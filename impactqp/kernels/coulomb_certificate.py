@@ -110,7 +110,7 @@ FRICTION_FIGURES = ("natural_map", "velocity", "cone", "dual_cone", "complementa
 certificate, then the two figures it reports beside them."""
 
 
-@kernel
+@kernel(interpretable=True)
 def friction_figures(r, u, q, mu, d, residual, out):
     """The figures of a local frictional problem's certificate in contact units
     (:data:`FRICTION_FIGURES`, defined in :func:`impactqp.model.friction.certify_friction`,
@@ -137,7 +137,7 @@ def friction_figures(r, u, q, mu, d, residual, out):
     out[6] = certificate_ratio(np.sqrt(penetration), q_scale)
 
 
-@kernel
+@kernel(interpretable=True)
 def coulomb_residuals(system, local, answer, out):
     """The five residuals of :data:`COULOMB_RESIDUALS` into ``out``; False (``out``
     untouched) when max|u⁻ᵢ| lies outside :data:`~impactqp.kernels.residuals.SCALE_RANGE`,

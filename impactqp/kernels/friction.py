@@ -51,7 +51,7 @@ def project_contact(x, mu, k, d, out):
             out[k + j] = mu * a * x[k + j] / t
 
 
-@kernel
+@kernel(interpretable=True)
 def project_cones(x, mu, d):
     """P_{K_μ}(x) contact by contact (μ one coefficient per contact)."""
     out = np.empty_like(x)
@@ -77,7 +77,7 @@ def modified_velocity(u, mu, d):
     return ut
 
 
-@kernel
+@kernel(interpretable=True)
 def natural_map(r, u, mu, d):
     """F = r − P_{K_μ}(r − ũ) contact by contact, ũ = u + μ‖u_T‖e_n."""
     ut = modified_velocity(u, mu, d)

@@ -15,7 +15,7 @@ from .friction import alart_curnier, natural_map, nsgs, project_cones
 from .jit import inline_kernel, kernel
 
 
-@kernel
+@kernel(interpretable=True)
 def scales(diagonal, d):
     """ρ_c of each contact's Alart–Curnier function (docs/theory.md §15): 1 over the mean of
     W_cc's diagonal (1 where that mean is not positive), from W's ``diagonal``."""
@@ -171,7 +171,7 @@ def _accept(W, q, mu, d, r, tol):
     return False
 
 
-@kernel
+@kernel(interpretable=True)
 def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
     """A local problem of a few contacts (dense W) in one compiled call, into ``r``: Newton
     from r = 0, then NSGS followed by Newton, then the damped Newton (shift factor 10) from

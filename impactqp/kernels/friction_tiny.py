@@ -50,7 +50,7 @@ class TinyLimits(NamedTuple):
     local_iters: int
 
 
-@kernel
+@kernel(interpretable=True)
 def solve_tiny(W, q, mu, d, limits, r, u, figures):
     """Solve and certify ``u = W r + q, K_μ ∋ r ⟂ ũ ∈ K*_μ`` for a dense W of a few contacts.
 

@@ -138,7 +138,7 @@ def _solve_into(ops, um, E, eps, moreau, tol, passive, up, lam, res, work):
     return True
 
 
-@kernel
+@kernel(interpretable=True)
 def solve_impact(packed, um, E, eps, moreau, tol, passive, out):
     """Solve and certify one impact of the structure ``packed``.
 

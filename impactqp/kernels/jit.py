@@ -7,10 +7,13 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import TextIO, TypeVar
+from typing import Any, TextIO, TypeVar
 
 import numba
 import numba.core.event
+from numba.core.registry import CPUDispatcher
+
+from .first_calls import InterpretableDispatcher
 
 F = TypeVar("F", bound=Callable)
 
@@ -42,23 +45,41 @@ def _cached_in_user_dir() -> Iterator[None]:
         numba.config.CACHE_DIR = ""
 
 
-def kernel(function: F) -> F:
+OPTIONS = {"nopython": True, "nogil": True, "error_model": "numpy", "boundscheck": None}
+"""numba's options for every kernel: ``error_model="numpy"`` lets a division by zero give
+inf/NaN (which every certificate then rejects) instead of raising."""
+
+
+def kernel(function: F | None = None, *, interpretable: bool = False,
+           inline: bool = False) -> Any:
     """Compile ``function`` with numba on its first call, caching the machine code on disk
     (in :func:`cache_dir`).
 
-    No signature is given, so nothing is compiled at import; ``error_model="numpy"`` lets a
-    division by zero give inf/NaN (which every certificate then rejects) instead of raising.
+    No signature is given, so nothing is compiled at import. ``interpretable`` declares that
+    the kernel's work is bounded by the sizes of its arrays (no loop over time steps or
+    rows): its first small calls in a process that holds no machine code for it run its
+    Python text instead (:mod:`.first_calls`). ``inline`` inlines it into every kernel
+    calling it. Used bare (``@kernel``) or with arguments.
     """
+    if function is None:
+        return lambda f: kernel(f, interpretable=interpretable, inline=inline)
+    if numba.config.DISABLE_JIT:
+        return function
+    options = {**OPTIONS, "inline": "always"} if inline else dict(OPTIONS)
     with _cached_in_user_dir():
-        return numba.njit(cache=True, nogil=True, error_model="numpy")(function)
+        if interpretable:
+            dispatcher = InterpretableDispatcher(py_func=function, locals={},
+                                                 targetoptions=options)
+        else:
+            dispatcher = CPUDispatcher(py_func=function, locals={}, targetoptions=options)
+        dispatcher.enable_caching()
+        return dispatcher
 
 
-def inline_kernel(function: F) -> F:
+def inline_kernel(function: F | None = None, *, interpretable: bool = False) -> Any:
     """:func:`kernel` for a helper of a few operations, inlined into every kernel calling it
     (a call that is not inlined costs as much as the helper's arithmetic)."""
-    with _cached_in_user_dir():
-        return numba.njit(cache=True, nogil=True, error_model="numpy",
-                          inline="always")(function)
+    return kernel(function, interpretable=interpretable, inline=True)
 
 
 NOTICE_AFTER = 1.0

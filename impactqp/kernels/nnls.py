@@ -14,7 +14,7 @@ from .active_set import SOLVED, lcp_psd
 from .jit import kernel
 
 
-@kernel
+@kernel(interpretable=True)
 def nnls(A, b, max_iter):
     """min ‖Ax − b‖₂ over x ≥ 0: the active-set search on G = AᵀA, q = −Aᵀb, then the
     least-squares problem on the final support solved on A itself (no squared condition).

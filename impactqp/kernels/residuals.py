@@ -138,7 +138,7 @@ def dense_momentum(M, MinvW, um, up, lam, f, d):
     return V, np.sqrt(_high(_scaled_quadratic(M, d, d, 1.0), 0.0))
 
 
-@kernel
+@kernel(interpretable=True)
 def dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, out, work):
     """The residuals of one impact with dense M (n × n), Wᵀ (m × n), M⁻¹W (n × m), the
     contact scales s and the law's E (m × m; for Moreau's law, ``moreau``, E = εI is used and
@@ -241,7 +241,7 @@ def _chain_pass(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, e
     finish(V, np.sqrt(q), acc, eps, moreau, cross, out)
 
 
-@inline_kernel
+@inline_kernel(interpretable=True)
 def chain_residuals(um, up, lam, masses, inverse, s, left_wall, right_wall, E, eps, moreau,
                     out):
     """The residuals of one impact of a 1-D chain (docs/theory.md §5, §8) in one O(N) loop.

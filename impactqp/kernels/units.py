@@ -14,7 +14,7 @@ import numpy as np
 from .jit import kernel
 
 
-@kernel
+@kernel(interpretable=True)
 def contact_units(diagonal: np.ndarray, d: int) -> np.ndarray:
     """Per-entry units sᵢ = s_c of the contact c of entry i, from W's diagonal.
 
