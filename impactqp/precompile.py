@@ -9,9 +9,11 @@ and both Moreau–Jean loops — so that later processes sharing the cache start
 from __future__ import annotations
 
 import importlib
+import multiprocessing
 import pkgutil
 import time
 from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 
 import numba
@@ -19,8 +21,9 @@ import numpy as np
 
 from . import kernels
 from .derivatives.batch import derivative_batch
-from .kernels.first_calls import compiling
-from .kernels.jit import cache_dir
+from .errors import InputError
+from .kernels.first_calls import cached, compiling
+from .kernels.jit import NOTICE, cache_dir
 from .laws.batch import solve_batch
 from .laws.complementarity import Fremond, Newton
 from .laws.coulomb import Coulomb
@@ -99,6 +102,9 @@ STAGES: tuple[tuple[str, Callable[[], None]], ...] = (
 )
 """The routes :func:`compile_kernels` runs, by name."""
 
+LONGEST_FIRST = ("friction", "simulations", "impacts", "LZB", "batches", "chains")
+"""The stages by their compile time (measured), the order a parallel compile starts them in."""
+
 
 @dataclass(frozen=True)
 class CompileReport:
@@ -140,28 +146,57 @@ def _kernels() -> dict[str, object]:
     return found
 
 
-def compile_kernels(progress: Callable[[str, int, int], None] | None = None) -> CompileReport:
+def _run_stages(names: tuple[str, ...], quiet: bool = False) -> None:
+    """Run the named stages, compiling every kernel they call (never their Python text)."""
+    if quiet:  # a worker of a parallel compile: the parent has said it once
+        NOTICE.said = True
+    stages = dict(STAGES)
+    with compiling():  # small first calls would otherwise run as Python (kernels/first_calls)
+        for name in names:
+            stages[name]()
+
+
+def compile_kernels(progress: Callable[[str, int, int], None] | None = None,
+                    jobs: int = 1) -> CompileReport:
     """Compile every kernel impactqp's routes call, writing their machine code to the cache.
 
     Parameters
     ----------
     progress : callable, optional
-        Called as ``progress(stage, done, total)`` before each stage and once at the end.
+        Called as ``progress(stage, done, total)`` before each stage (as each finishes, with
+        ``jobs`` > 1) and once at the end.
+    jobs : int
+        Processes compiling at once (``impactqp compile`` uses one per core): the stages are
+        shared among them, longest first, and each writes to the same cache. 1 compiles in
+        this process (a dask worker, which may not start processes of its own).
 
     Returns
     -------
     CompileReport
     """
+    if not isinstance(jobs, int) or jobs < 1:
+        raise InputError(f"jobs must be a positive integer (processes compiling at once), "
+                         f"got {jobs!r}")
     start = time.perf_counter()
-    with compiling():  # small first calls would otherwise run as Python (kernels/first_calls)
-        for i, (name, stage) in enumerate(STAGES):
+    names = [name for name, _ in STAGES]
+    if jobs == 1:
+        for i, name in enumerate(names):
             if progress is not None:
-                progress(name, i, len(STAGES))
-            stage()
+                progress(name, i, len(names))
+            _run_stages((name,))
+    else:
+        NOTICE.say()
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=min(jobs, len(names)), mp_context=context) as pool:
+            futures = {pool.submit(_run_stages, (name,), True): name for name in LONGEST_FIRST}
+            for i, future in enumerate(as_completed(futures)):
+                future.result()
+                if progress is not None:
+                    progress(futures[future], i + 1, len(names))
     if progress is not None:
-        progress("done", len(STAGES), len(STAGES))
+        progress("done", len(names), len(names))
     found = _kernels()
-    compiled = tuple(sorted(k for k, v in found.items() if v.signatures))
-    missing = tuple(sorted(k for k, v in found.items() if not v.signatures))
+    compiled = tuple(sorted(k for k, v in found.items() if v.signatures or cached(v)))
+    missing = tuple(sorted(k for k in found if k not in compiled))
     return CompileReport(time.perf_counter() - start, compiled, missing,
                          numba.config.CACHE_DIR or cache_dir())

@@ -102,3 +102,25 @@ def test_notice_is_written_once_and_only_after_its_delay():
     notice.say()
     notice.say()
     assert out.getvalue().count(NOTICE) == 1
+
+
+@pytest.mark.parametrize("jobs", [0, -1, 1.5, "2"])
+def test_compile_refuses_a_bad_number_of_processes(jobs):
+    from impactqp.errors import InputError
+    from impactqp.precompile import compile_kernels
+
+    with pytest.raises(InputError, match="jobs must be a positive integer"):
+        compile_kernels(jobs=jobs)
+
+
+def test_compile_command_names_a_bad_jobs_flag():
+    done = subprocess.run([sys.executable, "-m", "impactqp", "compile", "--jobs", "0"],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    assert "--jobs" in done.stderr and "positive integer" in done.stderr
+
+
+def test_a_parallel_compile_starts_every_stage():
+    from impactqp import precompile
+
+    assert sorted(precompile.LONGEST_FIRST) == sorted(name for name, _ in precompile.STAGES)

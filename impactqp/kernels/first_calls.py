@@ -79,7 +79,7 @@ def _elements(args: tuple[Any, ...]) -> int:
     return total
 
 
-def _cached(dispatcher: CPUDispatcher) -> bool:
+def cached(dispatcher: CPUDispatcher) -> bool:
     """The disk cache holds machine code of ``dispatcher`` for the current source (numba's
     index is dropped when the source changed). Unknown cache internals count as cached:
     numba then does what it always does."""
@@ -127,7 +127,7 @@ def _interpret(dispatcher: CPUDispatcher, args: tuple[Any, ...]) -> bool:
     """Run this call of a cold kernel as Python (see the module's rules)?"""
     if _state["compiling"] or _state["spent"] >= BUDGET or _elements(args) > SMALL:
         return False
-    return not dispatcher.signatures and not _cached(dispatcher)
+    return not dispatcher.signatures and not cached(dispatcher)
 
 
 def _timed(function: Callable) -> Callable:

@@ -4,6 +4,7 @@ cluster workers that share the cache folder)."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 
@@ -19,7 +20,7 @@ def run(args: argparse.Namespace) -> int:
             bar.n = done
             bar.refresh()
 
-        report = compile_kernels(progress)
+        report = compile_kernels(progress, jobs=args.jobs)
     print(report.summary())
     if args.list:
         for name in report.compiled:
@@ -29,10 +30,31 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cores() -> int:
+    """Cores this process may run on."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1
+
+
+def _positive(text: str) -> int:
+    """A positive integer, or argparse's error naming the flag."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("compile", help="compile every numba kernel now, into the cache folder")
     p.add_argument("--list", action="store_true",
                    help="list the kernels compiled on their own and those compiled into "
                         "their callers")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--jobs", type=_positive, default=_cores(),
+                   help="processes compiling at once (default: one per core of this "
+                        "process)")
     p.set_defaults(func=run)
