@@ -101,10 +101,16 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
 
 
 def chained(system: LinearSystem, maps: StepMaps, Q: np.ndarray, V: np.ndarray,
-            L: np.ndarray, settings: dict, cols: Columns, group: Group) -> Sensitivities:
+            L: np.ndarray, settings: dict, cols: Columns, group: Group, *,
+            dofs: bool = False) -> Sensitivities:
     """The steps of a recorded run differentiated by ``group`` (the steps closing one set
     of contacts at a time) and chained by :mod:`impactqp.kernels.sensitivity`, with the
-    activation kinks of every step (docs/theory.md §21)."""
+    activation kinks of every step (docs/theory.md §21).
+
+    ``dofs``: the groups give each step's tangent in the degrees of freedom rather than in
+    the rows of H (Ŵ⁻¹H_C T H_Cᵀ in place of T, "contacts" 0 … n − 1), which the chain
+    then reads with Ŵ⁻¹H and Hᵀ replaced by the identity: cheaper when a step closes more
+    rows than the system has degrees of freedom."""
     h, tol, t0 = settings["h"], settings["tol"], settings["t0"]
     gaps = np.atleast_2d(system.gaps(Q[:-1]))
     gam = np.atleast_2d(system.contact_velocities(V))
@@ -130,6 +136,9 @@ def chained(system: LinearSystem, maps: StepMaps, Q: np.ndarray, V: np.ndarray,
             margin = min(margin, low)
             found.extend(flagged)
     tangents = _stack(parts, cols.pcols)
+    if dofs:
+        eye = np.eye(system.n_dof)
+        maps = maps._replace(MinvH=eye, Ht=eye)
     out = np.empty((Q.shape[0],) + cols.S0.shape)
     forward(maps, tangents, np.ascontiguousarray(cols.S0), out)
 

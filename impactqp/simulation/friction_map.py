@@ -60,13 +60,15 @@ def frictional_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.nd
     """
     maps, _ = step_maps(system, settings["h"], settings["theta"])
     mu, e = coulomb_coefficients(law, system)
-    group = partial(_steps, maps.Ht, maps.MinvH, (mu, e, system.contact_dim), cols)
-    return chained(system, maps, Q, V, L, settings, cols, group)
+    dofs = system.H.shape[1] > system.n_dof  # more rows than dofs: chain in the dofs
+    group = partial(_steps, maps.Ht, maps.MinvH, (mu, e, system.contact_dim), cols, dofs)
+    return chained(system, maps, Q, V, L, settings, cols, group, dofs=dofs)
 
 
-def _steps(Ht: np.ndarray, MinvH: np.ndarray, law: tuple, cols: Columns, K: np.ndarray,
-           C: np.ndarray, run: Run) -> tuple[list, float, list[Flagged]]:
-    """The tangents of the steps K that close the contacts C, one per step, the smallest
+def _steps(Ht: np.ndarray, MinvH: np.ndarray, law: tuple, cols: Columns, dofs: bool,
+           K: np.ndarray, C: np.ndarray, run: Run) -> tuple[list, float, list[Flagged]]:
+    """The tangents of the steps K that close the contacts C, one per step (in the rows of
+    H, or in the dofs with ``dofs``: see :func:`.discrete_map.chained`), the smallest
     relative margin and the contacts on a kink."""
     mu_all, e_all, d = law
     L, gam, VF, tol = run
@@ -95,6 +97,9 @@ def _steps(Ht: np.ndarray, MinvH: np.ndarray, law: tuple, cols: Columns, K: np.n
     e_rows = np.zeros(rows.size)
     e_rows[::d] = e
     parts = [(K, rows, T, T * e_rows, Tp)]
+    if dofs:
+        Y, Hr = MinvH[:, rows], Ht[rows]
+        parts = [(K, np.arange(Y.shape[0]), Y @ T @ Hr, Y @ (T * e_rows) @ Hr, Y @ Tp)]
     return parts, margin, [(kind, K, C, mask) for kind, mask in flagged.items()]
 
 
