@@ -67,6 +67,24 @@ def test_thrown_sphere_equals_central_differences_of_the_discrete_map(name):
     assert np.abs(S - fd).max() <= 1e-6 * max(1.0, np.abs(fd).max())
 
 
+@pytest.mark.parametrize("mass", [1e-12, 1e12])
+def test_the_derivative_and_its_kinks_do_not_depend_on_the_unit_of_mass(mass):
+    """Under gravity and friction the motion is the same for every mass, and so are its
+    derivative and the modes read in contact units."""
+    def run(data: dict, **kw) -> iq.Trajectory:
+        base = iq.simulation.rolling_sphere(mass=mass)
+        system = LinearSystem(base.M, data["q0"], data["v0"], base.constant_force, base.H,
+                              base.b, contact_dim=2)
+        law = iq.Coulomb(float(data["mu"][0]), float(data["restitution"][0]))
+        return iq.simulate(system, law, 1.5, h=1e-3, **kw)
+
+    tr, unit = run(THROWN, sensitivities=NAMES), _thrown(THROWN, sensitivities=NAMES)
+    assert tr.kinks == [] and tr.sensitivities.margin == pytest.approx(
+        unit.sensitivities.margin, rel=1e-6)
+    assert np.abs(tr.sensitivity() - unit.sensitivity()).max() <= 1e-8 * np.abs(
+        unit.sensitivity()).max()
+
+
 def test_both_frictional_loops_give_the_same_derivative():
     compiled = _thrown(THROWN, sensitivities=NAMES)
     python = _thrown(THROWN, sensitivities=NAMES, backend="nsgs")

@@ -83,7 +83,7 @@ def _steps(Ht: np.ndarray, MinvH: np.ndarray, law: tuple, cols: Columns, dofs: b
     s = np.repeat(np.sqrt(np.maximum(np.diag(W)[::d], 1e-300)), d)  # contact units per row
     speed = np.maximum(np.maximum(np.abs(q).max(axis=1), np.abs(gamma_k).max(axis=1)),
                        1e-300)[:, None]
-    modes, flagged, margin = _modes(r * s, U / s, mu, d, speed, tol)
+    modes, flagged, margin = _modes(r * s, U / s, mu, d, speed / s[::d], tol)
     FL, FU, Fmu = mode_equations(modes, r * s, U / s, mu, d)
     inverse, loose = _inverse(FL + FU @ (W / np.outer(s, s)), MinvH[:, rows] / s)
     flagged["indeterminate"] = np.repeat(loose[:, None], C.size, axis=1)
@@ -117,7 +117,8 @@ def _inverse(J: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _modes(r: np.ndarray, U: np.ndarray, mu: np.ndarray, d: int, speed: np.ndarray,
            tol: float) -> tuple[np.ndarray, dict[str, np.ndarray], float]:
     """(the mode of each step's contacts (s, |C|), the contacts on a kink by kind, the
-    smallest relative distance to one) from r and U in contact units."""
+    smallest relative distance to one) from r and U in contact units, relative to each
+    step's speed in the same units ((s, |C|): velocities over s)."""
     rn, un = r[:, ::d] / speed, U[:, ::d] / speed
     rt = np.linalg.norm(r.reshape(r.shape[0], -1, d)[:, :, 1:], axis=2) / speed
     ut = np.linalg.norm(U.reshape(U.shape[0], -1, d)[:, :, 1:], axis=2) / speed
