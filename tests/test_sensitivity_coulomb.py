@@ -215,13 +215,29 @@ def test_adjoint_is_the_transposed_chain():
     assert isinstance(final["mu"], float) and final["q0"].shape == (3,)
 
 
-def test_per_contact_coefficients_have_one_column_each():
-    base = iq.simulation.box_on_floor(dim=2, velocity=1.0, gap=-1e-9)
-    tr = iq.simulate(base, iq.Coulomb([0.2, 0.4], [0.1, 0.3]), 0.2, h=1e-3,
-                     sensitivities=("mu", "restitution"))
-    assert tr.sensitivity("mu").shape == (tr.t.size, 6, 2)
+SPUN = {"mu": np.array([0.2, 0.4]), "restitution": np.array([0.1, 0.3])}
+"""One μ and one e per corner of a box in the plane, dropped sliding and turning."""
+
+
+def _spun(data: dict, **kw) -> iq.Trajectory:
+    base = iq.simulation.box_on_floor(dim=2, velocity=1.0, gap=0.05)
+    system = LinearSystem(base.M, base.q0, base.v0 + np.array([0.0, 0.0, 1.0]),
+                          base.constant_force, base.H, base.b, contact_dim=2)
+    return iq.simulate(system, iq.Coulomb(data["mu"], data["restitution"]), 0.4, h=1e-3,
+                       **kw)
+
+
+@pytest.mark.parametrize("name", ["mu", "restitution"])
+def test_per_contact_coefficients_have_one_column_each(name):
+    tr = _spun(SPUN, sensitivities=("mu", "restitution"))
+    assert tr.sensitivity(name).shape == (tr.t.size, 6, 2)
     grads = tr.vjp(q=np.ones(3))
     assert grads["mu"].shape == (2,) and grads["restitution"].shape == (2,)
+    # where the box stops, one corner's grip saturates and the other holds the rest
+    assert {k.kind for k in tr.kinks} == {"stick-slide"}
+    fd = _central(_spun, SPUN, name)
+    assert np.abs(fd).max() > 0.05
+    assert np.abs(tr.sensitivity(name)[-1] - fd).max() <= 1e-7 * np.abs(fd).max()
 
 
 @pytest.mark.parametrize("kw, match", [
