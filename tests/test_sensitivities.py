@@ -151,8 +151,8 @@ def test_callable_force_and_missing_sensitivities_are_refused():
     with pytest.raises(InputError, match="callable force"):
         iq.simulate(ball, iq.Newton(0.9), 1.0, sensitivities=("q0",))
     block = iq.simulation.block_on_incline(0.3, dim=2, speed=1.0)
-    with pytest.raises(InputError, match="frictionless"):
-        iq.simulate(block, iq.Coulomb(0.5, 0.0), 0.05, h=1e-2, sensitivities=("q0",))
+    frictional = iq.simulate(block, iq.Coulomb(0.5, 0.0), 0.05, h=1e-2, sensitivities=("q0",))
+    assert frictional.sensitivity_kind == "discrete-map"  # tests/test_sensitivity_coulomb.py
     tr = iq.simulate(iq.simulation.bouncing_ball(), iq.Newton(0.9), 0.1)
     assert tr.sensitivity_kind is None
     with pytest.raises(InputError, match="no sensitivities"):

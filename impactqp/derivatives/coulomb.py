@@ -107,29 +107,9 @@ class CoulombMap(ComplementarityMap):
 
     def _equations(self, modes: list[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """F_Λ, F_U (m × m) and F_μ (m × contacts) of the modes' equations."""
-        m, d = self.W.shape[1], self.d
-        FL, FU, Fmu = np.zeros((m, m)), np.zeros((m, m)), np.zeros((m, m // d))
-        for c, mode in enumerate(modes):
-            a, T = c * d, slice(c * d + 1, c * d + d)
-            ln, lt, _, ut = self._parts(c)
-            if mode == SEPARATE:
-                FL[a:a + d, a:a + d] = np.eye(d)
-                continue
-            if mode == STICK:
-                FU[a:a + d, a:a + d] = np.eye(d)
-                continue
-            FU[a, a] = 1.0
-            size = np.linalg.norm(ut)
-            if mode == ONSET:
-                t = -lt / (np.linalg.norm(lt) or 1.0)
-            else:
-                t = ut / size if size > 0 else np.zeros(d - 1)
-            FL[T, T] = np.eye(d - 1)
-            FL[T, a] = self.mu[c] * t
-            Fmu[T, c] = ln * t
-            if mode == SLIDE and size > 0:
-                FU[T, T] = self.mu[c] * ln * (np.eye(d - 1) - np.outer(t, t)) / size
-        return FL, FU, Fmu
+        FL, FU, Fmu = mode_equations(np.array([modes]), self.lam[None], self.w[None],
+                                     self.mu, self.d)
+        return FL[0], FU[0], Fmu[0]
 
     def _use_modes(self, modes: list[int]) -> None:
         FL, FU, Fmu = self._equations(modes)
@@ -273,3 +253,35 @@ def coulomb_map(law: Any, problem: Any, answer: Any, kink_tol: float) -> Coulomb
     return CoulombMap(problem.M, problem.W, problem.u_minus, answer.impulses, d=d,
                       mu=law.mu, restitution=normal_rows("restitution", law.restitution, nc, d),
                       kink_tol=kink_tol, evaluate=evaluate)
+
+
+def mode_equations(modes: np.ndarray, lam: np.ndarray, U: np.ndarray, mu: np.ndarray,
+                   d: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """F_Λ, F_U (s, m, m) and F_μ (s, m, contacts) of the modes' equations F(Λ, U, μ) = 0
+    (docs/theory.md §18) for s answers at once: ``modes`` (s, contacts), ``lam`` and ``U``
+    (s, m), ``mu`` (contacts,), d rows per contact."""
+    s, m = lam.shape
+    FL, FU, Fmu = np.zeros((s, m, m)), np.zeros((s, m, m)), np.zeros((s, m, m // d))
+    eye = np.eye(d - 1)
+    for c in range(m // d):
+        a, T = c * d, slice(c * d + 1, c * d + d)
+        mode = modes[:, c]
+        FL[mode == SEPARATE, a:a + d, a:a + d] = np.eye(d)
+        FU[mode == STICK, a:a + d, a:a + d] = np.eye(d)
+        rows = np.flatnonzero((mode == SLIDE) | (mode == ONSET))
+        if rows.size == 0:
+            continue
+        ln, lt, ut = lam[rows, a], lam[rows, a + 1:a + d], U[rows, a + 1:a + d]
+        size = np.linalg.norm(ut, axis=1)
+        onset = mode[rows] == ONSET
+        grip = np.linalg.norm(lt, axis=1)
+        t = np.where(onset[:, None], -lt / np.where(grip > 0, grip, 1.0)[:, None],
+                     ut / np.where(size > 0, size, np.inf)[:, None])
+        FU[rows, a, a] = 1.0
+        FL[rows, T, T] = eye
+        FL[rows, T, a] = mu[c] * t
+        Fmu[rows, T, c] = ln[:, None] * t
+        bend = ~onset & (size > 0)
+        FU[rows[bend], T, T] = (mu[c] * ln[bend] / size[bend])[:, None, None] * (
+            eye - np.einsum("si,sj->sij", t[bend], t[bend]))
+    return FL, FU, Fmu

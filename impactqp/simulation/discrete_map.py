@@ -11,6 +11,10 @@ and chained by :mod:`impactqp.kernels.sensitivity`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import partial
+from typing import NamedTuple
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -45,6 +49,35 @@ def step_maps(system: LinearSystem, h: float, theta: float) -> tuple[StepMaps, n
     return maps, K
 
 
+class Run(NamedTuple):
+    """What the steps of a recorded run are differentiated from.
+
+    Attributes
+    ----------
+    L : (steps + 1, columns of H) ndarray
+        The impulses of the step ending at each record.
+    gam : (steps + 1, m) ndarray
+        The normal velocities γ_k at each record.
+    VF : (steps, n) ndarray
+        v_free of each step, v_{k+1} − Ŵ⁻¹HΛ as the step computed it.
+    tol : float
+        The run's certificate tolerance: quantities within it of a kink are on it.
+    """
+
+    L: np.ndarray
+    gam: np.ndarray
+    VF: np.ndarray
+    tol: float
+
+
+Flagged = tuple[str, np.ndarray, np.ndarray, np.ndarray]
+"""(kind, steps K, contacts C, (|K|, |C|) bool mask of the contacts on the kink)."""
+
+Group = Callable[[np.ndarray, np.ndarray, Run], tuple[list, float, list[Flagged]]]
+"""The tangents of the steps K that close the contacts C: (parts for :func:`_stack`, the
+smallest relative margin, the kinks found)."""
+
+
 def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndarray,
                  L: np.ndarray, settings: dict, cols: Columns) -> Sensitivities:
     """The ``"discrete-map"`` sensitivities of a Moreau–Jean run recorded at every step
@@ -61,35 +94,51 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
     cols : Columns
         What the tangents are taken with respect to.
     """
-    h, theta, tol, t0 = settings["h"], settings["theta"], settings["tol"], settings["t0"]
-    maps, _ = step_maps(system, h, theta)
+    maps, _ = step_maps(system, settings["h"], settings["theta"])
     E = full_restitution(law, system.n_contacts)
-    Gfull = maps.Ht @ maps.MinvH
-    Qk, Vk = Q[:-1], V[:-1]
-    gaps = np.atleast_2d(system.gaps(Qk))
-    gam = np.atleast_2d(system.contact_velocities(Vk))
-    predicted = predicted_gap(gaps, gam, h)  # the activation rule's own quantity
+    group = partial(_group, maps.Ht @ maps.MinvH, maps.Ht, E, cols)
+    return chained(system, maps, Q, V, L, settings, cols, group)
+
+
+def chained(system: LinearSystem, maps: StepMaps, Q: np.ndarray, V: np.ndarray,
+            L: np.ndarray, settings: dict, cols: Columns, group: Group, *,
+            dofs: bool = False) -> Sensitivities:
+    """The steps of a recorded run differentiated by ``group`` (the steps closing one set
+    of contacts at a time) and chained by :mod:`impactqp.kernels.sensitivity`, with the
+    activation kinks of every step (docs/theory.md §21).
+
+    ``dofs``: the groups give each step's tangent in the degrees of freedom rather than in
+    the rows of H (Ŵ⁻¹H_C T H_Cᵀ in place of T, "contacts" 0 … n − 1), which the chain
+    then reads with Ŵ⁻¹H and Hᵀ replaced by the identity: cheaper when a step closes more
+    rows than the system has degrees of freedom."""
+    h, tol, t0 = settings["h"], settings["tol"], settings["t0"]
+    gaps = np.atleast_2d(system.gaps(Q[:-1]))
+    gam = np.atleast_2d(system.contact_velocities(V))
+    predicted = predicted_gap(gaps, gam[:-1], h)  # the activation rule's own quantity
     closed = np.empty(gaps.size, dtype=bool)
-    activation(np.ascontiguousarray(gaps).ravel(), np.ascontiguousarray(gam).ravel(), h, closed)
+    activation(np.ascontiguousarray(gaps).ravel(), np.ascontiguousarray(gam[:-1]).ravel(), h,
+               closed)
     closed = closed.reshape(gaps.shape)
     length = max(float(np.abs(gaps).max(initial=0.0)),
-                 h * float(np.abs(gam).max(initial=0.0)), 1e-300)
+                 h * float(np.abs(gam[:-1]).max(initial=0.0)), 1e-300)
     margin = float(np.abs(predicted).min(initial=np.inf)) / length
     near = np.argwhere(np.abs(predicted) <= tol * length)
     found: list[tuple] = [(near[:, 0], near[:, 1], np.abs(predicted[near[:, 0], near[:, 1]])
                            / length)]
-    VF = V[1:] - L[1:] @ maps.MinvH.T  # v_free = v_{k+1} − Ŵ⁻¹HΛ, as the step computed it
+    run = Run(L, gam, V[1:] - L[1:] @ maps.MinvH.T, tol)
     steps = np.flatnonzero(closed.any(axis=1))
     parts = []
     if steps.size:
         patterns, which = _patterns(closed[steps])
         for g, mask in enumerate(patterns):  # the steps that close the same contacts
-            part, low, flat = _group(steps[which == g], np.flatnonzero(mask), Gfull,
-                                     maps.Ht, E, cols, (L, gam, VF, tol))
+            part, low, flagged = group(steps[which == g], np.flatnonzero(mask), run)
             parts.extend(part)
             margin = min(margin, low)
-            found.append(flat)
+            found.extend(flagged)
     tangents = _stack(parts, cols.pcols)
+    if dofs:
+        eye = np.eye(system.n_dof)
+        maps = maps._replace(MinvH=eye, Ht=eye)
     out = np.empty((Q.shape[0],) + cols.S0.shape)
     forward(maps, tangents, np.ascontiguousarray(cols.S0), out)
 
@@ -100,20 +149,20 @@ def discrete_map(system: LinearSystem, law: ImpactLaw, Q: np.ndarray, V: np.ndar
         steps_, contacts_, distances = found[0]
         listed = [TrajectoryKink(float(t0 + k * h), "activation", (int(i),), float(d))
                   for k, i, d in zip(steps_, contacts_, distances)]
-        for K, C, degenerate in found[1:]:
-            listed += [TrajectoryKink(float(t0 + (k + 1) * h), "degenerate",
-                                   tuple(int(c) for c in C[row]), 0.0)
-                       for k, row in zip(K, degenerate)]
+        for kind, K, C, masks in found[1:]:
+            listed += [TrajectoryKink(float(t0 + (k + 1) * h), kind,
+                                      tuple(int(c) for c in C[row]), 0.0)
+                       for k, row in zip(K, masks) if row.any()]
         return sorted(listed, key=lambda kink: kink.time)
 
     return Sensitivities("discrete-map", cols, out, transposed, kinks, margin)
 
 
-def _group(K: np.ndarray, C: np.ndarray, Gfull: np.ndarray, Ht: np.ndarray, E: np.ndarray,
-           cols: Columns, run: tuple) -> tuple[list, float, tuple]:
+def _group(Gfull: np.ndarray, Ht: np.ndarray, E: np.ndarray, cols: Columns, K: np.ndarray,
+           C: np.ndarray, run: Run) -> tuple[list, float, list[Flagged]]:
     """The LCP tangents of the steps K that close the contacts C, one per active set
     (T depends on the active set only), the smallest relative margin and the degenerate
-    steps (steps, C, their degenerate masks)."""
+    steps."""
     L, gam, VF, tol = run
     G, ECC = Gfull[np.ix_(C, C)], E[np.ix_(C, C)]
     lam, gamma_k = L[K + 1][:, C], gam[K][:, C]
@@ -124,7 +173,6 @@ def _group(K: np.ndarray, C: np.ndarray, Gfull: np.ndarray, Ht: np.ndarray, E: n
     aset = classify((lam * np.diag(G)) / speed, (lam @ G + q_step) / speed, tol)
     active = aset.active.reshape(lam.shape)
     degenerate = aset.degenerate.reshape(lam.shape)
-    touching = degenerate.any(axis=1)
     R = np.einsum("jab,sb->saj", cols.directions[:, C][:, :, C], gamma_k)
     parts = []
     pressed = active.any(axis=1)
@@ -135,7 +183,7 @@ def _group(K: np.ndarray, C: np.ndarray, Gfull: np.ndarray, Ht: np.ndarray, E: n
             T = tangent(G, lam[rows[0]], ActiveSet(mask, np.zeros_like(mask), aset.margin),
                         dq=np.eye(C.size))
             parts.append((K[rows], C, T, T @ ECC, np.einsum("ab,sbj->saj", T, R[rows])))
-    return parts, aset.margin, (K[touching], C, degenerate[touching])
+    return parts, aset.margin, [("degenerate", K, C, degenerate)]
 
 
 def _patterns(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

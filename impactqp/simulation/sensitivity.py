@@ -35,13 +35,16 @@ class TrajectoryKink(NamedTuple):
         ``"activation"`` (a contact on the Moreau–Jean threshold g + ½hγ = 0, where the
         discrete map jumps), ``"degenerate"`` (Λᵢ = 0 = wᵢ in a step's or an impact's LCP),
         ``"grazing"`` (an impact or a touch with ∇g·f⁻ ≈ 0), ``"zeno"`` (an accumulation
-        of impacts settled into contact) or ``"simultaneous"`` (contacts closing at one
-        event).
+        of impacts settled into contact), ``"simultaneous"`` (contacts closing at one
+        event), ``"stick-slide"`` (a frictional contact of a step on the edge of its
+        cone: ‖Λ_T‖ = μΛ_n with U_T = 0) or ``"indeterminate"`` (a frictional step whose
+        impulses, and velocities, the law does not fix: redundant contacts sliding).
     contacts : tuple of int
     distance : float
         How far the run is from the kink, relative to the run's scale: abs(g + ½hγ) over its
         length scale (activation), ∇g·f⁻ or the least gap over its velocity or length
-        scale (grazing); 0 where the run sits on the kink (degenerate, Zeno, simultaneous).
+        scale (grazing); 0 where the run sits on the kink (degenerate, Zeno, simultaneous,
+        stick-slide, indeterminate).
     """
 
     time: float
@@ -60,22 +63,75 @@ def full_restitution(law: ImpactLaw, m: int) -> np.ndarray:
     return E * np.eye(m) if E.ndim == 0 else (np.diag(E) if E.ndim == 1 else E)
 
 
+def coefficient_directions(value: Any, m: int) -> np.ndarray:
+    """∂c/∂pⱼ of a coefficient c given as one number for all m contacts (one column p, c = p
+    on every contact) or one per contact (m columns), as (p, m)."""
+    return np.ones((1, m)) if np.size(value) == 1 else np.eye(m)
+
+
 def parameter_directions(law: ImpactLaw, m: int) -> np.ndarray:
     """∂E/∂pⱼ for the law's coefficients p (its ``coefficient_key``), as (p, m, m): one
     coefficient for all contacts (ε, a scalar e), one per contact (a vector e) or Frémond's
     m × m matrix, row-major."""
     c = np.asarray(law.coefficients, dtype=float)
-    if c.size == 1:
-        return np.eye(m)[None]
-    if c.ndim == 1:
-        out = np.zeros((m, m, m))
-        out[np.arange(m), np.arange(m), np.arange(m)] = 1.0
+    if c.ndim == 2:
+        return np.eye(m * m).reshape(m * m, m, m)
+    return diagonal(coefficient_directions(c, m))
+
+
+def diagonal(rows: np.ndarray) -> np.ndarray:
+    """(p, m, m): each row of a (p, m) array as a diagonal matrix."""
+    out = np.zeros(rows.shape + rows.shape[-1:])
+    out[:, np.arange(rows.shape[1]), np.arange(rows.shape[1])] = rows
+    return out
+
+
+FRICTION_PARAMETERS = ("mu", "restitution")
+"""The names of Coulomb's parameters in ``sensitivities=``: μ and Newton's e of the normal
+rows, as :meth:`impactqp.Coulomb.derivative` names them."""
+
+
+def _parameters(law: ImpactLaw, m: int) -> dict[str, tuple[np.ndarray, np.ndarray, tuple]]:
+    """name → (∂E/∂pⱼ (p, m, m), ∂μ/∂pⱼ (p, m), the parameter's shape) of each parameter of
+    the law that a run can be differentiated in."""
+    if law.frictional:
+        out = {}
+        for name in FRICTION_PARAMETERS:
+            value = getattr(law, name)
+            rows = coefficient_directions(value, m)
+            zero = np.zeros_like(rows)
+            shape = np.shape(value) if np.size(value) > 1 else ()
+            out[name] = (diagonal(zero), rows, shape) if name == "mu" else \
+                (diagonal(rows), zero, shape)
         return out
-    return np.eye(m * m).reshape(m * m, m, m)
+    key = law.coefficient_key
+    if not key or law.step_restitution(np.arange(m)) is None:
+        return {}
+    dE = parameter_directions(law, m)
+    return {key: (dE, np.zeros(dE.shape[:2]), np.shape(law.coefficients)
+                  if np.size(law.coefficients) > 1 else ())}
 
 
 class Columns(NamedTuple):
-    """The tangent columns of each name the user asked for."""
+    """The tangent columns of each name the user asked for.
+
+    Attributes
+    ----------
+    names : tuple of str
+    slices : dict
+        name → its tangent columns.
+    shapes : dict
+        name → the shape of its cotangent.
+    S0 : (2n, k) ndarray
+        The tangents of (q₀, v₀).
+    pcols : (p,) int ndarray
+        The tangent columns of the law's parameters, in the order of ``names``.
+    directions : (p, m, m) ndarray
+        ∂E/∂pⱼ: the restitution of the step form (Coulomb's e on the diagonal, acting on
+        the normal rows).
+    mu_directions : (p, m) ndarray
+        ∂μ/∂pⱼ (zero for the frictionless laws).
+    """
 
     names: tuple[str, ...]
     slices: dict[str, slice]
@@ -83,11 +139,13 @@ class Columns(NamedTuple):
     S0: np.ndarray
     pcols: np.ndarray
     directions: np.ndarray
+    mu_directions: np.ndarray
 
 
 def columns(wrt: Sequence[str], law: ImpactLaw, n: int, m: int) -> Columns:
-    """Parse ``sensitivities=`` into tangent columns: ``"q0"`` and ``"v0"`` n each, the
-    law's parameter one per coefficient.
+    """Parse ``sensitivities=`` into tangent columns: ``"q0"`` and ``"v0"`` n each, each
+    parameter of the law one per coefficient (``"eps"``, ``"e"`` or ``"E"`` of a
+    complementarity law; ``"mu"`` and ``"restitution"`` of Coulomb's).
 
     Raises
     ------
@@ -97,26 +155,31 @@ def columns(wrt: Sequence[str], law: ImpactLaw, n: int, m: int) -> Columns:
     if isinstance(wrt, str) or not all(isinstance(w, str) for w in wrt):
         raise InputError(f"sensitivities must be a sequence of names like ('q0', 'v0'), got "
                          f"{wrt!r}")
-    key = law.coefficient_key
-    known = ("q0", "v0") + ((key,) if key and law.step_restitution(np.arange(m)) is not None
-                            else ())
+    parameters = _parameters(law, m)
+    known = ("q0", "v0") + tuple(parameters)
     bad = [w for w in wrt if w not in known]
     if bad or not wrt or len(set(wrt)) != len(wrt):
         raise InputError(f"sensitivities takes distinct names among {known} for {law.name!r}, "
                          f"got {tuple(wrt)!r}")
-    directions = parameter_directions(law, m) if key in wrt else np.zeros((0, m, m))
     slices, shapes, start = {}, {}, 0
+    dE, dmu, pcols = [np.zeros((0, m, m))], [np.zeros((0, m))], []
     for w in wrt:
-        size = n if w in ("q0", "v0") else directions.shape[0]
+        size = n if w in ("q0", "v0") else parameters[w][1].shape[0]
         slices[w], start = slice(start, start + size), start + size
-        shapes[w] = (n,) if w in ("q0", "v0") else np.shape(law.coefficients) \
-            if np.size(law.coefficients) > 1 else ()
+        if w in ("q0", "v0"):
+            shapes[w] = (n,)
+            continue
+        dE.append(parameters[w][0])
+        dmu.append(parameters[w][1])
+        shapes[w] = parameters[w][2]
+        pcols.append(np.arange(slices[w].start, slices[w].stop))
     S0 = np.zeros((2 * n, start))
     for w, rows in (("q0", slice(0, n)), ("v0", slice(n, 2 * n))):
         if w in slices:
             S0[rows, slices[w]] = np.eye(n)
-    pcols = np.arange(start)[slices[key]] if key in slices else np.zeros(0, dtype=np.int64)
-    return Columns(tuple(wrt), slices, shapes, S0, pcols.astype(np.int64), directions)
+    return Columns(tuple(wrt), slices, shapes, S0,
+                   np.concatenate(pcols or [np.zeros(0)]).astype(np.int64),
+                   np.concatenate(dE), np.concatenate(dmu))
 
 
 class Sensitivities:
@@ -191,12 +254,16 @@ class Sensitivities:
             raise InputError("the cotangents must be finite")
         ax0, ap = self._adjoint(cot)
         out: dict[str, Any] = {}
+        start = 0  # ap holds the parameters' cotangents in the order of the names
         for name in self.cols.names:
             if name == "q0":
                 out[name] = ax0[:n].copy()
             elif name == "v0":
                 out[name] = ax0[n:].copy()
             else:
-                shape = self.cols.shapes[name]
-                out[name] = float(ap[0]) if shape == () else ap.reshape(shape)
+                part = self.cols.slices[name]
+                size, shape = part.stop - part.start, self.cols.shapes[name]
+                piece = ap[start:start + size]
+                start += size
+                out[name] = float(piece[0]) if shape == () else piece.reshape(shape)
         return out

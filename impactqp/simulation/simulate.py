@@ -91,11 +91,13 @@ def simulate(system: LinearSystem, law: ImpactLaw, t_end: float,
     sensitivities : sequence of str, optional
         Differentiate the run with respect to these (docs/theory.md §21): ``"q0"``,
         ``"v0"`` and the law's parameter (``"eps"`` for Moreau, ``"e"`` for Newton, ``"E"``
-        for Frémond). Moreau–Jean gives the derivative of its discrete map
+        for Frémond, ``"mu"`` and ``"restitution"`` for Coulomb). Moreau–Jean gives the
+        derivative of its discrete map
         (``trajectory.sensitivity_kind == "discrete-map"``), event-driven integration the
         derivative of the motion (``"flow"``, saltation at each impact); read them with
         ``trajectory.sensitivity(...)``, ``trajectory.vjp(...)`` and ``trajectory.kinks``.
-        Frictionless complementarity laws under a constant or linear force only.
+        Complementarity laws and Coulomb's (Moreau–Jean only) under a constant or linear
+        force.
     **options
         Moreau–Jean: ``record_every`` (int), ``keep_events`` (bool). Event-driven:
         ``gap_tol`` (1e-10 of the system's length scale), ``rest_velocity`` (1e-7 of its
