@@ -120,6 +120,34 @@ def test_vmap_is_one_impact_per_row() -> None:
         assert np.isclose(ge[i], own["eps"], atol=1e-12)
 
 
+@pytest.mark.parametrize("name", ["cradle-newton", "random-fremond"])
+def test_forward_mode_is_impactqps_jvp(name: str) -> None:
+    problem, law, params = CASES[name]
+    (key, value), = params.items()
+    d = iq.derivative(problem, law)
+    f = impact_map(problem, law, mode="forward", impulses=True)
+    u = jnp.asarray(problem.u_minus)
+    J = jax.jacfwd(lambda u: f(u)[0])(u)
+    assert np.allclose(J, d.jacobian("u_minus"), atol=1e-12)
+    rng = np.random.default_rng(3)
+    du, dp = rng.normal(size=problem.n_dof), rng.normal(size=np.shape(value))
+    out, tangent = jax.jit(lambda u, p, du, dp: jax.jvp(lambda u, p: f(u, {key: p}), (u, p),
+                                                         (du, dp)))(
+        u, jnp.asarray(value), jnp.asarray(du), jnp.asarray(dp))
+    own = d.jvp(u_minus=du, **{key: dp})
+    assert np.allclose(tangent[0], own.u_plus, atol=1e-12)
+    assert np.allclose(tangent[1], own.impulses, atol=1e-12)
+    # the same numbers as reverse mode's VJP: ⟨w, J du⟩ = ⟨Jᵀw, du⟩
+    w = np.linspace(1.0, 2.0, problem.n_dof)
+    back = d.vjp(u_plus=w)
+    assert np.isclose(w @ tangent[0], back["u_minus"] @ du + np.sum(back[key] * dp),
+                      rtol=1e-10)
+    rows = jax.vmap(lambda du: jax.jvp(lambda u: f(u)[0], (u,), (du,))[1])(jnp.eye(problem.n_dof))
+    assert np.allclose(rows.T, J, atol=1e-12)
+    with pytest.raises(ValueError, match="callbacks do not support transpose"):
+        jax.grad(lambda u: jnp.sum(f(u)[0]))(u)  # reverse mode is the other function
+
+
 def test_kink_uses_the_default_element() -> None:
     # docs/theory.md §19: three equal balls, u⁻ = (1, 0, ½), ε = 0; contact 2 is degenerate
     problem = iq.newtons_cradle(3).with_u_minus([1.0, 0.0, 0.5])
@@ -147,6 +175,19 @@ def test_coulomb_mu_gradient() -> None:
     assert np.allclose(g, [-1.3, 0.0], atol=1e-10)
 
 
+def test_sector_law_is_a_permutation_with_the_stable_sort_at_ties() -> None:
+    # docs/theory.md §19: u⁺ = Pu⁻, P the sorting permutation; at a tie, the stable sort
+    problem = iq.newtons_cradle(3).with_u_minus([1.0, 0.5, 0.5])
+    d = iq.derivative(problem, iq.SectorLaw())
+    assert d.status == "kink"
+    f = impact_map(problem, iq.SectorLaw())
+    assert f.parameters == {}
+    J = np.asarray(jax.jacrev(f)(jnp.asarray(problem.u_minus)))
+    assert np.allclose(J, d.jacobian(), atol=0)
+    assert set(np.unique(J)) == {0.0, 1.0} and np.all(J.sum(axis=0) == 1)  # a permutation
+    assert any(np.array_equal(J, L) for L in d.limiting_jacobians())
+
+
 def test_unsupported_laws_and_bad_input_are_refused_by_name() -> None:
     cradle = iq.newtons_cradle(3)
     with pytest.raises(DerivativeUnsupportedError, match="LZB"):
@@ -160,8 +201,10 @@ def test_unsupported_laws_and_bad_input_are_refused_by_name() -> None:
         f(jnp.ones(3), {"e": 0.5})
     with pytest.raises(ShapeError, match="eps"):
         f(jnp.ones(3), {"eps": jnp.ones(2)})
-    with pytest.raises(TypeError, match="forward-mode"):  # reverse mode only, said by jax
+    with pytest.raises(TypeError, match="forward-mode"):  # mode="forward" is another function
         jax.jvp(f, (jnp.ones(3),), (jnp.ones(3),))
+    with pytest.raises(InputError, match="mode"):
+        impact_map(cradle, iq.Moreau(0.5), mode="both")
     with pytest.raises(ValueError, match="callbacks do not support JVP"):  # no 2nd derivative
         jax.grad(lambda u: jnp.sum(jax.grad(lambda v: jnp.sum(f(v) ** 2))(u)))(jnp.ones(3))
 

@@ -12,6 +12,7 @@ derivative whose own certificate fails is refused, never returned.
 from __future__ import annotations
 
 import inspect
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -26,36 +27,33 @@ DATA = ("u_minus", "M", "W")
 """Inputs of a derivative that are the problem's data, not the law's parameters."""
 
 
-def law_with(law: Any, values: dict[str, np.ndarray]) -> Any:
-    """``law`` with its parameters replaced by ``values``, built by its own constructor: the
-    names a law's derivative differentiates in are its constructor's keywords (``eps``,
-    ``e``, ``E``, ``mu``, ``restitution``); the other keywords keep the law's attributes of
-    the same name.
+def rebuilder(law: Any, names: tuple[str, ...]) -> Callable[[dict[str, Any]], Any]:
+    """values ↦ ``law`` with the parameters ``names`` set to ``values``, built by its own
+    constructor: the names a law's derivative differentiates in are its constructor's
+    keywords (``eps``, ``e``, ``E``, ``mu``, ``restitution``); the other keywords keep the
+    law's attributes of the same name. The constructor is read once, here.
 
     Raises
     ------
     InputError
-        The law's constructor takes no keyword of that name.
+        The law's constructor takes no keyword of one of ``names``, or needs one that is not
+        an attribute of the law.
     """
-    if not values:
-        return law
     signature = inspect.signature(type(law))
-    unknown = sorted(set(values) - set(signature.parameters))
+    unknown = sorted(set(names) - set(signature.parameters))
     if unknown:
         raise InputError(f"{law.title}: its constructor takes no {', '.join(unknown)}, so the "
                          "adapters cannot set it (they rebuild the law by its keywords)")
-    kwargs = {}
+    kept = {}
     for name, param in signature.parameters.items():
-        if name in values:
-            kwargs[name] = values[name]
-        elif param.kind in (param.VAR_POSITIONAL, param.VAR_KEYWORD):
+        if name in names or param.kind in (param.VAR_POSITIONAL, param.VAR_KEYWORD):
             continue
-        elif hasattr(law, name):
-            kwargs[name] = getattr(law, name)
+        if hasattr(law, name):
+            kept[name] = getattr(law, name)
         elif param.default is param.empty:
             raise InputError(f"{law.title}: cannot rebuild it with new parameters, its "
                              f"constructor's {name!r} is not an attribute of the law")
-    return type(law)(**kwargs)
+    return lambda values: type(law)(**kept, **values)
 
 
 class ImpactMap:
@@ -101,6 +99,7 @@ class ImpactMap:
         values = first.local.values()
         self.parameters = {k: tuple(s) for k, s in first.inputs.items() if k not in DATA}
         self.defaults = {k: np.asarray(values[k], dtype=float).copy() for k in self.parameters}
+        self._rebuild = rebuilder(law, tuple(self.parameters))
         self.n, self.m = problem.n_dof, problem.n_impulses
 
     def __repr__(self) -> str:
@@ -134,9 +133,15 @@ class ImpactMap:
         return arr
 
     # ------------------------------------------------------------------ the map
+    def law_at(self, params: dict[str, Any] | None) -> Any:
+        """The law with ``params`` (checked; the law itself where they are its own values)."""
+        values = self.values(params)
+        if all(np.array_equal(values[k], self.defaults[k]) for k in values):
+            return self.law
+        return self._rebuild(values)
+
     def _result(self, u_minus: Any, params: dict[str, Any] | None) -> Any:
-        given = self.values(params)
-        law = law_with(self.law, {k: given[k] for k in params or {}})
+        law = self.law_at(params)
         problem = self.problem.with_u_minus(self._velocity("u_minus", u_minus))
         return solve(problem, law, self.backend, tol=self.tol)
 
