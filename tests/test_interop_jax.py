@@ -166,15 +166,6 @@ def test_kink_uses_the_default_element() -> None:
                        [-0.5, 0.5, 0.0], atol=1e-12)
 
 
-def test_coulomb_mu_gradient() -> None:
-    problem = iq.ImpactProblem(np.eye(2), np.array([[0.0, 1.0], [1.0, 0.0]]), [0.9, -1.0],
-                               contact_dim=2)  # it slides: ∂u⁺ₓ/∂μ = −(1 + e) = −1.3
-    f = impact_map(problem, iq.Coulomb(0.5, 0.3))
-    assert set(f.parameters) == {"mu", "restitution"}
-    g = jax.jacrev(lambda mu: f(jnp.asarray(problem.u_minus), {"mu": mu}))(0.5)
-    assert np.allclose(g, [-1.3, 0.0], atol=1e-10)
-
-
 def test_sector_law_is_a_permutation_with_the_stable_sort_at_ties() -> None:
     # docs/theory.md §19: u⁺ = Pu⁻, P the sorting permutation; at a tie, the stable sort
     problem = iq.newtons_cradle(3).with_u_minus([1.0, 0.5, 0.5])
@@ -189,9 +180,7 @@ def test_sector_law_is_a_permutation_with_the_stable_sort_at_ties() -> None:
 
 
 def test_unsupported_laws_and_bad_input_are_refused_by_name() -> None:
-    cradle = iq.newtons_cradle(3)
-    with pytest.raises(DerivativeUnsupportedError, match="LZB"):
-        impact_map(cradle, iq.LZB(1e6))
+    cradle = iq.newtons_cradle(3)  # (the LZB model, refused alike: tests/test_interop_torch.py)
     with pytest.raises(DerivativeUnsupportedError, match="reflection"):
         impact_map(cradle, iq.ReflectionLaw())
     f = impact_map(cradle, iq.Moreau(0.5))

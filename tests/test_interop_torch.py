@@ -84,6 +84,22 @@ def test_kink_uses_the_default_element() -> None:
     assert np.allclose(J, [[0.5, 0.5, 0], [0.5, 0.5, 0], [0, 0, 1]], atol=1e-12)
 
 
+def test_coulomb_gradients_in_mu_and_restitution() -> None:
+    # a point mass sliding on a floor (docs/theory.md §18): ∂u⁺ₓ/∂μ = −(1 + e) = −1.3
+    problem = iq.ImpactProblem(np.eye(2), np.array([[0.0, 1.0], [1.0, 0.0]]), [0.9, -1.0],
+                               contact_dim=2)
+    law = iq.Coulomb(0.5, 0.3, method="nsgs")  # a keyword the rebuilt law keeps
+    f = impact_map(problem, law)
+    assert f.parameters == {"mu": (), "restitution": ()}
+    u, mu, e = leaf(problem.u_minus), leaf(0.5), leaf(0.3)
+    assert torch.autograd.gradcheck(lambda u, mu, e: f(u, {"mu": mu, "restitution": e}),
+                                    (u, mu, e))
+    f(u, {"mu": mu, "restitution": e})[0].backward()
+    assert np.isclose(mu.grad.item(), -1.3) and np.isclose(e.grad.item(), -0.5)
+    d = iq.derivative(problem, law)
+    assert np.allclose(u.grad.numpy(), d.jacobian()[0], atol=1e-12)
+
+
 def test_the_autograd_function_itself() -> None:
     f = impact_map(CRADLE, iq.Moreau(0.5))
     u = leaf(CRADLE.u_minus)
