@@ -1,7 +1,8 @@
 """The autodiff adapters are never imported unless asked (docs/interop.rst): ``import
 impactqp`` (and its derivatives, and ``impactqp.interop`` itself) leaves jax and torch out
 of ``sys.modules``, and a missing framework is a named error that says which extra to
-install. Run in fresh interpreters, so what this session imported does not count."""
+install. Run in fresh interpreters, so what this session imported does not count. Also what
+the jax and torch tests share: the page's snippets, and a user's law with a derivative hook."""
 
 from __future__ import annotations
 
@@ -11,7 +12,11 @@ import sys
 import textwrap
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+import impactqp as iq
+from impactqp.results import LinearPiece
 
 
 def run(code: str) -> subprocess.CompletedProcess:
@@ -57,3 +62,24 @@ def page_snippet(module: str) -> str:
     found = [textwrap.dedent(b) for b in blocks if f"from {module} import" in b]
     assert len(found) == 1
     return found[0]
+
+
+class Stop(iq.ImpactLaw):
+    """A user's law: u⁺ = (I − wwᵀ/2)u⁻ on one contact w, with a derivative hook whose
+    linear solves report ``residual`` (large: a derivative whose certificate fails)."""
+
+    def __init__(self, residual: float = 0.0) -> None:
+        self.residual = residual
+
+    def closed_form(self, problem):
+        return problem.u_minus - problem.W[:, 0] * (problem.gamma_minus[0] / 2)
+
+    def derivative(self, problem, answer, *, kink_tol):
+        w = problem.W[:, 0]
+        piece = LinearPiece({"u_minus": np.eye(problem.n_dof) - np.outer(w, w) / 2},
+                            {"u_minus": problem.u_minus})
+        piece.residual = self.residual
+        return piece
+
+
+STOP = iq.ImpactProblem(np.eye(2), np.array([[1.0], [-1.0]]), [-1.0, 1.0])

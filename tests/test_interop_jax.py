@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_interop_imports import page_snippet
+from test_interop_imports import STOP, Stop, page_snippet
 
 import impactqp as iq
 from impactqp.errors import DerivativeUnsupportedError, InputError, ShapeError
@@ -177,6 +177,15 @@ def test_sector_law_is_a_permutation_with_the_stable_sort_at_ties() -> None:
     assert np.allclose(J, d.jacobian(), atol=0)
     assert set(np.unique(J)) == {0.0, 1.0} and np.all(J.sum(axis=0) == 1)  # a permutation
     assert any(np.array_equal(J, L) for L in d.limiting_jacobians())
+
+
+def test_a_failed_derivative_certificate_stops_the_gradient() -> None:
+    g = jax.grad(lambda u: jnp.sum(impact_map(STOP, Stop())(u)))(jnp.asarray(STOP.u_minus))
+    assert np.allclose(g, [1.0, 1.0])  # a user's hook: (I − wwᵀ/2)ᵀ𝟙, w = (1, −1)
+    f = impact_map(STOP, Stop(residual=1.0))  # solves, but its derivative is not certified
+    assert np.allclose(f(jnp.asarray(STOP.u_minus)), [0.0, 0.0])
+    with pytest.raises(Exception, match="derivative's certificate failed"):  # jax's error,
+        jax.grad(lambda u: jnp.sum(f(u)))(jnp.asarray(STOP.u_minus))  # impactqp's message
 
 
 def test_unsupported_laws_and_bad_input_are_refused_by_name() -> None:

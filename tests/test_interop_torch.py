@@ -6,10 +6,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_interop_imports import page_snippet
+from test_interop_imports import STOP, Stop, page_snippet
 
 import impactqp as iq
-from impactqp.errors import DerivativeUnsupportedError, InputError, ShapeError
+from impactqp.errors import (
+    CertificateError,
+    DerivativeUnsupportedError,
+    InputError,
+    ShapeError,
+)
 
 torch = pytest.importorskip("torch")
 from impactqp.interop.torch import ImpactFunction, impact_map  # noqa: E402
@@ -98,6 +103,18 @@ def test_coulomb_gradients_in_mu_and_restitution() -> None:
     assert np.isclose(mu.grad.item(), -1.3) and np.isclose(e.grad.item(), -0.5)
     d = iq.derivative(problem, law)
     assert np.allclose(u.grad.numpy(), d.jacobian()[0], atol=1e-12)
+
+
+def test_a_users_hook_and_a_failed_derivative_certificate() -> None:
+    u = leaf(STOP.u_minus)
+    impact_map(STOP, Stop())(u).sum().backward()
+    assert np.allclose(u.grad.numpy(), [1.0, 1.0])  # (I − wwᵀ/2)ᵀ𝟙, w = (1, −1)
+    f = impact_map(STOP, Stop(residual=1.0))  # solves, but its derivative is not certified
+    u = leaf(STOP.u_minus)
+    out = f(u)
+    with pytest.raises(CertificateError, match="derivative's certificate failed"):
+        out.sum().backward()  # no gradient is returned
+    assert u.grad is None
 
 
 def test_the_autograd_function_itself() -> None:
