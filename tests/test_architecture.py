@@ -26,7 +26,7 @@ LAYERS = {
     "laws": 4, "derivatives": 4,
     "verification": 5, "simulation": 5,
     "io": 6, "figures": 6,
-    "cli": 7,
+    "cli": 7, "interop": 7,
     "__init__": 8, "__main__": 8, "precompile": 7,
     # the public submodules re-export from every layer
     "problems": 8, "results": 8, "friction": 8, "chains": 8,
