@@ -13,22 +13,32 @@ The layout is that of Siconos' ``frictionContact_printInFile`` and
      cumulated sizes of the block rows and of the block columns, the lengths of the two index
      arrays (block rows + 1, blocks), the block-row pointers, the block-column index of each
      block, then each block as its own number followed by its entries column by column;
+   - compressed sparse (``NM_SPARSE``): the origin of the matrix (1 triplet, 2 compressed
+     columns, 3 compressed rows), then CSparse's own print of it: a banner line
+     (``CSparse Version …``), a header (``[triplet:|csr:] n₀-by-n₁, nzmax: … nnz: …``), then
+     each entry as ``i j : x`` (triplet) or, per column (row), ``col j : locations a to b``
+     followed by its b − a + 1 entries ``i : x``. CSparse prints the entries with six
+     significant digits (``%g``): the problem is the one of the rounded numbers, as Siconos
+     itself reads it back;
 
-3. q (n₁ numbers) and μ (m numbers).
+3. q (n₁ numbers) and μ (m numbers), then, in files Siconos wrote before 2010, one flag
+   (0 or 1, the problem's former ``isComplete`` field, which Siconos' reader skips).
 
 Reading is as strict as that of FCLib's HDF5 files (:mod:`.fclib`): every count is checked
 against the others (n₀ = n₁ = d·m, pointers from 0 that never decrease, block indices in
-range, blocks numbered in order), every number must be finite, μ ≥ 0, and nothing may follow
-μ (numbers left over mean that a count is wrong). Errors are
+range, blocks numbered in order, the compressed-sparse header's sizes, pointers and indices),
+every number must be finite, μ ≥ 0, and nothing but the old 0/1 flag may follow μ (numbers
+left over mean that a count is wrong). Errors are
 :class:`~impactqp.errors.ProblemFileError` naming the file, the field and the position of the
 offending number. Files are read whole into memory, and refused above
-:data:`MAX_TEXT_BYTES` (once decompressed) before any number is parsed. Siconos' third
-storage (compressed sparse, ``NM_SPARSE``) is refused by name.
+:data:`MAX_TEXT_BYTES` (once decompressed) before any number is parsed. Siconos' half-triplet
+origin (the lower half of a symmetric matrix) is refused by name.
 """
 
 from __future__ import annotations
 
 import gzip
+import re
 import zlib
 from collections.abc import Iterator
 from pathlib import Path
@@ -50,7 +60,20 @@ MAX_SIZE = 1_000_000
 GZIP_MAGIC = b"\x1f\x8b"
 """The first two bytes of a gzip stream."""
 
-STORAGES = {0: "dense", 1: "sparse-block"}
+STORAGES = {0: "dense", 1: "sparse-block", 2: "compressed sparse"}
+"""W's storages read; the first two are written."""
+WRITTEN = (0, 1)
+"""W's storages :func:`write_siconos_text` writes."""
+
+SPARSE_ORIGINS = {1: "triplet", 2: "compressed columns", 3: "compressed rows"}
+"""Origins of a compressed-sparse W read (Siconos' ``NSM_TRIPLET``, ``NSM_CSC``,
+``NSM_CSR``); its fourth, ``NSM_HALF_TRIPLET``, is refused."""
+
+BANNER_TOKENS = 40
+"""Most words of CSparse's banner line searched for the header that follows it."""
+
+LEGACY_FLAGS = ("0", "1")
+"""The one number Siconos wrote after μ before 2010 (``isComplete``), skipped on reading."""
 
 
 def looks_like_siconos_text(head: bytes) -> bool:
@@ -148,6 +171,8 @@ class _Numbers:
 
     def finish(self) -> None:
         left = len(self.tokens) - self.pos
+        if left == 1 and self.tokens[-1] in LEGACY_FLAGS:
+            return
         if left:
             raise self.error("after μ", f"{left} number(s) left over; a count in the file "
                                         "does not match its contents")
@@ -238,6 +263,129 @@ def _block_values(numbers: _Numbers, tokens: list[str], first: np.ndarray,
     return values
 
 
+def _sparse(numbers: _Numbers, n0: int, n1: int) -> sp.csr_matrix:
+    """A compressed-sparse W: its origin, then CSparse's print of it (see the module doc)."""
+    origin = numbers.integer("W's sparse origin", 1, 4)
+    if origin not in SPARSE_ORIGINS:
+        raise numbers.error("W's sparse origin", f"{origin} (half triplet) is not read; "
+                                                 "1 (triplet), 2 (compressed columns) and 3 "
+                                                 "(compressed rows) are", numbers.pos - 1)
+    field = "W's CSparse header"
+    if numbers.take(field, 1)[0] != "CSparse":
+        raise numbers.error(field, "expected CSparse's banner 'CSparse Version …'",
+                            numbers.pos - 1)
+    start = numbers.pos
+    window = numbers.tokens[start:start + BANNER_TOKENS]
+    at = next((k for k, t in enumerate(window) if re.fullmatch(r"\d+-by-\d+,", t)), None)
+    if at is None:
+        raise numbers.error(field, "no 'rows-by-columns,' header after the banner", start)
+    numbers.pos = start + at
+    rows, cols = (int(x) for x in numbers.take(field, 1)[0][:-1].split("-by-"))
+    if (rows, cols) != (n0, n1):
+        raise numbers.error(field, f"{rows}-by-{cols} is not W's {n0}-by-{n1}",
+                            numbers.pos - 1)
+    kind = {"triplet:": 1, "csr:": 3}.get(numbers.tokens[start + at - 1], 2) if at else 2
+    if kind != origin:
+        raise numbers.error(field, f"prints {SPARSE_ORIGINS[kind]}, the origin says "
+                                   f"{SPARSE_ORIGINS[origin]}", numbers.pos - 1)
+    _word(numbers, field, "nzmax:")
+    numbers.integer("W's nzmax", 0, MAX_SIZE**2)
+    _word(numbers, field, "nnz:")
+    if kind == 1:
+        nnz = numbers.integer("W's number of entries", 0, MAX_SIZE**2)
+        at = numbers.pos
+        cells = np.array(numbers.take("W's entries (i j : x)", 4 * nnz)).reshape(nnz, 4)
+        where = at + 4 * np.arange(nnz)
+        i, j, x = _entries(numbers, cells[:, [0, 2, 3]], where, n0, "W's entries (i j : x)",
+                           column=(cells[:, 1], n1))
+        return sp.csr_matrix(sp.coo_matrix((x, (i, j)), shape=(n0, n1)))  # duplicates add
+    token = numbers.take("W's number of entries", 1)[0]
+    if not token.endswith(",") or not token[:-1].isdigit():
+        raise numbers.error("W's number of entries", f"{token!r} is not 'count,'",
+                            numbers.pos - 1)
+    _word(numbers, field, "1-norm:")
+    numbers.take("W's 1-norm", 1)
+    outer, inner, word = (n1, n0, "col") if kind == 2 else (n0, n1, "row")
+    heads, counts = [], []  # where each column's entries start, and how many
+    tokens, end = numbers.tokens, 0
+    for j in range(outer):
+        at = numbers.pos
+        head = numbers.take(f"W's {word} {j}", 7)
+        first, last = head[4], head[6]
+        if head[:4] != [word, str(j), ":", "locations"] or head[5] != "to" \
+                or not first.isdigit() or not (last.isdigit() or last == "-1"):
+            raise numbers.error(f"W's {word} {j}", f"expected '{word} {j} : locations a to "
+                                                   f"b', got {' '.join(head)!r}", at)
+        if int(first) != end or int(last) < end - 1:
+            raise numbers.error(f"W's {word} {j}", f"locations {first} to {last} do not "
+                                                   f"follow entry {end - 1}", at + 4)
+        end = int(last) + 1
+        heads.append(numbers.pos)
+        counts.append(end - int(first))
+        numbers.take(f"W's {word} {j} entries", 3 * counts[-1])
+    counts_a = np.array(counts, dtype=np.int64)
+    offsets = np.arange(int(counts_a.sum())) - np.repeat(np.cumsum(counts_a) - counts_a,
+                                                         counts_a)
+    where = np.repeat(np.array(heads, dtype=np.int64), counts_a) + 3 * offsets
+    base = heads[0] if heads else 0  # the entries' tokens, from the first column's on
+    cells = np.array(tokens[base:numbers.pos] or [""])[where[:, None] - base + np.arange(3)]
+    index, _, values = _entries(numbers, cells, where, inner,
+                                f"W's entries ({SPARSE_ORIGINS[kind]})")
+    pointers = np.r_[0, np.cumsum(counts_a)]
+    W = (sp.csc_matrix if kind == 2 else sp.csr_matrix)((values, index, pointers),
+                                                         shape=(n0, n1))
+    W.sum_duplicates()
+    return sp.csr_matrix(W)
+
+
+def _word(numbers: _Numbers, field: str, word: str) -> None:
+    if numbers.take(field, 1)[0] != word:
+        raise numbers.error(field, f"expected {word!r}", numbers.pos - 1)
+
+
+def _entries(numbers: _Numbers, cells: np.ndarray, where: np.ndarray, size: int, field: str,
+             column: tuple[np.ndarray, int] | None = None
+             ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:
+    """The index, ':' and value of each entry (rows of ``cells``, the first at file position
+    ``where``; a triplet's column index one position after its row and ``column`` = (those
+    tokens, their bound)), checked: indices in [0, size), ':' in place, values finite."""
+    cells = cells.astype(str)
+    shift = 1 if column is None else 2  # positions of ':' and x after the index
+    bad = np.flatnonzero(cells[:, 1] != ":")
+    if bad.size:
+        raise numbers.error(field, f"expected ':', got {cells[bad[0], 1]!r}",
+                            int(where[bad[0]]) + shift)
+    index = _indices(numbers, cells[:, 0], where, size, field)
+    other = None if column is None else _indices(numbers, column[0].astype(str), where + 1,
+                                                 column[1], field)
+    try:
+        values = cells[:, 2].astype(float)
+    except ValueError:
+        k = next(k for k, t in enumerate(cells[:, 2]) if not _is_float(str(t)))
+        raise numbers.error(field, f"{cells[k, 2]!r} is not a number",
+                            int(where[k]) + shift + 1) from None
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise numbers.error(field, f"holds {bad.size} non-finite number(s) (NaN or "
+                                   "infinity), the first here", int(where[bad[0]]) + shift + 1)
+    return index, other, values
+
+
+def _indices(numbers: _Numbers, tokens: np.ndarray, where: np.ndarray, size: int,
+             field: str) -> np.ndarray:
+    """Integers in [0, size), the k-th token at file position ``where[k]``."""
+    ok = np.char.isdigit(tokens) if tokens.size else np.ones(0, dtype=bool)
+    if not ok.all():
+        k = int(np.flatnonzero(~ok)[0])
+        raise numbers.error(field, f"{tokens[k]!r} is not an index", int(where[k]))
+    values = tokens.astype(np.int64)
+    bad = np.flatnonzero(values >= size)
+    if bad.size:
+        raise numbers.error(field, f"{values[bad[0]]} is outside [0, {size - 1}]",
+                            int(where[bad[0]]))
+    return values
+
+
 def read_siconos_text(path: str | Path) -> FrictionContactProblem:
     """Read the local frictional contact problem of a Siconos text file.
 
@@ -249,16 +397,19 @@ def read_siconos_text(path: str | Path) -> FrictionContactProblem:
     Returns
     -------
     FrictionContactProblem
-        W sparse (CSR) when stored sparse-block, dense otherwise; q, μ and ``contact_dim`` d.
+        W sparse (CSR) when stored sparse-block or compressed sparse, dense otherwise; q, μ
+        and ``contact_dim`` d.
 
     Raises
     ------
     ProblemFileError
         An unreadable file or damaged gzip stream, text that is not ASCII, a missing or
         non-numeric number, a count that does not fit the others (n₀ ≠ d·m, block pointers,
-        indices, block numbers, numbers left over after μ), a storage other than dense or
-        sparse-block, non-finite numbers, negative μ, or more than :data:`MAX_TEXT_BYTES` of
-        text. The message names the file, the field and the position of the number.
+        indices, block numbers, a compressed-sparse header, location or index out of place,
+        numbers left over after μ beyond Siconos' old 0/1 flag), a storage other than dense,
+        sparse-block or compressed sparse, a half-triplet W, non-finite numbers, negative μ,
+        or more than :data:`MAX_TEXT_BYTES` of text. The message names the file, the field
+        and the position of the number.
     """
     path = Path(path)
     numbers = _Numbers(path, _text(path))
@@ -267,13 +418,9 @@ def read_siconos_text(path: str | Path) -> FrictionContactProblem:
     d = numbers.integer("d, the dimension of a contact", 2, 3)
     m = numbers.integer("the number of contacts", 1, MAX_SIZE // d)
     storage = numbers.integer("W's storage", 0, 2)
-    if storage not in STORAGES:
-        raise numbers.error("W's storage", f"{storage} (compressed sparse) is not read; "
-                                           "dense (0) and sparse-block (1) are",
-                            numbers.pos - 1)
     n0 = numbers.integer("W's rows", d * m, d * m)
     n1 = numbers.integer("W's columns", d * m, d * m)
-    W = _dense(numbers, n0, n1) if storage == 0 else _blocks(numbers, n0, n1)
+    W = (_dense, _blocks, _sparse)[storage](numbers, n0, n1)
     q = numbers.floats("q", n1)
     at = numbers.pos
     mu = numbers.floats("μ", m)
@@ -334,7 +481,7 @@ def write_siconos_text(problem: FrictionContactProblem, path: str | Path, *,
     InputError
         Another storage, or ``problem`` is not a FrictionContactProblem.
     """
-    if storage not in STORAGES:
+    if storage not in WRITTEN:
         raise InputError(f"storage must be 0 (dense) or 1 (sparse-block), got {storage!r}")
     if not isinstance(problem, FrictionContactProblem):
         raise InputError(f"problem must be a FrictionContactProblem, got "
