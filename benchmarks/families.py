@@ -179,6 +179,7 @@ SUITES: dict[str, dict[str, list[int]]] = {
              "batch": [10_000, 100_000, 1_000_000, 10_000_000],
              "chain-random": [1_000_000]},
     "friction": {},  # the friction rows alone (benchmarks/friction.py, friction_impacts.py)
+    "fclib-wide": {},  # the friction suite's problems and the widened FCLib/Siconos set
 }
 
 

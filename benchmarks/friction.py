@@ -8,13 +8,20 @@ only. A solve that does not reach the tolerance is a failure whose time spent is
 stopped after :data:`TIME_LIMIT` seconds.
 
 Rows: family ``friction:<problem>`` (size: contacts), methods ``iq:auto``,
-``iq:clarabel``, ``iq:nsgs`` (:data:`IQ_METHODS`) and ``siconos:NSGS``,
-``siconos:NSN_AC``, ``siconos:PROX`` (:data:`SICONOS_SOLVERS`, served by
-:mod:`benchmarks.siconos_worker` in Debian's Python; skipped when it cannot import siconos).
+``iq:clarabel``, ``iq:nsgs`` (:data:`IQ_METHODS`; the ``fclib-wide`` suite runs the default
+alone, :data:`SUITE_IQ_METHODS`) and ``siconos:NSGS``, ``siconos:NSN_AC``, ``siconos:PROX``
+(:data:`SICONOS_SOLVERS`, served by :mod:`benchmarks.siconos_worker` in Debian's Python;
+skipped when it cannot import siconos). On 2-D problems Siconos' NSGS is its fc2d NSGS, and
+NSN_AC and PROX, which Siconos 4.4 has in 3-D only, are failures (∞ in the profile).
+
+Where the default does not certify, ``solve_friction`` raises ``CertificateError`` carrying
+its best answer and the attempts: the row keeps the time spent and the ABH error of that
+best answer, recomputed here from its r.
 """
 
 from __future__ import annotations
 
+import math
 import multiprocessing
 import tempfile
 import time
@@ -55,28 +62,41 @@ METHODS = (*IQ_METHODS, *(f"siconos:{s}" for s in SICONOS_SOLVERS))
 """Every method of the suite, in the order of the tables and the profile."""
 DEFAULT, BASELINE = "iq:auto", "siconos:NSGS"
 """The ratio reported per problem: impactqp's default over Siconos' NSGS."""
-#: problems per suite (names of :data:`benchmarks.friction_data.FILES`)
+#: problems per suite (names of :data:`benchmarks.friction_data.ALL`)
 PROBLEMS: dict[str, list[str]] = {
     "quick": ["LMGC-00046"],
     "full": list(friction_data.FILES),
     "friction": list(friction_data.FILES),
+    "fclib-wide": list(friction_data.ALL),
 }
+SUITE_IQ_METHODS: dict[str, tuple[str, ...]] = {"fclib-wide": (DEFAULT,)}
+"""impactqp's methods per suite where not all of :data:`IQ_METHODS` (the widened set times the
+default beside Siconos, within a CPU budget of minutes)."""
+TIME_LIMITS: dict[str, float] = {"fclib-wide": 30.0}
+"""Per-problem time limit of a suite's runs where not :data:`TIME_LIMIT` (seconds)."""
+PLANAR_SOLVERS = ("NSGS",)
+"""Siconos' solvers of :data:`SICONOS_SOLVERS` that its fc2d_driver has (2-D problems)."""
 IQ_NOTE = ("iq.solve_friction(problem, backend=…, tol=1e-8) on the loaded problem; error = "
            "ABH recomputed by certify_friction")
-PEER_NOTE = ("fc3d_driver from r = 0 (tol 1e-8, ≤ 1e5 iterations), W sparse-block as "
-             "Siconos reads its own text files, in /usr/bin/python3; error = ABH recomputed "
-             "by impactqp's certify_friction from Siconos' r")
+PEER_NOTE = ("fc3d_driver (fc2d_driver in 2-D) from r = 0 (tol 1e-8, ≤ 1e5 iterations), W "
+             "sparse-block as Siconos reads its own text files, in /usr/bin/python3; error = "
+             "ABH recomputed by impactqp's certify_friction from Siconos' r")
 
 
 def _child(conn: Any, method: Callable[[Any], Any], problem: Any) -> None:
     """Run ``method(problem)`` once in a forked process; send back its seconds and r, u
-    (or the exception's text)."""
+    (or the exception's text, with the best answer's r and the attempts of a
+    ``CertificateError``)."""
     t0 = time.perf_counter()
     try:
         result = method(problem)
         conn.send(("ok", time.perf_counter() - t0, result.r, result.u, result.backend))
     except Exception as exc:  # e.g. CertificateError: a failure with its time spent
-        conn.send(("error", time.perf_counter() - t0, f"{type(exc).__name__}: {exc}"))
+        seconds = time.perf_counter() - t0
+        best = getattr(exc, "best", None)
+        conn.send(("error", seconds, f"{type(exc).__name__}: {exc}",
+                   None if best is None else np.asarray(best.r),
+                   list(getattr(exc, "attempts", []))))
     conn.close()
 
 
@@ -87,7 +107,8 @@ def first_run(method: Callable[[Any], Any], problem: Any,
 
     Returns
     -------
-    ("ok", seconds, (r, u, route)), ("error", seconds, message) or ("stopped", limit, "")
+    ("ok", seconds, (r, u, route)), ("error", seconds, (message, best r or None, attempts))
+    or ("stopped", limit, "")
     """
     ctx = multiprocessing.get_context("fork")
     receive, send = ctx.Pipe(duplex=False)
@@ -105,7 +126,7 @@ def first_run(method: Callable[[Any], Any], problem: Any,
     finally:
         proc.join()
         receive.close()
-    return (status, seconds, tuple(rest)) if status == "ok" else (status, seconds, rest[0])
+    return status, seconds, tuple(rest)
 
 
 def _repeat(run: Callable[[], Any], budget: float, max_repeats: int) -> list[float]:
@@ -140,24 +161,41 @@ def warm_up() -> None:
         method(p)
 
 
-def run_impactqp(case: FrictionCase, *, budget: float, max_repeats: int) -> list[dict]:
-    """One row per method of :data:`IQ_METHODS` on ``case``: the first run counts alone when
-    it takes the budget (a solve of seconds needs no warm-up; one stopped at
-    :data:`TIME_LIMIT` fails), else it is the warm-up and timed repeats follow — the rule of
-    Siconos' side too."""
+def _failure(case: FrictionCase, out: Any, seconds: float) -> tuple[str, float | None]:
+    """(message, ABH error of the best answer) of a run that did not certify: the error is
+    recomputed here from the best r a ``CertificateError`` carried (None without one)."""
+    if not out:
+        return f"stopped after {seconds:g} s", None
+    message, best_r, attempts = out
+    if best_r is None:
+        return message, None
+    error = certify_friction(case.problem, best_r, tol=TOL).error
+    return (f"best answer ABH {error:.1e} (recomputed) after {len(attempts)} attempts; "
+            f"{message}", error if math.isfinite(error) else None)
+
+
+def run_impactqp(case: FrictionCase, *, budget: float, max_repeats: int,
+                 methods: tuple[str, ...] = tuple(IQ_METHODS),
+                 limit: float = TIME_LIMIT) -> list[dict]:
+    """One row per method of ``methods`` (names of :data:`IQ_METHODS`) on ``case``: the
+    first run counts alone when it takes the budget (a solve of seconds needs no warm-up;
+    one stopped at ``limit`` seconds fails), else it is the warm-up and timed repeats follow
+    — the rule of Siconos' side too."""
     rows = []
-    for name, method in IQ_METHODS.items():
+    for name in methods:
+        method = IQ_METHODS[name]
         with quiet_stdout():
-            status, seconds, out = first_run(method, case.problem)
+            status, seconds, out = first_run(method, case.problem, limit)
             times = [seconds]
             if status == "ok" and seconds < budget:
                 try:
                     times = _repeat(lambda m=method: m(case.problem), budget, max_repeats)
                 except Exception as exc:  # solved in the child, not here: a failure
-                    status, out = "error", f"{type(exc).__name__}: {exc}"
+                    status, out = "error", (f"{type(exc).__name__}: {exc}", None, [])
         if status != "ok":
-            message = out or f"stopped after {seconds:g} s"
-            rows.append(_row(case, name, "impactqp", "failed", times, None, message, IQ_NOTE))
+            message, error = _failure(case, out, seconds)
+            rows.append(_row(case, name, "impactqp", "failed", times, error, message,
+                             IQ_NOTE))
             continue
         r, u, route = out
         cert = certify_friction(case.problem, r, u, tol=TOL)
@@ -183,19 +221,23 @@ class SiconosPeer:
         self.tmp = tempfile.TemporaryDirectory()
 
     def solve(self, case: FrictionCase, solver: str, *, budget: float,
-              max_repeats: int) -> dict:
+              max_repeats: int, limit: float = TIME_LIMIT) -> dict:
         """Run one solver on ``case``; its row (failed rows keep the time spent)."""
+        name = f"siconos:{solver}"
+        if case.problem.contact_dim == 2 and solver not in PLANAR_SOLVERS:
+            return _row(case, name, "peer", "failed", [], None,
+                        f"Siconos 4.4 has no 2-D {solver} (fc2d_driver: NSGS, CPG, Lemke, "
+                        "enumeration)", PEER_NOTE)
         path = Path(self.tmp.name) / f"{case.name}.dat"
         if not path.exists():
             write_siconos_text(case.problem, path)
         if self.server is None or not self.server.alive:
             self.server = SiconosServer(self.python, WORKER, "--fc3d-serve")
-        name = f"siconos:{solver}"
         job = {"path": str(path), "solver": solver, "tol": TOL, "max_iter": MAX_ITER,
                "budget": budget, "max_repeats": max_repeats}
         t0 = time.perf_counter()
         try:
-            answer = self.server.request(job, timeout=TIME_LIMIT + 2 * budget + READ_ALLOWANCE)
+            answer = self.server.request(job, timeout=limit + 2 * budget + READ_ALLOWANCE)
         except TimeoutError as exc:
             self.server = None
             return _row(case, name, "peer", "failed", [time.perf_counter() - t0], None,
@@ -230,6 +272,8 @@ def run_friction(suite: str, *, budget: float, max_repeats: int,
     names = PROBLEMS.get(suite, [])
     if not names:
         return []
+    methods = SUITE_IQ_METHODS.get(suite, tuple(IQ_METHODS))
+    limit = TIME_LIMITS.get(suite, TIME_LIMIT)
     warm_up()
     why = _peer_status(siconos_python)
     peer = SiconosPeer(siconos_python) if why is None else None
@@ -239,7 +283,8 @@ def run_friction(suite: str, *, budget: float, max_repeats: int,
             case = friction_data.load(name)
             if progress:
                 progress(name)
-            rows += run_impactqp(case, budget=budget, max_repeats=max_repeats)
+            rows += run_impactqp(case, budget=budget, max_repeats=max_repeats,
+                                 methods=methods, limit=limit)
             for solver in SICONOS_SOLVERS:
                 if peer is None:
                     rows.append(_row(case, f"siconos:{solver}", "peer", "skipped", [], None,
@@ -247,7 +292,7 @@ def run_friction(suite: str, *, budget: float, max_repeats: int,
                                      PEER_NOTE))
                 else:
                     rows.append(peer.solve(case, solver, budget=budget,
-                                           max_repeats=max_repeats))
+                                           max_repeats=max_repeats, limit=limit))
     finally:
         if peer is not None:
             peer.close()

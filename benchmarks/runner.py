@@ -22,7 +22,7 @@ from .sweeps import run_sweeps
 
 #: per suite: (seconds of timed repeats per method and case, most repeats)
 TIMING = {"smoke": (0.01, 10), "quick": (0.02, 30), "full": (0.3, 500),
-          "friction": (0.3, 500)}
+          "friction": (0.3, 500), "fclib-wide": (0.1, 100)}
 #: families a suite's rows belong to when they replace rows of earlier results (``merge``)
 FRICTION_FAMILIES = ("friction:", "friction-impact")
 

@@ -12,10 +12,11 @@ Usage: ``/usr/bin/python3 siconos_worker.py --fc3d-serve`` serves frictional con
 problems, one JSON line per request on stdin: ``{"path", "solver", "tol", "max_iter",
 "budget", "max_repeats"}`` with ``path`` a local problem in Siconos' text layout (read by
 Siconos' own ``frictionContact_new_from_filename``, W stored sparse-block) and ``solver``
-among ``NSGS``, ``NSN_AC``, ``PROX`` (:data:`FC3D`). Each timed run calls ``fc3d_driver``
-from r = u = 0 with fresh solver options (tolerance ``SICONOS_DPARAM_TOL``, most
-iterations ``SICONOS_IPARAM_MAX_ITER``); the problem is read before the timer. The answer,
-one line prefixed :data:`ANSWER`, holds the run times, Siconos' info code, its iterations
+among ``NSGS``, ``NSN_AC``, ``PROX`` (:data:`FC3D`; a 2-D problem goes to ``fc2d_driver``,
+whose solvers are :data:`FC2D`). Each timed run calls the driver from r = u = 0 with fresh
+solver options (tolerance ``SICONOS_DPARAM_TOL``, most iterations
+``SICONOS_IPARAM_MAX_ITER``); the problem is read before the timer. The answer, one line
+prefixed :data:`ANSWER`, holds the run times, Siconos' info code, its iterations
 and its own error (for the record only: the caller recomputes the error), r and u.
 
 This file must stay importable without siconos and self-contained (no impactqp import).
@@ -37,6 +38,8 @@ def _solver_ids(sn) -> dict:
 #: the fc3d solvers served: name → Siconos' solver id attribute
 FC3D = {"NSGS": "SICONOS_FRICTION_3D_NSGS", "NSN_AC": "SICONOS_FRICTION_3D_NSN_AC",
         "PROX": "SICONOS_FRICTION_3D_PROX"}
+#: the fc2d solvers served (2-D problems): name → Siconos' solver id attribute
+FC2D = {"NSGS": "SICONOS_FRICTION_2D_NSGS"}
 #: the prefix of the server's answer lines (anything else on its stdout is Siconos talking)
 ANSWER = "@@ "
 
@@ -64,14 +67,19 @@ def time_solver(sn, np, M, q, solver_id: int, budget: float, max_repeats: int) -
 
 
 def fc3d_once(sn, np, problem, solver: str, tol: float, max_iter: int) -> dict:
-    """One fc3d_driver call from r = u = 0; its seconds, info, iterations, own error, r, u."""
+    """One fc3d_driver (fc2d_driver in 2-D) call from r = u = 0; its seconds, info,
+    iterations, own error, r, u."""
     size = problem.dimension * problem.numberOfContacts
     r, u = np.zeros(size), np.zeros(size)
-    options = sn.SolverOptions(getattr(sn, FC3D[solver]))
+    planar = problem.dimension == 2
+    if planar and solver not in FC2D:
+        raise ValueError(f"no 2-D {solver} in Siconos (2-D: {sorted(FC2D)})")
+    options = sn.SolverOptions(getattr(sn, (FC2D if planar else FC3D)[solver]))
     options.dparam[sn.SICONOS_DPARAM_TOL] = tol
     options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = max_iter
+    driver = sn.fc2d_driver if planar else sn.fc3d_driver
     t0 = time.perf_counter()
-    info = sn.fc3d_driver(problem, r, u, options)
+    info = driver(problem, r, u, options)
     seconds = time.perf_counter() - t0
     return {"seconds": seconds, "info": int(info),
             "iterations": int(options.iparam[sn.SICONOS_IPARAM_ITER_DONE]),

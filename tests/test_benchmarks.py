@@ -355,7 +355,7 @@ def test_friction_report_by_hand(tmp_path):
 
     assert target("every FCLib") == ("2 of 2", "met")
     assert target("iq:auto time") == ("1 of 2 (slower: b)", "MISSED")
-    assert target("geometric mean") == ("0.707", "MISSED by 1.4×")  # √(0.25 · 2)
+    assert target("geometric mean") == ("0.707", "MISSED by 2.4×")  # √(0.25 · 2) / 0.3
     assert target("Dolan–Moré")[0].startswith("fastest on 2 of 2")
     text = "\n".join(friction_report.markdown(rows))
     assert "| b | 50 |" in text and "2.00 (NSGS failed)" in text and "0.707" in text
@@ -435,8 +435,9 @@ def test_impactqp_runs_are_stopped_at_the_limit():
     p = iq.FrictionContactProblem([[1.0, 0, 0], [0, 2.0, 0], [0, 0, 2.0]], [-1.0, 2.0, 0.0],
                                   0.5)
     assert first_run(slow, p, limit=0.5) == ("stopped", 0.5, "")
-    status, seconds, message = first_run(broken, p)
+    status, seconds, (message, best, attempts) = first_run(broken, p)
     assert status == "error" and "CertificateError: no method" in message and seconds < 5
+    assert best is None and attempts == []  # raised without a best answer
     status, _, (r, u, route) = first_run(iq.solve_friction, p)
     # sliding (sticking would need r_t = −1, outside the cone): r_n = 1, r_t = −μ r_n
     assert status == "ok" and abs(r[0] - 1.0) < 1e-9 and abs(r[1] + 0.5) < 1e-9 and route

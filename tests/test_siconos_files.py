@@ -121,7 +121,7 @@ def _tokens_edit(text: str, k: int, value: str | None) -> str:
     (0, "2.5", "'2.5' is not an integer"),
     (1, "3", r"W's rows \(number 4 of the file\): 4 is outside \[6, 6\]"),  # wrong count
     (1, "-1", "the number of contacts .*-1 is outside"),
-    (2, "2", r"2 \(compressed sparse\) is not read"),
+    (2, "2", r"W's CSparse header \(number 7 of the file\): expected CSparse's banner"),
     (2, "3", r"W's storage \(number 3 of the file\): 3 is outside \[0, 2\]"),
     (5, "4", r"W's length of block-column indices .*3 is outside \[4, 4\]"),
     (9, "3", "block-row ends .*must increase and end at 4"),
@@ -150,7 +150,7 @@ def test_every_truncation_and_extra_number_is_refused(tmp_path: Path) -> None:
         path.write_text(" ".join(tokens[:keep]))
         with pytest.raises(ProblemFileError, match="ends after|outside"):
             iq.load_fclib(path)
-    path.write_text(" ".join([*tokens, "0"]))
+    path.write_text(" ".join([*tokens, "2"]))  # not Siconos' old 0/1 flag
     with pytest.raises(ProblemFileError, match=r"1 number\(s\) left over"):
         iq.load_fclib(path)
 

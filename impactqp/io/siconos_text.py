@@ -13,17 +13,26 @@ The layout is that of Siconos' ``frictionContact_printInFile`` and
      cumulated sizes of the block rows and of the block columns, the lengths of the two index
      arrays (block rows + 1, blocks), the block-row pointers, the block-column index of each
      block, then each block as its own number followed by its entries column by column;
+   - compressed sparse (``NM_SPARSE``, read by :mod:`.csparse_text`): the origin of the
+     matrix (1 triplet, 2 compressed columns, 3 compressed rows), then CSparse's own print
+     of it: a banner line (``CSparse Version …``), a header
+     (``[triplet:|csr:] n₀-by-n₁, nzmax: … nnz: …``), then each entry as ``i j : x``
+     (triplet) or, per column (row), ``col j : locations a to b`` followed by its b − a + 1
+     entries ``i : x``. CSparse prints the entries with six significant digits (``%g``):
+     the problem is the one of the rounded numbers, as Siconos itself reads it back;
 
-3. q (n₁ numbers) and μ (m numbers).
+3. q (n₁ numbers) and μ (m numbers), then, in files Siconos wrote before 2010, one flag
+   (0 or 1, the problem's former ``isComplete`` field, which Siconos' reader skips).
 
 Reading is as strict as that of FCLib's HDF5 files (:mod:`.fclib`): every count is checked
 against the others (n₀ = n₁ = d·m, pointers from 0 that never decrease, block indices in
-range, blocks numbered in order), every number must be finite, μ ≥ 0, and nothing may follow
-μ (numbers left over mean that a count is wrong). Errors are
+range, blocks numbered in order, the compressed-sparse header's sizes, pointers and indices),
+every number must be finite, μ ≥ 0, and nothing but the old 0/1 flag may follow μ (numbers
+left over mean that a count is wrong). Errors are
 :class:`~impactqp.errors.ProblemFileError` naming the file, the field and the position of the
 offending number. Files are read whole into memory, and refused above
-:data:`MAX_TEXT_BYTES` (once decompressed) before any number is parsed. Siconos' third
-storage (compressed sparse, ``NM_SPARSE``) is refused by name.
+:data:`MAX_TEXT_BYTES` (once decompressed) before any number is parsed. Siconos' half-triplet
+origin (the lower half of a symmetric matrix) is refused by name.
 """
 
 from __future__ import annotations
@@ -39,6 +48,8 @@ import scipy.sparse as sp
 from ..base.outputs import atomic_output
 from ..errors import InputError, ProblemFileError
 from ..model.friction import FrictionContactProblem
+from .csparse_text import read_compressed_sparse
+from .text_numbers import TextNumbers, is_float
 
 MAX_TEXT_BYTES = 2**27
 """Largest Siconos text file read, in bytes once decompressed (128 MiB, some five million
@@ -50,8 +61,10 @@ MAX_SIZE = 1_000_000
 GZIP_MAGIC = b"\x1f\x8b"
 """The first two bytes of a gzip stream."""
 
-STORAGES = {0: "dense", 1: "sparse-block"}
-
+STORAGES = {0: "dense", 1: "sparse-block", 2: "compressed sparse"}
+"""W's storages read; the first two are written."""
+WRITTEN = (0, 1)
+"""W's storages :func:`write_siconos_text` writes."""
 
 def looks_like_siconos_text(head: bytes) -> bool:
     """True when a file starting with ``head`` is gzip-compressed or starts (after white space)
@@ -86,88 +99,13 @@ def _text(path: Path) -> str:
                                "is not ASCII text") from None
 
 
-class _Numbers:
-    """The white-space separated numbers of one file, taken in order, each checked and
-    named in every error by its field and its position in the file."""
-
-    def __init__(self, path: Path, text: str) -> None:
-        self.path = path
-        self.tokens = text.split()
-        self.pos = 0
-
-    def error(self, field: str, what: str, at: int | None = None) -> ProblemFileError:
-        where = self.pos if at is None else at
-        return ProblemFileError(f"{self.path}: {field} (number {where + 1} of the file): {what}")
-
-    def take(self, field: str, count: int) -> list[str]:
-        if count > len(self.tokens) - self.pos:
-            raise self.error(field, f"the file ends after {len(self.tokens)} numbers, "
-                                    f"{count} more expected here (truncated, or a count in the "
-                                    "header is wrong)")
-        out = self.tokens[self.pos:self.pos + count]
-        self.pos += count
-        return out
-
-    def integer(self, field: str, low: int, high: int) -> int:
-        token = self.take(field, 1)[0]
-        try:
-            value = int(token)
-        except ValueError:
-            raise self.error(field, f"{token!r} is not an integer", self.pos - 1) from None
-        if not low <= value <= high:
-            raise self.error(field, f"{value} is outside [{low}, {high}]", self.pos - 1)
-        return value
-
-    def integers(self, field: str, count: int, low: int, high: int) -> np.ndarray:
-        start = self.pos
-        tokens = self.take(field, count)
-        try:
-            values = np.array([int(t) for t in tokens], dtype=np.int64)
-        except ValueError:
-            bad = next(k for k, t in enumerate(tokens) if not t.lstrip("+-").isdigit())
-            raise self.error(field, f"{tokens[bad]!r} is not an integer", start + bad) from None
-        out = np.flatnonzero((values < low) | (values > high))
-        if out.size:
-            raise self.error(field, f"{values[out[0]]} is outside [{low}, {high}]",
-                             start + int(out[0]))
-        return values
-
-    def floats(self, field: str, count: int) -> np.ndarray:
-        start = self.pos
-        tokens = self.take(field, count)
-        try:
-            values = np.array(tokens, dtype=float)
-        except ValueError:
-            bad = next(k for k, t in enumerate(tokens) if not _is_float(t))
-            raise self.error(field, f"{tokens[bad]!r} is not a number", start + bad) from None
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            raise self.error(field, f"holds {bad.size} non-finite number(s) (NaN or "
-                                    "infinity), the first here", start + int(bad[0]))
-        return values
-
-    def finish(self) -> None:
-        left = len(self.tokens) - self.pos
-        if left:
-            raise self.error("after μ", f"{left} number(s) left over; a count in the file "
-                                        "does not match its contents")
-
-
-def _is_float(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
-
-
-def _dense(numbers: _Numbers, n0: int, n1: int) -> np.ndarray:
+def _dense(numbers: TextNumbers, n0: int, n1: int) -> np.ndarray:
     numbers.integer("W's rows (dense)", n0, n0)
     numbers.integer("W's columns (dense)", n1, n1)
     return numbers.floats("W (dense, column by column)", n0 * n1).reshape(n1, n0).T
 
 
-def _ends(numbers: _Numbers, field: str, count: int, size: int) -> np.ndarray:
+def _ends(numbers: TextNumbers, field: str, count: int, size: int) -> np.ndarray:
     """Cumulated block sizes: increasing, ending at ``size``."""
     ends = numbers.integers(field, count, 1, size)
     if np.any(np.diff(ends) <= 0) or ends[-1] != size:
@@ -176,7 +114,7 @@ def _ends(numbers: _Numbers, field: str, count: int, size: int) -> np.ndarray:
     return ends
 
 
-def _blocks(numbers: _Numbers, n0: int, n1: int) -> sp.csr_matrix:
+def _blocks(numbers: TextNumbers, n0: int, n1: int) -> sp.csr_matrix:
     """A sparse-block W (see the module doc)."""
     nblocks = numbers.integer("W's number of blocks", 1, MAX_SIZE**2)
     brows = numbers.integer("W's number of block rows", 1, n0)
@@ -210,7 +148,7 @@ def _blocks(numbers: _Numbers, n0: int, n1: int) -> sp.csr_matrix:
     return sp.csr_matrix((entries[keep], (rows[keep], cols[keep])), shape=(n0, n1))
 
 
-def _block_values(numbers: _Numbers, tokens: list[str], first: np.ndarray,
+def _block_values(numbers: TextNumbers, tokens: list[str], first: np.ndarray,
                   at: int) -> np.ndarray:
     """The numbers of W's blocks (each block's own number, then its entries), all finite and
     each block numbered in order; an error names the block of the offending number."""
@@ -229,7 +167,7 @@ def _block_values(numbers: _Numbers, tokens: list[str], first: np.ndarray,
     try:
         values = np.array(tokens, dtype=float)
     except ValueError:
-        bad = next(k for k, t in enumerate(tokens) if not _is_float(t))
+        bad = next(k for k, t in enumerate(tokens) if not is_float(t))
         raise numbers.error(field(bad), f"{tokens[bad]!r} is not a number", at + bad) from None
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
@@ -249,31 +187,30 @@ def read_siconos_text(path: str | Path) -> FrictionContactProblem:
     Returns
     -------
     FrictionContactProblem
-        W sparse (CSR) when stored sparse-block, dense otherwise; q, μ and ``contact_dim`` d.
+        W sparse (CSR) when stored sparse-block or compressed sparse, dense otherwise; q, μ
+        and ``contact_dim`` d.
 
     Raises
     ------
     ProblemFileError
         An unreadable file or damaged gzip stream, text that is not ASCII, a missing or
         non-numeric number, a count that does not fit the others (n₀ ≠ d·m, block pointers,
-        indices, block numbers, numbers left over after μ), a storage other than dense or
-        sparse-block, non-finite numbers, negative μ, or more than :data:`MAX_TEXT_BYTES` of
-        text. The message names the file, the field and the position of the number.
+        indices, block numbers, a compressed-sparse header, location or index out of place,
+        numbers left over after μ beyond Siconos' old 0/1 flag), a storage other than dense,
+        sparse-block or compressed sparse, a half-triplet W, non-finite numbers, negative μ,
+        or more than :data:`MAX_TEXT_BYTES` of text. The message names the file, the field
+        and the position of the number.
     """
     path = Path(path)
-    numbers = _Numbers(path, _text(path))
+    numbers = TextNumbers(path, _text(path))
     if not numbers.tokens:
         raise ProblemFileError(f"{path}: empty; not a Siconos text problem file")
     d = numbers.integer("d, the dimension of a contact", 2, 3)
     m = numbers.integer("the number of contacts", 1, MAX_SIZE // d)
     storage = numbers.integer("W's storage", 0, 2)
-    if storage not in STORAGES:
-        raise numbers.error("W's storage", f"{storage} (compressed sparse) is not read; "
-                                           "dense (0) and sparse-block (1) are",
-                            numbers.pos - 1)
     n0 = numbers.integer("W's rows", d * m, d * m)
     n1 = numbers.integer("W's columns", d * m, d * m)
-    W = _dense(numbers, n0, n1) if storage == 0 else _blocks(numbers, n0, n1)
+    W = (_dense, _blocks, read_compressed_sparse)[storage](numbers, n0, n1)
     q = numbers.floats("q", n1)
     at = numbers.pos
     mu = numbers.floats("μ", m)
@@ -334,7 +271,7 @@ def write_siconos_text(problem: FrictionContactProblem, path: str | Path, *,
     InputError
         Another storage, or ``problem`` is not a FrictionContactProblem.
     """
-    if storage not in STORAGES:
+    if storage not in WRITTEN:
         raise InputError(f"storage must be 0 (dense) or 1 (sparse-block), got {storage!r}")
     if not isinstance(problem, FrictionContactProblem):
         raise InputError(f"problem must be a FrictionContactProblem, got "
