@@ -7,7 +7,7 @@ for membership and polishing."""
 from __future__ import annotations
 
 import numpy as np
-from scipy import optimize
+from scipy import linalg, optimize
 
 from ..errors import SolverError
 from .active_set import SOLVED, lcp_psd
@@ -15,33 +15,34 @@ from .jit import kernel
 
 
 @kernel(interpretable=True)
-def nnls(A, b, max_iter):
-    """min ‖Ax − b‖₂ over x ≥ 0: the active-set search on G = AᵀA, q = −Aᵀb, then the
-    least-squares problem on the final support solved on A itself (no squared condition).
-
-    Returns ``(x, ‖Ax − b‖₂, status)`` with the status codes of :func:`lcp_psd`.
-    """
-    n, m = A.shape
+def nnls_search(A, b, max_iter):
+    """The active-set search of :func:`nnls` on G = AᵀA, q = −Aᵀb: ``(x, support, status)``
+    with the status codes of :func:`lcp_psd`."""
+    m = A.shape[1]
     G = A.T @ A
     q = -(A.T @ b)
     x = np.zeros(m)
     w = np.zeros(m)
     passive = np.zeros(m, dtype=np.bool_)
     status = lcp_psd(G, q, passive, x, w, max_iter)
-    k = 0
-    for j in range(m):
-        k += passive[j]
-    if status == SOLVED and 0 < k <= n:
-        support = np.flatnonzero(passive)
-        sub = np.empty((n, k))
-        for a in range(k):
-            sub[:, a] = A[:, support[a]]
-        xs = np.linalg.lstsq(sub, b.astype(np.float64), -1.0)[0]
+    return x, passive, status
+
+
+def nnls(A: np.ndarray, b: np.ndarray, max_iter: int) -> tuple[np.ndarray, float, int]:
+    """min ‖Ax − b‖₂ over x ≥ 0: the compiled active-set search on G = AᵀA, q = −Aᵀb
+    (:func:`nnls_search`), then the least-squares problem on the final support solved on A
+    itself by SciPy (no squared condition; kept when every entry stays positive).
+
+    Returns ``(x, ‖Ax − b‖₂, status)`` with the status codes of :func:`lcp_psd`.
+    """
+    x, support, status = nnls_search(A, b, max_iter)
+    k = int(support.sum())
+    if status == SOLVED and 0 < k <= A.shape[0]:
+        xs = linalg.lstsq(A[:, support], b)[0]
         if (xs > 0.0).all():
-            for a in range(k):
-                x[support[a]] = xs[a]
+            x[support] = xs
     r = A @ x - b
-    return x, np.sqrt(np.sum(r * r)), status
+    return x, float(np.sqrt(r @ r)), status
 
 
 def solve_nnls(A: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, float]:
