@@ -113,9 +113,10 @@ class ComplementarityMap(LocalMap):
         """The local map at the answer ``impulses`` on ``problem``: for a dense problem, its
         cell and certificate figures in one compiled call
         (:func:`impactqp.kernels.local_map.local_cell`) on the structure's operators; a
-        kink, a singular G_AA or a sparse problem through the constructor."""
+        kink, a singular G_AA, a sparse problem or one without contacts through the
+        constructor."""
         st = problem.structure
-        if st.sparse or st.n > DENSE_LIMIT:
+        if st.sparse or st.n > DENSE_LIMIT or st.m == 0:
             return cls(problem.M, problem.W, problem.u_minus, impulses, parameter,
                        kink_tol=kink_tol)
         ops = operands(st)
@@ -300,12 +301,14 @@ class ComplementarityMap(LocalMap):
 
     def vjp(self, u_bar: np.ndarray, lam_bar: np.ndarray) -> dict[str, np.ndarray]:
         k, (n, m) = u_bar.shape[0], self.W.shape
+        identity = self.parameter.identity  # its cotangent is tr Ē: Ē is not formed
         out = compiled.Cotangents(np.empty((k, n)), np.empty((k, n, n)), np.empty((k, n, m)),
-                                  np.empty((k, m, m)))
+                                  np.empty((k, 0, 0) if identity else (k, m, m)))
+        trace = np.empty(k)
         compiled.vjp(self._point, np.ascontiguousarray(u_bar, dtype=float),
-                     np.ascontiguousarray(lam_bar, dtype=float), *out)
+                     np.ascontiguousarray(lam_bar, dtype=float), *out, trace)
         return {"u_minus": out.u, "M": out.M, "W": out.W,
-                self.parameter.name: self.parameter.cotangent(out.E)}
+                self.parameter.name: trace if identity else self.parameter.cotangent(out.E)}
 
     def pieces(self, cap: int) -> list[LocalMap]:
         out: list[LocalMap] = []

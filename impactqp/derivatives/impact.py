@@ -15,7 +15,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..base.arrays import as_array, as_count
+from ..base.arrays import as_array, as_count, finite
 from ..base.checks import DEFAULT_TOL
 from ..errors import DerivativeUnsupportedError, InputError, ShapeError
 from .certificate import DerivativeCertificate, derivative_certificate
@@ -27,6 +27,15 @@ most this (relative to ‖u⁻‖) is on a kink (docs/theory.md §19)."""
 
 OUTPUTS = ("u_plus", "impulses")
 """What the Jacobians differentiate: the post-impact velocity or the impulses."""
+
+
+def _read(name: str, value: Any) -> np.ndarray:
+    """A tangent or cotangent as a finite float array, read only: a float array is checked
+    for finiteness alone, anything else goes through :func:`as_array`'s checks."""
+    if type(value) is np.ndarray and value.dtype == np.float64:
+        finite(name, value)
+        return value
+    return as_array(name, value, copy=False)
 
 
 class Tangents(NamedTuple):
@@ -135,7 +144,7 @@ class ImpactDerivative:
             if value is None:
                 continue
             shape = self._shape_of(name)
-            arr = as_array(name, value, copy=False)  # read only
+            arr = _read(name, value)
             if arr.shape != shape:
                 raise ShapeError(f"the tangent of {name} must have shape {shape}, got "
                                  f"{arr.shape}")
@@ -171,7 +180,7 @@ class ImpactDerivative:
 
     @staticmethod
     def _cotangent(name: str, value: Any, size: int) -> np.ndarray:
-        arr = as_array(name, value, copy=False)  # read only
+        arr = _read(name, value)
         if arr.shape != (size,):
             raise ShapeError(f"the cotangent of {name} must have shape ({size},), got "
                              f"{arr.shape}")

@@ -115,7 +115,7 @@ def classify_row(G, s, R, M, um, lam, kink_tol, w, active):
         for j in range(n):
             V += um[i] * M[i, j] * um[j]
     scale = 1.0 / np.sqrt(V) if V > 0.0 else 1.0
-    status, key = SMOOTH, 0
+    degenerate, key = False, 0
     for i in range(m):
         total = 0.0
         for c in range(n):
@@ -124,14 +124,12 @@ def classify_row(G, s, R, M, um, lam, kink_tol, w, active):
             total += G[i, j] * lam[j]
         w[i] = total
         a, b = lam[i] * s[i] * scale, total / s[i] * scale
-        active[i] = False
-        if max(a, b) <= kink_tol:
-            status = KINK
-        elif a >= b:
-            active[i] = True
-            if m <= MASK_BITS:
-                key |= 1 << i
-    return status, key
+        flat = max(a, b) <= kink_tol
+        on = a >= b and not flat
+        active[i] = on
+        degenerate |= flat
+        key |= np.int64(on) << i  # no branch on the row's data
+    return (KINK if degenerate else SMOOTH), (key if m <= MASK_BITS else 0)
 
 
 @inline_kernel
@@ -237,6 +235,8 @@ def derivative_rows(packed, Um, dU, Ubar, law, settings, passive, out):
     ops = _unpack(packed, n, m)
     R = law.IE @ ops.Wt  # ∂q/∂u⁻ and Yᵀ, the same for every row
     YT = np.ascontiguousarray(ops.MinvW.T)
+    # contiguous copies of the packed views: the row loop indexes them faster
+    G, s, M = ops.G.copy(), ops.s.copy(), ops.M.copy()
     kept = CACHED_CELLS if m <= MASK_BITS else 0
     cells = new_cells(m, kept)
     work = workspace(n, m)
@@ -249,13 +249,12 @@ def derivative_rows(packed, Um, dU, Ubar, law, settings, passive, out):
                 out.Res[r], work):
             out.status[r], out.margin[r] = UNCERTIFIED, np.nan
             continue
-        status, key = classify_row(ops.G, ops.s, R, ops.M, um, lam, settings.kink_tol, w,
-                                   active)
+        status, key = classify_row(G, s, R, M, um, lam, settings.kink_tol, w, active)
         e = cells.slot[key] if kept else -1
         if e < 0:
             e = used if used < kept else kept
-            factor_cell(ops.G, active, cells, e)
-            measure_cell(ops.G, R, active, cells, e)
+            factor_cell(G, active, cells, e)
+            measure_cell(G, R, active, cells, e)
             if e < kept:
                 cells.slot[key] = e
                 used += 1

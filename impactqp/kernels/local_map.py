@@ -219,11 +219,13 @@ class Cotangents(NamedTuple):
 
 
 @kernel
-def vjp(point, ubar, lbar, u_out, M_out, W_out, E_out):
+def vjp(point, ubar, lbar, u_out, M_out, W_out, E_out, trace_out):
     """The transpose of :func:`jvp` at the packed ``point`` for rows of cotangents ū
     (k, n) and Λ̄ (k, m), into the rows of ``u_out``, ``M_out``, ``W_out``, ``E_out``
-    (:class:`Cotangents`): with l = Λ̄ + Yᵀū, b = −Kᵀl, a = M⁻¹ū + Yb and
-    ρ = (I + E)ᵀb, ū⁻ = ū + Wρ, M̄ = −a vᵀ, W̄ = aΛᵀ + v bᵀ + u⁻ρᵀ, Ē = b γ⁻ᵀ."""
+    (:class:`Cotangents`; ``E_out`` of shape (k, 0, 0): Ē left out) and ``trace_out``
+    (tr Ē, the cotangent of a parameter with E = value·I): with l = Λ̄ + Yᵀū, b = −Kᵀl,
+    a = M⁻¹ū + Yb and ρ = (I + E)ᵀb, ū⁻ = ū + Wρ, M̄ = −a vᵀ, W̄ = aΛᵀ + v bᵀ + u⁻ρᵀ,
+    Ē = b γ⁻ᵀ."""
     n, m = ubar.shape[1], lbar.shape[1]
     p = unpack_point(point, n, m)
     lt, b, rho, a = np.empty(m), np.empty(m), np.empty(m), np.empty(n)
@@ -258,7 +260,10 @@ def vjp(point, ubar, lbar, u_out, M_out, W_out, E_out):
                 M_out[row, c, d] = -a[c] * p.v[d]
             for j in range(m):
                 W_out[row, c, j] = a[c] * p.lam[j] + p.v[c] * b[j] + p.u[c] * rho[j]
+        trace = 0.0
         for i in range(m):
-            for j in range(m):
+            trace += b[i] * p.gamma[i]
+            for j in range(E_out.shape[2]):
                 E_out[row, i, j] = b[i] * p.gamma[j]
+        trace_out[row] = trace
 
