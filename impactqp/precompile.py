@@ -21,6 +21,7 @@ import numpy as np
 
 from . import kernels
 from .derivatives.batch import derivative_batch
+from .derivatives.solve import derivative
 from .errors import InputError
 from .kernels.first_calls import cached, compiling
 from .kernels.jit import NOTICE, cache_dir
@@ -52,6 +53,10 @@ def _impacts() -> None:
     r = random_impact(8, 5, seed=1)
     moreau(r, 0.5)
     moreau(r, 0.5, backend="nnls")
+    for law in (Moreau(0.5), Fremond(0.2 * np.eye(5))):  # the compiled derivative
+        d = derivative(r, law)
+        d.jvp(u_minus=r.u_minus)
+        d.vjp(u_plus=r.u_minus)
 
 
 def _batches() -> None:
@@ -75,7 +80,7 @@ def _lzb() -> None:
 
 def _friction() -> None:
     p = sphere_on_plane(1.0, 0.1, [1.0, -2.0, 0.0])
-    solve(p, Coulomb(0.3, 0.5))
+    solve(p, Coulomb(0.3, 0.5)).derivative().jvp(u_minus=p.u_minus)
     rng = np.random.default_rng(2)
     m = 40
     A = rng.standard_normal((3 * m, 3 * m + 5))

@@ -63,7 +63,7 @@ class DerivativeBatch:
 def _directions(name: str, value: Any, shape: tuple[int, int]) -> np.ndarray | None:
     if value is None:
         return None
-    arr = as_array(name, value)
+    arr = as_array(name, value, copy=False)  # read only
     if arr.shape != shape:
         raise ShapeError(f"{name} must have shape {shape} (one row per impact), got "
                          f"{arr.shape}")
@@ -82,11 +82,13 @@ def _compiled(problem, law, U, dU, Ubar, tol, kink_tol, n_jobs):
     settings = compiled.Settings(tol, kink_tol, dU is not None, Ubar is not None, solved)
     dUp, Uout = np.empty((k, n)) if dU is not None else None, \
         np.empty((k, n)) if Ubar is not None else None
-    out = compiled.Rows(np.empty((k, n)), np.empty((k, m)), np.empty((k, 6)),
-                        dUp, Uout, np.empty(k, dtype=np.int64), np.empty(k))
     if solved:  # a short chain: its columns solve faster than rows; differentiate after
         done = solve_batch(problem, law, U, tol=tol, n_jobs=n_jobs)
-        out.Up[:], out.Lam[:] = done.u_plus, done.impulses
+        Up, Lam = done.u_plus, done.impulses
+    else:
+        Up, Lam = np.empty((k, n)), np.empty((k, m))
+    out = compiled.Rows(Up, Lam, np.empty((k, 6)), dUp, Uout, np.empty(k, dtype=np.int64),
+                        np.empty(k))
     placeholder = np.zeros((1, n))
 
     def work(a: int, b: int) -> np.ndarray:

@@ -9,7 +9,13 @@ q = (I + E)Wᵀu⁻ and G = WᵀM⁻¹W:
 
 with K = G_AA⁺ embedded, Y = M⁻¹W and v = YΛ = u⁺ − u⁻. For Moreau's law this is
 du⁺ = (I − (1 + ε)P_A)du⁻ with P_A = M⁻¹W_A G_AA⁺W_Aᵀ. The VJP is the transpose of the
-same few products (docs/theory.md §18).
+same few products (docs/theory.md §18), one compiled definition of each
+(:mod:`impactqp.kernels.local_map`).
+
+A dense problem's derivative is formed from its structure's operators by one compiled call
+(:meth:`ComplementarityMap.at`): the classification, the factor of G_AA and every figure of
+the certificate (margin, residual of the solves, condition). A kink or a singular G_AA is
+formed here instead (eigen-decompositions: the minimum-norm element, the degenerate set).
 """
 
 from __future__ import annotations
@@ -21,9 +27,12 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..errors import DerivativeUnsupportedError
+from ..kernels import local_map as compiled
+from ..kernels.derivative import SMOOTH
 from ..qp.lcp import solve_lcp
 from . import lcp
 from .local import Kink, LocalMap
+from .operands import EMPTY, POINT_SIZE, UNPACK, dense, directions, operands
 
 DENSE_LIMIT = 2000
 """Most degrees of freedom of a derivative: its operands (M⁻¹, the Jacobians) are dense."""
@@ -42,18 +51,21 @@ class Parameter(NamedTuple):
         value ↦ E, an (m, m) matrix (linear: the same map takes a tangent to dE).
     cotangent : callable
         Ē of shape (k, m, m) ↦ the parameter's cotangents, shape (k, *value.shape).
+    identity : bool
+        E = value·I (a scalar value): the compiled cell forms I + E itself.
     """
 
     name: str
     value: np.ndarray
     to_E: Callable[[np.ndarray], np.ndarray]
     cotangent: Callable[[np.ndarray], np.ndarray]
+    identity: bool = False
 
 
 def scalar_times_identity(name: str, value: float, m: int) -> Parameter:
     """E = value·I (Moreau's ε, one Newton coefficient for every contact)."""
     return Parameter(name, np.asarray(float(value)), lambda p: float(p) * np.eye(m),
-                     lambda Ebar: np.trace(Ebar, axis1=1, axis2=2))
+                     lambda Ebar: np.trace(Ebar, axis1=1, axis2=2), True)
 
 
 def diagonal(name: str, value: np.ndarray) -> Parameter:
@@ -66,10 +78,6 @@ def full_matrix(name: str, value: np.ndarray) -> Parameter:
     """E itself (Frémond's matrix of impact coefficients)."""
     return Parameter(name, np.asarray(value, dtype=float).copy(),
                      lambda p: np.asarray(p, dtype=float), lambda Ebar: Ebar)
-
-
-def _dense(A: Any) -> np.ndarray:
-    return np.asarray(A.toarray() if hasattr(A, "toarray") else A, dtype=float)
 
 
 class ComplementarityMap(LocalMap):
@@ -99,6 +107,75 @@ class ComplementarityMap(LocalMap):
             self.kink = Kink(D, float(max(np.abs(impulses[D] * s[D] / V).max(),
                                           np.abs(w[D] / (s[D] * V)).max())))
 
+    @classmethod
+    def at(cls, problem: Any, impulses: np.ndarray, parameter: Parameter, *,
+           kink_tol: float) -> ComplementarityMap:
+        """The local map at the answer ``impulses`` on ``problem``: for a dense problem, its
+        cell and certificate figures in one compiled call
+        (:func:`impactqp.kernels.local_map.local_cell`) on the structure's operators; a
+        kink, a singular G_AA, a sparse problem or one without contacts through the
+        constructor."""
+        st = problem.structure
+        if st.sparse or st.n > DENSE_LIMIT or st.m == 0:
+            return cls(problem.M, problem.W, problem.u_minus, impulses, parameter,
+                       kink_tol=kink_tol)
+        ops = operands(st)
+        n, m = ops.W.shape
+        u = np.ascontiguousarray(problem.u_minus, dtype=float)
+        lam = np.ascontiguousarray(impulses, dtype=float)
+        E, eps = (EMPTY[2], float(parameter.value)) if parameter.identity else \
+            (np.ascontiguousarray(parameter.to_E(parameter.value), dtype=float), 0.0)
+        size = POINT_SIZE(n, m)
+        out = np.empty(size + 2 * m + 3)
+        if compiled.local_cell(ops.packed, ops.Minv, E, eps, u, lam, float(kink_tol),
+                               out) != SMOOTH:
+            return cls(ops.M, ops.W, u, lam, parameter, kink_tol=kink_tol)
+        self = object.__new__(cls)
+        self.M, self.W, self.Minv, self.Y, self.G = ops.M, ops.W, ops.Minv, ops.Y, ops.G
+        self.u, self.lam, self.parameter = u, lam, parameter
+        self._cell, self._point, self.impulses_unique = out, out[:size], True
+        margin, residual, self.condition = out[-3:].tolist()
+        self.__dict__["_measures"] = (residual, margin)  # measured by the kernel
+        return self
+
+    # What the compiled cell holds, read from it when first needed (the constructor sets
+    # them itself).
+    @cached_property
+    def inputs(self) -> dict[str, tuple[int, ...]]:  # type: ignore[override]
+        n, m = self.W.shape
+        return {"u_minus": (n,), "M": (n, n), "W": (n, m),
+                self.parameter.name: self.parameter.value.shape}
+
+    @cached_property
+    def _fields(self) -> compiled.Point:
+        return UNPACK(self._cell, *self.W.shape)
+
+    @cached_property
+    def K(self) -> np.ndarray:
+        return self._fields.K
+
+    @cached_property
+    def IE(self) -> np.ndarray:
+        return self._fields.IE
+
+    @cached_property
+    def v(self) -> np.ndarray:
+        return self._fields.v
+
+    @cached_property
+    def gamma(self) -> np.ndarray:
+        return self._fields.gamma
+
+    @cached_property
+    def w(self) -> np.ndarray:
+        m = self.W.shape[1]
+        return self._cell[-2 * m - 3:-m - 3]
+
+    @cached_property
+    def active(self) -> np.ndarray:
+        m = self.W.shape[1]
+        return self._cell[-m - 3:-3] > 0.5
+
     @property
     def margin(self) -> float:  # type: ignore[override]
         return 0.0 if self.status == "kink" else self._measures[1]
@@ -120,8 +197,9 @@ class ComplementarityMap(LocalMap):
             raise DerivativeUnsupportedError(
                 f"the derivative of an impact with n = {M.shape[0]} degrees of freedom: "
                 f"derivatives are formed densely, up to n = {DENSE_LIMIT}")
-        self.M, self.W = _dense(M), _dense(W)
-        self.u, self.lam, self.parameter = np.asarray(u_minus, float), impulses, parameter
+        self.M, self.W = dense(M), dense(W)
+        self.u = np.ascontiguousarray(u_minus, dtype=float)
+        self.lam, self.parameter = np.ascontiguousarray(impulses, dtype=float), parameter
         n, m = self.W.shape
         self.inputs = {"u_minus": (n,), "M": (n, n), "W": (n, m),
                        parameter.name: parameter.value.shape}
@@ -132,11 +210,30 @@ class ComplementarityMap(LocalMap):
         self.G = 0.5 * (G + G.T)
         self.gamma = self.W.T @ self.u
         self.IE = np.eye(m) + parameter.to_E(parameter.value)
-        self.v = self.Y @ impulses
-        self.q = self.IE @ self.gamma
-        self.w = self.G @ impulses + self.q
+        self.v = self.Y @ self.lam
+        self.w = self.G @ self.lam + self.q
         s = np.sqrt(np.maximum(np.diag(self.G), 1e-300))
         return s, float(np.sqrt(max(self.u @ self.M @ self.u, 0.0))) or 1.0
+
+    @cached_property
+    def q(self) -> np.ndarray:
+        """q = (I + E)γ⁻, the LCP's vector."""
+        return self.IE @ self.gamma
+
+    @cached_property
+    def aset(self) -> lcp.ActiveSet:
+        """The classification (the compiled path's cell has no degenerate contact)."""
+        return lcp.ActiveSet(self.active, np.zeros_like(self.active), np.nan)
+
+    @cached_property
+    def _point(self) -> np.ndarray:
+        """The compiled kernels' operands at this answer, with this piece's K, packed
+        (:class:`~impactqp.kernels.local_map.Point`; the compiled cell comes with its own)."""
+        return compiled.pack_point(self.Minv, self.Y, self.W, self.IE, self.K, self.u,
+                                   self.lam, self.v, self.gamma)
+
+    def _directions(self, tangents: dict[str, np.ndarray]) -> tuple[np.ndarray, ...]:
+        return directions(tangents, self.parameter.name, self.parameter.to_E)
 
     def _absorb_redundant(self, aset: lcp.ActiveSet, scale: np.ndarray,
                           kink_tol: float) -> lcp.ActiveSet:
@@ -162,6 +259,7 @@ class ComplementarityMap(LocalMap):
         self.condition = f.condition
         self.impulses_unique = f.rank == int(active.sum())
         self.__dict__.pop("_measures", None)
+        self.__dict__.pop("_point", None)
 
     @cached_property
     def _measures(self) -> tuple[float, float]:
@@ -191,27 +289,10 @@ class ComplementarityMap(LocalMap):
 
     def _rhs(self, t: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """(r = dG Λ + dq, the part of du⁺ outside Y dΛ) for tangents ``t``."""
-        n, m = self.W.shape
-        r, du = np.zeros(m), np.zeros(n)
-        if (d := t.get("u_minus")) is not None:
-            r += self.IE @ (self.W.T @ d)
-            du += d
-        if (d := t.get(self.parameter.name)) is not None:
-            r += self.parameter.to_E(d) @ self.gamma
-        if (d := t.get("W")) is not None:
-            dW_lam = d @ self.lam
-            r += self.IE @ (d.T @ self.u) + d.T @ self.v + self.Y.T @ dW_lam
-            du += self.Minv @ dW_lam
-        if (d := t.get("M")) is not None:
-            dMv = d @ self.v
-            r -= self.Y.T @ dMv
-            du -= self.Minv @ dMv
-        return r, du
+        return compiled.rhs(self._point, *self.W.shape, *self._directions(t))
 
     def jvp(self, tangents: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-        r, du = self._rhs(tangents)
-        dlam = -(self.K @ r)
-        return du + self.Y @ dlam, dlam
+        return compiled.jvp(self._point, *self.W.shape, *self._directions(tangents))
 
     def directional(self, tangents: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         r, du = self._rhs(tangents)
@@ -219,16 +300,15 @@ class ComplementarityMap(LocalMap):
         return du + self.Y @ dlam, dlam
 
     def vjp(self, u_bar: np.ndarray, lam_bar: np.ndarray) -> dict[str, np.ndarray]:
-        lt = lam_bar + u_bar @ self.Y
-        rb = -(lt @ self.K)
-        a = u_bar @ self.Minv + rb @ self.Y.T
-        rho = rb @ self.IE
-        Wbar = a[:, :, None] * self.lam[None, None, :] + self.v[None, :, None] * rb[:, None, :] \
-            + self.u[None, :, None] * rho[:, None, :]
-        return {"u_minus": u_bar + rho @ self.W.T, "M": -a[:, :, None] * self.v[None, None, :],
-                "W": Wbar,
-                self.parameter.name: self.parameter.cotangent(
-                    rb[:, :, None] * self.gamma[None, None, :])}
+        k, (n, m) = u_bar.shape[0], self.W.shape
+        identity = self.parameter.identity  # its cotangent is tr Ē: Ē is not formed
+        out = compiled.Cotangents(np.empty((k, n)), np.empty((k, n, n)), np.empty((k, n, m)),
+                                  np.empty((k, 0, 0) if identity else (k, m, m)))
+        trace = np.empty(k)
+        compiled.vjp(self._point, np.ascontiguousarray(u_bar, dtype=float),
+                     np.ascontiguousarray(lam_bar, dtype=float), *out, trace)
+        return {"u_minus": out.u, "M": out.M, "W": out.W,
+                self.parameter.name: trace if identity else self.parameter.cotangent(out.E)}
 
     def pieces(self, cap: int) -> list[LocalMap]:
         out: list[LocalMap] = []

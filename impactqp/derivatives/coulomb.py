@@ -120,6 +120,7 @@ class CoulombMap(ComplementarityMap):
         self.impulses_unique = True
         self._J, self._FU = J, FU
         self.__dict__.pop("_measures", None)
+        self.__dict__.pop("_point", None)
 
     @cached_property
     def _measures(self) -> tuple[float, float]:

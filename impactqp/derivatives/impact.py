@@ -9,12 +9,13 @@ ever returned as a derivative.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import cached_property
 from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..base.arrays import as_array, as_count
+from ..base.arrays import as_array, as_count, finite
 from ..base.checks import DEFAULT_TOL
 from ..errors import DerivativeUnsupportedError, InputError, ShapeError
 from .certificate import DerivativeCertificate, derivative_certificate
@@ -26,6 +27,15 @@ most this (relative to ‖u⁻‖) is on a kink (docs/theory.md §19)."""
 
 OUTPUTS = ("u_plus", "impulses")
 """What the Jacobians differentiate: the post-impact velocity or the impulses."""
+
+
+def _read(name: str, value: Any) -> np.ndarray:
+    """A tangent or cotangent as a finite float array, read only: a float array is checked
+    for finiteness alone, anything else goes through :func:`as_array`'s checks."""
+    if type(value) is np.ndarray and value.dtype == np.float64:
+        finite(name, value)
+        return value
+    return as_array(name, value, copy=False)
 
 
 class Tangents(NamedTuple):
@@ -57,8 +67,9 @@ class ImpactDerivative:
         What the law's ``derivative`` hook returned (None: unsupported).
     reason : str
         Why the derivative is unsupported (names the law).
-    tol : float
-        The certificate's tolerance.
+    tol : float or callable
+        The certificate's tolerance, or what returns it (read when the certificate is
+        built: a result's own certificate is then not built before it is needed).
     solve : callable, optional
         data ↦ (u⁺, Λ): the law at other inputs, for audits of a local map that cannot
         evaluate itself.
@@ -84,11 +95,12 @@ class ImpactDerivative:
     """
 
     def __init__(self, problem: Any, law: Any, u_plus: np.ndarray, impulses: np.ndarray,
-                 local: LocalMap | None, *, reason: str = "", tol: float = DEFAULT_TOL,
+                 local: LocalMap | None, *, reason: str = "",
+                 tol: float | Callable[[], float] = DEFAULT_TOL,
                  solve: Any = None) -> None:
         self.problem, self.impact_law, self.law = problem, law, law.name
         self.u_plus, self.impulses = u_plus, impulses
-        self.local, self.reason, self.tol, self._solve = local, reason, tol, solve
+        self.local, self.reason, self._tol, self._solve = local, reason, tol, solve
         if isinstance(local, LinearPiece):
             dense = [np.asarray(A.toarray() if hasattr(A, "toarray") else A, dtype=float)
                      for A in (problem.M, problem.W)]
@@ -110,6 +122,11 @@ class ImpactDerivative:
     def impulses_unique(self) -> bool:
         return self.local is not None and self.local.impulses_unique
 
+    @property
+    def tol(self) -> float:
+        """The certificate's tolerance (the solve's)."""
+        return self._tol() if callable(self._tol) else self._tol
+
     @cached_property
     def certificate(self) -> DerivativeCertificate:
         return derivative_certificate(self, self.tol)
@@ -127,7 +144,7 @@ class ImpactDerivative:
             if value is None:
                 continue
             shape = self._shape_of(name)
-            arr = as_array(name, value)
+            arr = _read(name, value)
             if arr.shape != shape:
                 raise ShapeError(f"the tangent of {name} must have shape {shape}, got "
                                  f"{arr.shape}")
@@ -163,7 +180,7 @@ class ImpactDerivative:
 
     @staticmethod
     def _cotangent(name: str, value: Any, size: int) -> np.ndarray:
-        arr = as_array(name, value)
+        arr = _read(name, value)
         if arr.shape != (size,):
             raise ShapeError(f"the cotangent of {name} must have shape ({size},), got "
                              f"{arr.shape}")
@@ -218,7 +235,8 @@ def derivative_of(result: Any, *, kink_tol: float = KINK_TOL) -> ImpactDerivativ
     """The derivative of a certified impact result (``result.derivative()``): the law's
     ``derivative`` hook at the result's answer, or ``"unsupported"`` by name."""
     law, problem = result.impact_law, result.problem
-    kink_tol = float(as_array("kink_tol", kink_tol))
+    if type(kink_tol) is not float:  # the default needs no conversion
+        kink_tol = float(as_array("kink_tol", kink_tol))
     if not 0.0 <= kink_tol < 1.0:
         raise InputError(f"kink_tol must lie in [0, 1), got {kink_tol!r}")
 
@@ -236,4 +254,4 @@ def derivative_of(result: Any, *, kink_tol: float = KINK_TOL) -> ImpactDerivativ
         f"{law.title} ({law.name!r}) has no derivative: it defines no `derivative` hook"
         " (impactqp never returns a finite difference as a derivative)")
     return ImpactDerivative(problem, law, result.u_plus, result.impulses, local,
-                            reason=reason, tol=result.certificate.tol, solve=solve)
+                            reason=reason, tol=lambda: result.certificate.tol, solve=solve)

@@ -1,16 +1,22 @@
 """Derivatives of many dense impacts of a complementarity law, in compiled code
 (docs/theory.md §18–§20).
 
-Each row is solved and certified by the compiled impact (:mod:`impactqp.kernels.impact`);
-on the row's active set A, G_AA is factored (G_AA = LLᵀ, dependent columns dropped as in
-the active-set search) and reused for the row's JVP, VJP and cell margin:
+Each row is solved and certified by the compiled impact (:mod:`impactqp.kernels.impact`)
+and classified; its cell (active set A) is factored once — G_AA = LLᵀ, dependent columns
+dropped as in the active-set search, K_AA = G_AA⁻¹ from the factor — with what depends on A
+alone: the gradients in u⁻ of the quantities bounding the cell and the relative residual
+‖G_AA K_AA R_A − R_A‖ / ‖R_A‖ of its linear solves (a wrong factor shows there). Up to
+:data:`CACHED_CELLS` cells of a call are kept by active set (for at most :data:`MASK_BITS`
+contacts), so rows in a cell already met pay only for their classification, margin, JVP
+and VJP:
 
-    du⁺ = du⁻ − Y_A G_AA⁻¹ (R du⁻)_A,   ū⁻ = ū − Rᵀ_A G_AA⁻¹ (Yᵀū)_A,
+    du⁺ = du⁻ − Y_A K_AA (R du⁻)_A,   ū⁻ = ū − Rᵀ_A K_AAᵀ (Yᵀū)_A,
 
 with Y = M⁻¹W and R = (I + E)Wᵀ = ∂q/∂u⁻. The margin is the distance, relative to ‖u⁻‖,
 from u⁻ to the nearest hyperplane where an active Λᵢ or an inactive wᵢ reaches zero
 (docs/theory.md §20); a row with a degenerate contact is a kink (margin 0, the default
-element: degenerate contacts counted as separating).
+element: degenerate contacts counted as separating). The single impact's derivative
+(:mod:`impactqp.kernels.local_map`) factors its cell by the same functions.
 """
 
 from __future__ import annotations
@@ -19,12 +25,19 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .active_set import _append, solve_factored_into
+from .active_set import _append, cholesky_solve
 from .impact import _solve_into, _unpack, workspace
-from .jit import kernel
+from .jit import inline_kernel, kernel
 
-SMOOTH, KINK, UNCERTIFIED = 0, 1, 2
-"""Row status codes of :func:`derivative_rows`."""
+SMOOTH, KINK, UNCERTIFIED, DEPENDENT = 0, 1, 2, 3
+"""Status codes: of :func:`derivative_rows`' rows (the first three) and of the single
+impact's cell (DEPENDENT: G_AA is singular, Λ not unique)."""
+
+MASK_BITS = 16
+"""Most contacts for which a call keeps its cells by active set (a table of 2^m slots)."""
+
+CACHED_CELLS = 64
+"""Most cells a call keeps; further ones are factored again for each row."""
 
 
 class Law(NamedTuple):
@@ -63,137 +76,195 @@ class Rows(NamedTuple):
     margin: np.ndarray
 
 
+class Cells(NamedTuple):
+    """Factored cells, by number (the last one is scratch, refilled for every row whose
+    cell is not kept): the factor's contacts ``idx[e, :size[e]]``, K_AA = G_AA⁻¹ embedded
+    in ``K[e]`` (m × m, read on idx only), the inverse gradient norms ``grad[e]`` of the
+    bounding quantities, the solves' relative ``residual[e]``; ``slot`` maps an active-set
+    bit mask to its cell (−1: not factored yet); L and y are scratch."""
+
+    idx: np.ndarray
+    size: np.ndarray
+    K: np.ndarray
+    grad: np.ndarray
+    residual: np.ndarray
+    slot: np.ndarray
+    L: np.ndarray
+    y: np.ndarray
+
+
 @kernel
-def _active_factor(G, IE, Wt, M, um, lam, kink_tol, L, idx, w, active, gamma):
-    """w = GΛ + q for the row, the factor of G_AA on the active contacts (in L, idx) and
-    the row's status. Returns (k, status)."""
-    m, n = Wt.shape
+def new_cells(m, cached):
+    """Room for ``cached`` kept cells and the scratch one (``cached`` = 0: scratch only)."""
+    slots = (1 << m) if cached > 0 else 1
+    return Cells(np.empty((cached + 1, m), dtype=np.int64),
+                 np.zeros(cached + 1, dtype=np.int64), np.zeros((cached + 1, m, m)),
+                 np.zeros((cached + 1, m)), np.zeros(cached + 1),
+                 np.full(slots, -1, dtype=np.int64), np.empty((m, m)), np.empty(2 * m))
+
+
+@inline_kernel
+def classify_row(G, s, R, M, um, lam, kink_tol, w, active):
+    """w = GΛ + Ru⁻ (= GΛ + q) for the row and its classification (docs/theory.md §19): a
+    contact is degenerate when its scaled Λᵢsᵢ and wᵢ/sᵢ (sᵢ = √Gᵢᵢ) are both at most
+    ``kink_tol``·‖u⁻‖_M, else active when Λᵢsᵢ ≥ wᵢ/sᵢ. Returns (status, the active set's
+    bit mask; 0 beyond :data:`MASK_BITS` contacts)."""
+    m, n = R.shape
     V = 0.0
     for i in range(n):
         for j in range(n):
             V += um[i] * M[i, j] * um[j]
-    V = np.sqrt(V) if V > 0.0 else 1.0
-    for j in range(m):
-        g = 0.0
-        for c in range(n):
-            g += Wt[j, c] * um[c]
-        gamma[j] = g
+    scale = 1.0 / np.sqrt(V) if V > 0.0 else 1.0
+    degenerate, key = False, 0
     for i in range(m):
         total = 0.0
+        for c in range(n):
+            total += R[i, c] * um[c]
         for j in range(m):
-            total += IE[i, j] * gamma[j] + G[i, j] * lam[j]
+            total += G[i, j] * lam[j]
         w[i] = total
-    k, status = 0, SMOOTH
-    for i in range(m):
-        s = np.sqrt(G[i, i])
-        a, b = lam[i] * s / V, w[i] / (s * V)
-        active[i] = False
-        if max(a, b) <= kink_tol:
-            status = KINK
-        elif a >= b:
-            active[i] = True
-            if _append(L, idx, k, G, i):
-                k += 1
-    return k, status
+        a, b = lam[i] * s[i] * scale, total / s[i] * scale
+        flat = max(a, b) <= kink_tol
+        on = a >= b and not flat
+        active[i] = on
+        degenerate |= flat
+        key |= np.int64(on) << i  # no branch on the row's data
+    return (KINK if degenerate else SMOOTH), (key if m <= MASK_BITS else 0)
 
 
-@kernel
-def _margin(G, IE, Wt, um, lam, w, L, idx, k, active, buf):
-    """The cell's radius relative to ‖u⁻‖ (docs/theory.md §20): min over contacts of the
-    value (Λᵢ active, wᵢ inactive) over the norm of its gradient in u⁻."""
-    m, n = Wt.shape
-    R, dlam, grad = buf[:m], buf[m:2 * m], buf[2 * m:3 * m]
+@inline_kernel
+def factor_cell(G, active, cells, e):
+    """Factor the cell of ``active`` into cell number ``e`` of ``cells``: G_AA = LLᵀ (a
+    dependent contact is dropped, as in the active-set search) and K_AA = G_AA⁻¹ from it.
+    Returns the factor's size."""
+    idx, K, L, y = cells.idx[e], cells.K[e], cells.L, cells.y
+    k = 0
+    for i in range(active.size):
+        if active[i] and _append(L, idx, k, G, i):
+            k += 1
+    for a in range(k):
+        for b in range(k):
+            y[b] = 1.0 if a == b else 0.0
+        cholesky_solve(L, k, y)
+        for b in range(k):
+            K[idx[b], idx[a]] = y[b]
+    cells.size[e] = k
+    return k
+
+
+@inline_kernel
+def measure_cell(G, R, active, cells, e):
+    """What cell ``e`` of ``cells`` depends on alone (docs/theory.md §20), from X =
+    K_AA R_A: the inverse norms of the gradients in u⁻ of Λᵢ (active: −Xᵢ) and wᵢ
+    (inactive: (R − G X)ᵢ; 0 for a zero gradient), and the relative residual
+    ‖G_AA X − R_A‖ / ‖R_A‖ (Frobenius), measured with G itself: a wrong K shows here."""
+    m, n = R.shape
+    idx, K, k, grad, x = cells.idx[e], cells.K[e], cells.size[e], cells.grad[e], cells.y[m:]
     grad[:] = 0.0
-    unorm = 0.0
+    res, scale = 0.0, 0.0
     for c in range(n):
-        unorm += um[c] * um[c]
-        for i in range(m):
+        for a in range(k):
             total = 0.0
-            for j in range(m):
-                total += IE[i, j] * Wt[j, c]
-            R[i] = total
-            dlam[i] = 0.0
-        solve_factored_into(L, idx, k, R, dlam, buf[4 * m:5 * m])
+            for b in range(k):
+                total += K[idx[a], idx[b]] * R[idx[b], c]
+            x[a] = total
+            grad[idx[a]] += total * total
         for i in range(m):
-            if active[i]:  # an active contact dropped as dependent keeps a zero gradient
-                grad[i] += dlam[i] * dlam[i]
-            else:
-                total = R[i]
-                for a in range(k):
-                    total -= G[i, idx[a]] * dlam[idx[a]]
-                grad[i] += total * total
-    best = np.inf
+            if active[i]:
+                continue
+            z = -R[i, c]
+            for b in range(k):
+                z += G[i, idx[b]] * x[b]
+            grad[i] += z * z
+        for a in range(k):
+            z = -R[idx[a], c]
+            for b in range(k):
+                z += G[idx[a], idx[b]] * x[b]
+            res += z * z
+            scale += R[idx[a], c] * R[idx[a], c]
     for i in range(m):
-        value = lam[i] if active[i] else w[i]
-        if grad[i] > 0.0 and value / np.sqrt(grad[i]) < best:
-            best = value / np.sqrt(grad[i])
+        grad[i] = 1.0 / np.sqrt(grad[i]) if grad[i] > 0.0 else 0.0
+    cells.residual[e] = np.sqrt(res) / (np.sqrt(scale) if scale > 0.0 else 1.0)
+
+
+@inline_kernel
+def row_margin(um, lam, w, active, inverse):
+    """The cell's radius relative to ‖u⁻‖ (docs/theory.md §20): min over contacts of the
+    value (Λᵢ active, wᵢ inactive) times the inverse norm of its gradient in u⁻ (0 for a
+    zero gradient, as of a dropped dependent contact: it bounds nothing)."""
+    best, unorm = np.inf, 0.0
+    for c in range(um.size):
+        unorm += um[c] * um[c]
+    for i in range(lam.size):
+        if inverse[i] > 0.0:
+            best = min(best, (lam[i] if active[i] else w[i]) * inverse[i])
     return best / np.sqrt(unorm) if unorm > 0.0 else 0.0
 
 
-@kernel
-def _jvp_vjp(IE, Wt, MinvW, L, idx, k, du, ubar, dup, uout, settings, buf):
-    """The row's JVP du⁺ and VJP ū⁻ on the factored active set."""
-    m, n = Wt.shape
-    r, x = buf[:m], buf[m:2 * m]
-    if settings.jvp:
-        for i in range(m):
-            total = 0.0
-            for j in range(m):
-                g = 0.0
-                for c in range(n):
-                    g += Wt[j, c] * du[c]
-                total += IE[i, j] * g
-            r[i] = total
-            x[i] = 0.0
-        solve_factored_into(L, idx, k, r, x, buf[4 * m:5 * m])
+@inline_kernel
+def apply_cell(P, Q, cells, e, transpose, x, out):
+    """out = x − Q_Aᵀ K_AA P_A x (K_AAᵀ with ``transpose``): with P = R, Q = Yᵀ the JVP of
+    u⁻, with P = Yᵀ, Q = R and ``transpose`` its VJP (docs/theory.md §18)."""
+    m, n = P.shape
+    idx, K, k, y = cells.idx[e], cells.K[e], cells.size[e], cells.y
+    for a in range(k):
+        total = 0.0
         for c in range(n):
-            total = du[c]
-            for a in range(k):
-                total -= MinvW[c, idx[a]] * x[idx[a]]
-            dup[c] = total
-    if settings.vjp:
-        for i in range(m):
-            total = 0.0
-            for c in range(n):
-                total += MinvW[c, i] * ubar[c]
-            r[i] = total
-            x[i] = 0.0
-        solve_factored_into(L, idx, k, r, x, buf[4 * m:5 * m])
-        for c in range(n):
-            total = ubar[c]
-            for i in range(m):
-                g = 0.0
-                for j in range(m):
-                    g += IE[j, i] * x[j]
-                total -= Wt[i, c] * g
-            uout[c] = total
+            total += P[idx[a], c] * x[c]
+        y[a] = total
+    z = y[m:]
+    for a in range(k):
+        total = 0.0
+        for b in range(k):
+            total += (K[idx[b], idx[a]] if transpose else K[idx[a], idx[b]]) * y[b]
+        z[a] = total
+    for c in range(n):
+        total = x[c]
+        for a in range(k):
+            total -= Q[idx[a], c] * z[a]
+        out[c] = total
 
 
 @kernel
 def derivative_rows(packed, Um, dU, Ubar, law, settings, passive, out):
     """Solve, certify and differentiate every row of U⁻ into ``out`` (:class:`Rows`); a
-    row that the compiled solve does not certify gets status UNCERTIFIED (the caller
-    answers it on its own)."""
+    row that the compiled solve does not certify, or whose cell's linear solves miss the
+    tolerance, gets status UNCERTIFIED (the caller answers it on its own)."""
     k_rows, n = Um.shape
     m = passive.size
     ops = _unpack(packed, n, m)
-    M, Wt, MinvW, G = ops.M, ops.Wt, ops.MinvW, ops.G
+    R = law.IE @ ops.Wt  # ∂q/∂u⁻ and Yᵀ, the same for every row
+    YT = np.ascontiguousarray(ops.MinvW.T)
+    # contiguous copies of the packed views: the row loop indexes them faster
+    G, s, M = ops.G.copy(), ops.s.copy(), ops.M.copy()
+    kept = CACHED_CELLS if m <= MASK_BITS else 0
+    cells = new_cells(m, kept)
     work = workspace(n, m)
-    L, idx = np.empty((m, m)), np.empty(m, dtype=np.int64)
-    w, buf, active = np.empty(m), np.empty(5 * m), np.empty(m, dtype=np.bool_)
+    w, active = np.empty(m), np.empty(m, dtype=np.bool_)
+    used = 0
     for r in range(k_rows):
+        um, lam = Um[r], out.Lam[r]
         if not settings.solved and not _solve_into(
-                ops, Um[r], law.E, law.eps, law.moreau, settings.tol, passive, out.Up[r],
-                out.Lam[r], out.Res[r], work):
-            out.status[r] = UNCERTIFIED
-            out.margin[r] = np.nan
+                ops, um, law.E, law.eps, law.moreau, settings.tol, passive, out.Up[r], lam,
+                out.Res[r], work):
+            out.status[r], out.margin[r] = UNCERTIFIED, np.nan
             continue
-        k, status = _active_factor(G, law.IE, Wt, M, Um[r], out.Lam[r], settings.kink_tol,
-                                   L, idx, w, active, buf[3 * m:])
+        status, key = classify_row(G, s, R, M, um, lam, settings.kink_tol, w, active)
+        e = cells.slot[key] if kept else -1
+        if e < 0:
+            e = used if used < kept else kept
+            factor_cell(G, active, cells, e)
+            measure_cell(G, R, active, cells, e)
+            if e < kept:
+                cells.slot[key] = e
+                used += 1
+        if not cells.residual[e] <= settings.tol:  # NaN fails
+            out.status[r], out.margin[r] = UNCERTIFIED, np.nan
+            continue
         out.status[r] = status
-        out.margin[r] = 0.0 if status == KINK else _margin(
-            G, law.IE, Wt, Um[r], out.Lam[r], w, L, idx, k, active, buf)
-        a = r if settings.jvp else 0  # rows not asked for are one placeholder row
-        b = r if settings.vjp else 0
-        _jvp_vjp(law.IE, Wt, MinvW, L, idx, k, dU[a], Ubar[b], out.dUp[a], out.Ubar[b],
-                 settings, buf)
+        out.margin[r] = 0.0 if status == KINK else row_margin(um, lam, w, active,
+                                                             cells.grad[e])
+        if settings.jvp:
+            apply_cell(R, YT, cells, e, False, dU[r], out.dUp[r])
+        if settings.vjp:
+            apply_cell(YT, R, cells, e, True, Ubar[r], out.Ubar[r])

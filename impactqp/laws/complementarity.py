@@ -76,8 +76,8 @@ class _ComplementarityLaw(ImpactLaw):
                    kink_tol: float) -> ComplementarityMap:
         """The LCP's local map, differentiable in u⁻, M, W and the law's coefficients
         (docs/theory.md §18–§19)."""
-        return ComplementarityMap(problem.M, problem.W, problem.u_minus, answer.impulses,
-                                  self.parameter(problem.n_contacts), kink_tol=kink_tol)
+        return ComplementarityMap.at(problem, answer.impulses,
+                                     self.parameter(problem.n_contacts), kink_tol=kink_tol)
 
     def linear_terms(self, problem: ImpactProblem, U_minus: np.ndarray,
                      form: str) -> np.ndarray:

@@ -108,9 +108,9 @@ class Moreau(ImpactLaw):
                    kink_tol: float) -> ComplementarityMap:
         """The LCP's local map with E = εI, differentiable in ``"eps"`` (docs/theory.md §18):
         ∂u⁺/∂u⁻ = I − (1 + ε)P_A, ∂u⁺/∂ε = z − u⁻."""
-        return ComplementarityMap(problem.M, problem.W, problem.u_minus, answer.impulses,
-                                  scalar_times_identity("eps", self.eps, problem.n_contacts),
-                                  kink_tol=kink_tol)
+        return ComplementarityMap.at(problem, answer.impulses,
+                                     scalar_times_identity("eps", self.eps, problem.n_contacts),
+                                     kink_tol=kink_tol)
 
     def linear_terms(self, problem: ImpactProblem, U_minus: np.ndarray,
                      form: str) -> np.ndarray:

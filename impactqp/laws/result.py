@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..base.checks import ResidualChecks
+from ..derivatives.impact import derivative_of
 from ..model.admissible import Membership
 from ..model.classify import Classification, classify
 from ..model.friction import FrictionCertificate
@@ -178,7 +179,6 @@ class ImpactResult(CertifiedResult):
             Contacts whose scaled impulse and gap velocity are both at most this (relative
             to ‖u⁻‖) count as degenerate: the answer is then on a kink.
         """
-        from ..derivatives.impact import derivative_of
         return derivative_of(self, kink_tol=kink_tol)
 
     def __repr__(self) -> str:
