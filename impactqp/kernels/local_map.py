@@ -77,7 +77,7 @@ def unpack_point(point, n, m):
                  point[h:h + m])
 
 
-@kernel
+@kernel(interpretable=True)
 def local_cell(packed, Minv, E, eps, um, lam, kink_tol, out):
     """Classify and factor the cell of one answer (the structure ``packed``, M⁻¹, the
     law's E — or, given as an empty array, E = εI —, u⁻, Λ). Fills ``out``: the packed
@@ -188,7 +188,7 @@ def rhs(point, n, m, du, dM, dW, dE):
     return r, out
 
 
-@kernel
+@kernel(interpretable=True)
 def jvp(point, n, m, du, dM, dW, dE):
     """(du⁺, dΛ) at the packed ``point`` along the directions (du⁻, dM, dW, dE; empty:
     none): dΛ = −K r, du⁺ = du + Y dΛ."""
@@ -218,7 +218,7 @@ class Cotangents(NamedTuple):
     E: np.ndarray
 
 
-@kernel
+@kernel(interpretable=True)
 def vjp(point, ubar, lbar, u_out, M_out, W_out, E_out, trace_out):
     """The transpose of :func:`jvp` at the packed ``point`` for rows of cotangents ū
     (k, n) and Λ̄ (k, m), into the rows of ``u_out``, ``M_out``, ``W_out``, ``E_out``
