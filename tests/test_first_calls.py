@@ -142,3 +142,25 @@ def test_python_text_answers_as_the_machine_code(seed):
     np.testing.assert_allclose(interpreted.u_plus, compiled.u_plus, rtol=1e-12, atol=1e-13)
     np.testing.assert_allclose(interpreted.impulses, compiled.impulses, rtol=1e-11,
                                atol=1e-13)
+
+
+def test_every_kernel_module_imports_as_python_text():
+    """Each kernel's twin exists, with its relative imports (``..errors``, ``.jit``) resolved
+    as in the compiled package."""
+    import importlib
+    import pkgutil
+
+    from impactqp import kernels
+    from impactqp.kernels import first_calls
+
+    interpretable = 0
+    for info in pkgutil.iter_modules(kernels.__path__):
+        module = importlib.import_module(f"{kernels.__name__}.{info.name}")
+        for value in vars(module).values():
+            if getattr(value, "py_func", None) is not None and \
+                    value.py_func.__module__ == module.__name__:
+                twin = first_calls.python_text(value)
+                assert twin.__code__.co_code == value.py_func.__code__.co_code
+                interpretable += isinstance(value, first_calls.InterpretableDispatcher)
+    if not os.environ.get("NUMBA_DISABLE_JIT"):
+        assert interpretable >= 10

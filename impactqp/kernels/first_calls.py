@@ -44,8 +44,9 @@ SMALL = 4096
 BUDGET = float(os.environ.get("IMPACTQP_INTERPRETED_SECONDS", "2.0"))
 """Seconds of interpreted kernels a process may spend before its kernels compile."""
 
-TWIN = "impactqp.kernels.python_text"
-"""The name under which the kernel modules are imported a second time, uncompiled."""
+TWIN = "impactqp.kernels_as_python"
+"""The name under which the kernel modules are imported a second time, uncompiled: a sibling
+of :mod:`impactqp.kernels`, so that their relative imports reach the same modules."""
 
 _lock = threading.Lock()
 _state = {"spent": 0.0, "calls": 0, "compiling": 0}
