@@ -1,0 +1,156 @@
+"""Whole collections of friction problems: every file of a folder solved and recorded once,
+the same records in this process, on child processes and on a Dask cluster, resumed after a
+crash without solving anything twice, stopped at a time limit and never called solved."""
+
+from __future__ import annotations
+
+import gzip
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import impactqp as iq
+import impactqp.io.collection as collection_io
+from impactqp.collection import run_collection
+from impactqp.io.collection import collection_files
+from impactqp.io.journal import Journal
+
+ROOT = Path(__file__).resolve().parents[1]
+FILES = [ROOT / "tests/data/fclib" / name for name in (
+    "FrictionContact3D_1c.dat", "FC2D_SliderCrankLagrangian00000.dat",
+    "LMGC_GlobalFrictionContactProblem00046.hdf5", "Box_Stacks-i0122-82-5.hdf5",
+    "LMGC_100_PR_PerioBox-i00361-60-03000.hdf5")] + [
+    ROOT / "benchmarks/data/fclib/NESpheres_10_1.dat.gz"]
+#: what a record says apart from times, the same wherever it was solved
+SAME = ("file", "method", "status", "error_name", "contacts", "d", "mu_min", "mu_max",
+        "iterations", "backend", "tol")
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The repository's small problems, one in a subfolder, and three hostile files."""
+    root = tmp_path_factory.mktemp("collection")
+    (root / "global").mkdir()
+    for path in FILES:
+        shutil.copy(path, root / ("global" if "Global" in path.name else "") / path.name)
+    (root / "garbage.hdf5").write_bytes(np.random.default_rng(0).bytes(3000))
+    (root / "truncated.hdf5").write_bytes(FILES[3].read_bytes()[:4000])
+    (root / "cut.dat.gz").write_bytes(gzip.compress(FILES[1].read_bytes())[:200])
+    (root / "notes.txt").write_text("not a problem file")
+    return root
+
+
+@pytest.fixture(scope="module")
+def local(folder: Path, tmp_path_factory: pytest.TempPathFactory) -> list[dict]:
+    out = tmp_path_factory.mktemp("local") / "records.jsonl"
+    return run_collection(folder, out, methods=("auto", "nsgs")).records
+
+
+def same(a: list[dict], b: list[dict]) -> None:
+    assert [{k: r[k] for k in SAME} for r in a] == [{k: r[k] for k in SAME} for r in b]
+    for x, y in zip(a, b, strict=True):
+        for key in ("abh_error", "r_norm"):
+            assert (x[key] is None) == (y[key] is None)
+            if x[key] is not None:
+                assert y[key] == pytest.approx(x[key], rel=1e-9, abs=1e-300)
+
+
+def test_every_file_is_recorded_once_per_method(folder: Path, local: list[dict]) -> None:
+    files = collection_files(folder)
+    assert "notes.txt" not in files and "global/LMGC_GlobalFrictionContactProblem00046.hdf5" \
+        in files and len(files) == 9
+    assert [(r["file"], r["method"]) for r in local] == \
+        [(f, m) for f in files for m in ("auto", "nsgs")]
+    certified = [r for r in local if r["status"] == "certified"]
+    assert len(certified) == 12 and all(r["abh_error"] <= 1e-8 for r in certified)
+    for r in certified:  # the record holds the answer's own figures: recomputed here
+        problem = iq.load_fclib(folder / r["file"])
+        assert (r["contacts"], r["d"]) == (problem.n_contacts, problem.contact_dim)
+        assert r["mu_min"] == pytest.approx(np.min(problem.mu))
+        if r["method"] == "auto":
+            answer = iq.solve_friction(problem)
+            assert r["backend"] == answer.backend
+            assert r["r_norm"] == pytest.approx(np.linalg.norm(answer.r), rel=1e-9)
+    hostile = {r["file"]: r for r in local if r["status"] == "error"}
+    assert set(hostile) == {"garbage.hdf5", "truncated.hdf5", "cut.dat.gz"}
+    assert {r["error_name"] for r in hostile.values()} == {"ProblemFileError"}
+
+
+def test_output_is_json_lines(folder: Path, tmp_path: Path) -> None:
+    out = tmp_path / "one.jsonl"
+    run = run_collection(folder, out, methods="auto")
+    lines = out.read_text().splitlines()
+    assert len(lines) == run.new == 9 and run.skipped == 0
+    assert [json.loads(line) for line in lines] == \
+        sorted(run.records, key=lambda r: lines.index(json.dumps(r, separators=(",", ":"))))
+
+
+def test_child_processes_give_the_same_records(folder: Path, tmp_path: Path,
+                                               local: list[dict]) -> None:
+    run = run_collection(folder, tmp_path / "two.jsonl", methods=("auto", "nsgs"), n_jobs=2,
+                         time_limit=120.0)
+    same(local, run.records)
+
+
+def test_dask_local_cluster_gives_the_same_records(folder: Path, tmp_path: Path,
+                                                   local: list[dict]) -> None:
+    distributed = pytest.importorskip("distributed", reason="the optional dask extra")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        run = run_collection(folder, tmp_path / "dask.jsonl", methods=("auto", "nsgs"),
+                             client=client)
+        assert set(client.run(lambda: 1)) == set(client.scheduler_info()["workers"])
+    same(local, run.records)
+
+
+def test_resume_solves_only_what_is_missing(folder: Path, tmp_path: Path,
+                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    out = tmp_path / "resumed.jsonl"
+    first = run_collection(folder, out)
+    lines = out.read_text().splitlines(keepends=True)
+    solved = [i for i, line in enumerate(lines) if '"certified"' in line]
+    kept = [line for i, line in enumerate(lines) if i not in solved[-2:]]
+    out.write_text("".join(kept) + lines[solved[-1]][:25])  # a crash in the middle of a line
+    calls = []
+    real = collection_io.solve_friction
+    monkeypatch.setattr(collection_io, "solve_friction",
+                        lambda *a, **k: calls.append(1) or real(*a, **k))
+    again = run_collection(folder, out)
+    assert (len(calls), again.new, again.skipped) == (2, 2, 7)
+    same(first.records, again.records)
+    assert len(Journal(out).records()) == 9 and out.read_text().endswith("}\n")
+    assert run_collection(folder, out).new == 0 and len(calls) == 2
+
+
+def test_tiny_time_limit_is_never_a_solve(folder: Path, tmp_path: Path) -> None:
+    run = run_collection(folder, tmp_path / "limit.jsonl", time_limit=1e-3)
+    stopped = [r for r in run.records if r["status"] == "time limit"]
+    # the global problems take longer than 1 ms to read and reduce alone
+    assert {"Box_Stacks-i0122-82-5.hdf5", "LMGC_100_PR_PerioBox-i00361-60-03000.hdf5"} <= \
+        {r["file"] for r in stopped}
+    assert all(r["seconds"] >= 1e-3 and r["abh_error"] is None for r in stopped)
+    assert not any(r["status"] == "certified" and r["read_seconds"] + r["seconds"] > 1e-3
+                   for r in run.records)
+
+
+def test_a_damaged_journal_line_is_named(folder: Path, tmp_path: Path) -> None:
+    out = tmp_path / "damaged.jsonl"
+    out.write_text('{"file": "a", "method": "auto"}\nnot json\n{"file": "b"}\n')
+    with pytest.raises(iq.errors.ProblemFileError, match="line 2"):
+        run_collection(folder, out)
+
+
+def test_bad_arguments(folder: Path, tmp_path: Path) -> None:
+    out = tmp_path / "x.jsonl"
+    for kwargs in ({"methods": ()}, {"methods": ("auto", "auto")}, {"methods": "lemke"},
+                   {"time_limit": 0.0}, {"time_limit": float("nan")}, {"n_jobs": 0},
+                   {"scheduler": "tcp://x:1", "client": object()}):
+        with pytest.raises(iq.InputError):
+            run_collection(folder, out, **kwargs)
+    with pytest.raises(iq.InputError, match="not a folder"):
+        run_collection(tmp_path / "missing", out)
+    assert not out.exists()
