@@ -154,3 +154,34 @@ def test_bad_arguments(folder: Path, tmp_path: Path) -> None:
     with pytest.raises(iq.InputError, match="not a folder"):
         run_collection(tmp_path / "missing", out)
     assert not out.exists()
+
+
+def test_benchmark_command_runs_a_collection(folder: Path, tmp_path: Path,
+                                             capsys: pytest.CaptureFixture) -> None:
+    from benchmarks.__main__ import main
+
+    out = tmp_path / "bench.jsonl"
+    assert main(["run", "--suite", "fclib", "--collection", str(folder), "--output", str(out),
+                 "--siconos-python", "", "--methods", "auto,nsgs", "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "| auto | 6 | 0 | 0 | 3 |" in text and "| nsgs | 6 | 0 | 0 | 3 |" in text
+    assert len(out.read_text().splitlines()) == 18 and out.with_suffix(".png").is_file()
+    with pytest.raises(SystemExit):
+        main(["run", "--suite", "fclib"])  # no --collection
+
+
+def test_siconos_answers_are_judged_by_impactqp(tmp_path: Path) -> None:
+    from benchmarks.collection import run_fclib_collection, summary
+    from benchmarks.peers import SICONOS_PYTHON, siconos_status
+
+    if siconos_status(SICONOS_PYTHON) is not None:
+        pytest.skip("Siconos is not installed for /usr/bin/python3")
+    for path in FILES[:3]:
+        shutil.copy(path, tmp_path / path.name)
+    records = run_fclib_collection(tmp_path, tmp_path / "out.jsonl", time_limit=60.0)
+    peer = [r for r in records if r["method"].startswith("siconos:")]
+    assert {r["file"] for r in peer} == {FILES[0].name, FILES[2].name}  # 3-D only
+    for r in peer:  # the verdict is the ABH error impactqp recomputed from Siconos' r
+        assert r["status"] in ("certified", "not certified")
+        assert (r["abh_error"] <= 1e-8) == (r["status"] == "certified")
+    assert "geometric mean over the 2 problems" in summary(records)

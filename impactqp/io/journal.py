@@ -12,7 +12,6 @@ the file.
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 from typing import Any
 
@@ -48,7 +47,8 @@ class Journal:
 
     def append(self, record: dict[str, Any]) -> None:
         """Write ``record`` as one line, flushed to the operating system at once (a crash of
-        this process loses nothing written before it)."""
+        this process loses nothing written before it). Not synced to the disk: a record a
+        crash of the machine loses is only solved again (a sync cost 3.7 ms a record)."""
         line = json.dumps(record, allow_nan=False, separators=(",", ":")) + "\n"
         self.path.parent.mkdir(parents=True, exist_ok=True)
         with self.path.open("a+b") as fh:
@@ -57,7 +57,6 @@ class Journal:
                 self._complete = None
             fh.write(line.encode("utf-8"))
             fh.flush()
-            os.fsync(fh.fileno())
         self._records.append(record)
 
 
