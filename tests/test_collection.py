@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import gzip
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -15,7 +16,8 @@ import pytest
 import impactqp as iq
 import impactqp.io.collection as collection_io
 from impactqp.collection import run_collection
-from impactqp.io.collection import collection_files
+from impactqp.io.collection import Task, collection_files
+from impactqp.io.deadline import SolverProcess
 from impactqp.io.journal import Journal
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -95,16 +97,37 @@ def test_child_processes_give_the_same_records(folder: Path, tmp_path: Path,
     same(local, run.records)
 
 
+@pytest.mark.parametrize("limit", [None, 120.0])
 def test_dask_local_cluster_gives_the_same_records(folder: Path, tmp_path: Path,
-                                                   local: list[dict]) -> None:
+                                                   local: list[dict],
+                                                   limit: float | None) -> None:
+    """Without a limit the workers solve in their own threads; with one, each worker thread
+    runs a spawned supervisor that forks the solving children."""
     distributed = pytest.importorskip("distributed", reason="the optional dask extra")
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster, \
+                                  dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         run = run_collection(folder, tmp_path / "dask.jsonl", methods=("auto", "nsgs"),
-                             client=client)
+                             client=client, time_limit=limit)
         assert set(client.run(lambda: 1)) == set(client.scheduler_info()["workers"])
     same(local, run.records)
+
+
+def test_a_solver_that_kills_its_process_is_an_error_record(
+        folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(collection_io, "solve_friction", lambda *a, **k: os._exit(3))
+    proc = SolverProcess(method="fork")  # the child inherits the patched solver
+    try:
+        died = proc.run(Task(str(folder), FILES[0].name, "auto", 1e-8), 60.0)
+        assert (died["status"], died["error_name"], died["contacts"]) == \
+            ("error", "RuntimeError", 1)
+        assert "exit 3" in died["message"]
+        monkeypatch.undo()  # the next child is forked afresh, with the real solver
+        monkeypatch.setattr(collection_io, "solve_friction", iq.solve_friction)
+        assert proc.run(Task(str(folder), FILES[0].name, "auto", 1e-8), 60.0)["status"] == \
+            "certified"
+    finally:
+        proc.close()
 
 
 def test_resume_solves_only_what_is_missing(folder: Path, tmp_path: Path,
