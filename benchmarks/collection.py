@@ -148,6 +148,8 @@ def summary(records: list[dict], profile: Path | None = None) -> str:
         counts = [sum(1 for f in files if by.get((f, m), {}).get("status") == s)
                   for s in ("certified", "not certified", "time limit", "error")]
         lines.append(f"| {m} | " + " | ".join(map(str, counts)) + " |")
+    if any(r["d"] == 2 for r in records) and any(m.startswith("siconos:") for m in methods):
+        lines += ["", "Siconos' solvers ran on the 3-D files only (its fc3d driver)."]
     ratios = [by[(f, DEFAULT)]["seconds"] / by[(f, BASELINE)]["seconds"] for f in files
               if all(by.get((f, m), {}).get("status") == "certified" for m in (DEFAULT, BASELINE))]
     if ratios:

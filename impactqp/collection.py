@@ -108,7 +108,8 @@ def run_collection(folder: str | Path, output: str | Path, *,
     n_jobs : int
         Local worker processes (1 and no time limit: solved in this process).
     scheduler : str, optional
-        Address of a dask.distributed scheduler to run on (the ``dask`` extra).
+        Address of a dask.distributed scheduler to run on (the ``dask`` extra); its workers
+        read the files at ``folder``'s path (a filesystem they share).
     client : dask.distributed.Client, optional
         A client to run on, instead of ``scheduler``.
     on_record : callable, optional
@@ -208,13 +209,16 @@ def _run_dask(tasks: list[Task], limit: float | None, emit: Callable[[Record], N
         client.run(_prepare_once)  # the workers there now; later ones prepare on first task
         futures = {client.submit(_solve_on_worker, task, limit, pure=False): task
                    for task in tasks}
-        for future in distributed.as_completed(futures):
-            try:
-                record = future.result()
-            except Exception as exc:  # the worker died with it (Dask gave up retrying)
-                record = failed_record(blank_record(futures[future]), exc)
-            emit(record)
-        client.run(_close_solvers)
+        try:
+            for future in distributed.as_completed(futures):
+                try:
+                    record = future.result()
+                except Exception as exc:  # the worker died with it (Dask gave up retrying)
+                    record = failed_record(blank_record(futures[future]), exc)
+                emit(record)
+        finally:
+            client.cancel(list(futures))
+            client.run(_close_solvers)
     finally:
         if own is not None:
             own.close()

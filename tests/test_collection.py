@@ -101,10 +101,11 @@ def test_child_processes_give_the_same_records(folder: Path, tmp_path: Path,
 def test_dask_local_cluster_gives_the_same_records(folder: Path, tmp_path: Path,
                                                    local: list[dict],
                                                    limit: float | None) -> None:
-    """Without a limit the workers solve in their own threads; with one, each worker thread
-    runs a spawned supervisor that forks the solving children."""
+    """Without a limit: workers as threads of this process, solving in them. With one:
+    workers as daemon processes (as a real cluster's), each starting a supervisor subprocess
+    that forks the solving children."""
     distributed = pytest.importorskip("distributed", reason="the optional dask extra")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=limit is not None,
                                   dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         run = run_collection(folder, tmp_path / "dask.jsonl", methods=("auto", "nsgs"),

@@ -3,11 +3,12 @@ time, and is killed when one overruns its limit (the solvers have no budget of t
 
 A :class:`SolverProcess` lives across tasks, so a task costs two messages over a pipe, not a
 process start, and a stop costs one fork. Where the caller may fork (POSIX, one thread: the
-child inherits its compiled kernels) the child is forked from it; elsewhere (a Dask worker
-runs threads, and forking a process with other threads may copy a lock one of them holds)
-a fresh interpreter is spawned once, runs ``prepare``, and forks the solving children
-itself, watching their limits. A task stopped at its limit, or whose reading and solving
-took longer than it, is recorded as ``"time limit"`` by
+child inherits its compiled kernels) the child is forked from it. Elsewhere — a Dask worker
+runs threads (forking a process with other threads may copy a lock one of them holds) and
+is a daemon (which :mod:`multiprocessing` forbids to have children) — a fresh interpreter is
+started once as a plain subprocess, runs ``prepare``, and forks the solving children itself,
+watching their limits. A task stopped at its limit, or whose reading and solving took
+longer than it, is recorded as ``"time limit"`` by
 :func:`~impactqp.io.collection.stopped_record`, never as a solve.
 """
 
@@ -15,6 +16,10 @@ from __future__ import annotations
 
 import math
 import multiprocessing
+import os
+import socket
+import subprocess
+import sys
 import threading
 import time
 from collections.abc import Callable
@@ -23,36 +28,41 @@ from typing import Any
 
 from .collection import Task, blank_record, failed_record, solve_task, stopped_record
 
-__all__ = ["GRACE", "SolverProcess", "start_method"]
+__all__ = ["GRACE", "SolverProcess", "start_method", "supervise"]
 
 GRACE = 30.0
-"""Seconds past a task's limit after which a spawned supervisor that has not answered is
-killed with its task (it stops the task itself at the limit)."""
+"""Seconds past a task's limit after which a supervisor that has not answered is killed
+with its task (it stops the task itself at the limit)."""
 
 
 def start_method() -> str:
-    """``"fork"`` where the platform forks and this process runs one thread, else
-    ``"spawn"`` (forking a process with other threads may copy a lock one of them holds)."""
+    """``"fork"`` where this process may fork a solving child itself (POSIX, one thread,
+    not a daemon), else ``"supervisor"``: a subprocess that forks them."""
+    daemon = multiprocessing.current_process().daemon
     forks = "fork" in multiprocessing.get_all_start_methods()
-    return "fork" if forks and threading.active_count() == 1 else "spawn"
+    return "fork" if forks and not daemon and threading.active_count() == 1 else "supervisor"
 
 
-def _serve(conn: Connection, prepare: Callable[[], Any] | None) -> None:
-    """A forked child: solve each task received until None."""
-    if prepare is not None:
-        prepare()
+def _serve(conn: Connection) -> None:
+    """A forked child: solve each task received until None or the caller's end."""
     conn.send(("ready", None))
-    while (job := conn.recv()) is not None:
-        task, _ = job
-        try:
-            record = solve_task(task, facts=lambda f: conn.send(("facts", f)))
-        except BaseException as exc:  # noqa: BLE001 (a record, not the end of the child)
-            record = failed_record(blank_record(task), exc)
-        conn.send(("done", record))
+    try:
+        while (job := conn.recv()) is not None:
+            task, _ = job
+            try:
+                record = solve_task(task, facts=lambda f: conn.send(("facts", f)))
+            except BaseException as exc:  # noqa: BLE001 (a record, not the end of the child)
+                record = failed_record(blank_record(task), exc)
+            conn.send(("done", record))
+    except (EOFError, BrokenPipeError):  # the caller has gone
+        pass
 
 
-def _supervise(conn: Connection, prepare: Callable[[], Any] | None) -> None:
-    """A spawned child: prepare once, then run each task in a child forked from here."""
+def supervise(fd: int) -> None:
+    """The supervisor subprocess, on the socket ``fd``: receive ``prepare`` and run it, then
+    run each task in a child forked from here, until None or the caller's end."""
+    conn = Connection(fd)
+    prepare = conn.recv()
     if prepare is not None:
         prepare()
     inner = SolverProcess(method="fork")
@@ -60,7 +70,7 @@ def _supervise(conn: Connection, prepare: Callable[[], Any] | None) -> None:
     try:
         while (job := conn.recv()) is not None:
             conn.send(("done", inner.run(*job)))
-    except EOFError:  # the caller has gone
+    except (EOFError, BrokenPipeError):  # the caller has gone
         pass
     finally:
         inner.close()
@@ -74,16 +84,15 @@ class SolverProcess:
     prepare : callable, optional
         Run by a spawned child before its first task (a forked one inherits the caller's
         state); picklable (a module-level function).
-    method : str, optional
-        The start method; default :func:`start_method`. With ``"spawn"`` the child is a
-        supervisor that forks the solving children; this side then stops it only
-        :data:`GRACE` seconds after a task's limit.
+    method : {"fork", "supervisor"}, optional
+        Default :func:`start_method`. A supervisor forks the solving children and stops
+        them at their limits; this side stops it only :data:`GRACE` seconds after one.
     """
 
     def __init__(self, prepare: Callable[[], Any] | None = None,
                  method: str | None = None) -> None:
         self.prepare = prepare
-        self.context = multiprocessing.get_context(method or start_method())
+        self.forked = (method or start_method()) == "fork"
         self.process: Any = None
         self.conn: Connection | None = None
         self.task: Task | None = None
@@ -92,18 +101,26 @@ class SolverProcess:
         self.limit = 0.0
 
     def _start(self) -> Connection:
-        here, there = self.context.Pipe()
-        forked = self.context.get_start_method() == "fork"
-        self.process = self.context.Process(target=_serve if forked else _supervise,
-                                            args=(there, None if forked else self.prepare),
-                                            daemon=forked)  # a supervisor has children
-        try:
-            self.process.start()
-        finally:
-            there.close()
-            if self.process.pid is None:  # it did not start: nothing to stop
-                self.process = None
-                here.close()
+        if self.forked:
+            context = multiprocessing.get_context("fork")
+            here, there = context.Pipe()
+            process = context.Process(target=_serve, args=(there,), daemon=True)
+            try:
+                process.start()
+            finally:
+                there.close()
+        else:
+            mine, theirs = socket.socketpair()
+            code = f"from {__name__} import supervise; supervise({theirs.fileno()})"
+            env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+            try:  # the interpreter's own path, as multiprocessing's spawn gives it
+                process = subprocess.Popen([sys.executable, "-c", code],
+                                           pass_fds=[theirs.fileno()], env=env)
+            finally:
+                theirs.close()
+            here = Connection(mine.detach())
+            here.send(self.prepare)
+        self.process = process
         if here.recv()[0] != "ready":  # EOFError when the child dies preparing
             raise RuntimeError("the solving process did not start")
         self.conn = here
@@ -118,8 +135,7 @@ class SolverProcess:
         conn = self.conn or self._start()
         self.task, self.facts, self.limit = task, None, limit
         self.started = time.perf_counter()
-        spawned = self.context.get_start_method() != "fork"
-        self.deadline = self.started + limit + (GRACE if spawned else 0.0)
+        self.deadline = self.started + limit + (0.0 if self.forked else GRACE)
         conn.send((task, limit))
 
     def collect(self, timeout: float | None = None) -> dict[str, Any] | None:
@@ -169,10 +185,14 @@ class SolverProcess:
 
     def _stop(self) -> int | None:
         """Kill the child; its exit code. The next task starts another."""
+        code = None
         if self.process is not None:
             self.process.kill()
-            self.process.join()
-        code = None if self.process is None else self.process.exitcode
+            if self.forked:
+                self.process.join()
+                code = self.process.exitcode
+            else:
+                code = self.process.wait()
         if self.conn is not None:
             self.conn.close()
         self.process = self.conn = None
@@ -183,7 +203,10 @@ class SolverProcess:
         if self.conn is not None and self.task is None:
             try:
                 self.conn.send(None)
-                self.process.join(timeout=5)
-            except (OSError, ValueError):
+                if self.forked:
+                    self.process.join(timeout=5)
+                else:
+                    self.process.wait(timeout=5)
+            except (OSError, ValueError, subprocess.TimeoutExpired):
                 pass
         self._stop()
