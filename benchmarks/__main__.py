@@ -56,8 +56,8 @@ def main(argv: list[str] | None = None) -> int:
                      help="interpreter that imports siconos ('' skips the peer)")
     run.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     run.add_argument("--n-jobs", type=_jobs, default=2,
-                     help="local processes of the sweep benchmark, timed against one "
-                          "(default 2)")
+                     help="local processes of the sweep benchmark, timed against one, "
+                          "and of --suite fclib without --scheduler (default 2)")
     run.add_argument("--merge", action="store_true",
                      help="replace only this suite's families in the results already in --out "
                           "(e.g. --suite friction --out benchmarks/reference)")

@@ -91,6 +91,12 @@ def main(argv: list[str] | None = None) -> int:
         many, tn, wn = on_cluster(folder, Path(tmp) / "many.jsonl", args.workers)
         print(f"{args.workers} workers: {tn:.1f} s (warm-up {wn:.1f} s; {_spent(many)}); load "
               f"{os.getloadavg()}")
+        for name in NAMES:  # where the time went: mean solve per source file
+            source = FILES[name].name
+            mean = [sum(r["seconds"] for r in recs if r["file"].endswith(source))
+                    / sum(r["file"].endswith(source) for r in recs) for recs in (one, many)]
+            print(f"  {name}: {mean[0] * 1e3:.1f} ms on 1 worker, {mean[1] * 1e3:.1f} ms on "
+                  f"{args.workers}")
         certified = sum(r["status"] == "certified" for r in many)
         print(f"speed-up {t1 / tn:.2f}x; certified {certified} of {len(many)}; records agree "
               f"(1 vs {args.workers} workers): {agree(one, many)}"
