@@ -21,7 +21,7 @@ from multiprocessing.connection import wait
 from pathlib import Path
 from typing import Any
 
-from .base.arrays import as_count
+from .base.arrays import as_count, check_tol
 from .errors import InputError
 from .io.collection import (
     STATUSES,
@@ -123,19 +123,21 @@ def run_collection(folder: str | Path, output: str | Path, *,
     ------
     InputError
         ``folder`` is not a folder, ``output`` is not a regular file, a method is unknown,
-        ``time_limit`` is not a positive number, or both ``scheduler`` and ``client``.
+        ``time_limit`` is not a positive number, ``tol`` is not a tolerance, or both
+        ``scheduler`` and ``client``.
     ProblemFileError
         ``output`` holds a damaged line before its last one.
     """
     start = time.perf_counter()
     names = check_methods(methods)
     limit = _check_limit(time_limit)
+    tol = check_tol(tol)
     n_jobs = as_count("n_jobs", n_jobs, minimum=1)
     if scheduler is not None and client is not None:
         raise InputError("give a scheduler address or a client, not both")
     journal = Journal(output)
     files = collection_files(folder)
-    tasks = [Task(str(folder), f, m, float(tol)) for f in files for m in names]
+    tasks = [Task(str(folder), f, m, tol) for f in files for m in names]
     done = {(r.get("file"), r.get("method")) for r in journal.records()}
     todo = [t for t in tasks if t.key not in done]
 

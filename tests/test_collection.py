@@ -172,6 +172,7 @@ def test_bad_arguments(folder: Path, tmp_path: Path) -> None:
     out = tmp_path / "x.jsonl"
     for kwargs in ({"methods": ()}, {"methods": ("auto", "auto")}, {"methods": "lemke"},
                    {"time_limit": 0.0}, {"time_limit": float("nan")}, {"n_jobs": 0},
+                   {"tol": -1.0},
                    {"scheduler": "tcp://x:1", "client": object()}):
         with pytest.raises(iq.InputError):
             run_collection(folder, out, **kwargs)

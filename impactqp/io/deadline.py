@@ -82,8 +82,8 @@ class SolverProcess:
     Parameters
     ----------
     prepare : callable, optional
-        Run by a spawned child before its first task (a forked one inherits the caller's
-        state); picklable (a module-level function).
+        Run by a supervisor before its first task (a forked child inherits the caller's
+        state instead); picklable (a module-level function).
     method : {"fork", "supervisor"}, optional
         Default :func:`start_method`. A supervisor forks the solving children and stops
         them at their limits; this side stops it only :data:`GRACE` seconds after one.
@@ -171,7 +171,7 @@ class SolverProcess:
         than the limit (the answer came back before this side saw the deadline pass)."""
         task, self.task = self.task, None
         spent = (record.get("read_seconds") or 0.0) + (record.get("seconds") or 0.0)
-        if record["status"] != "time limit" and spent > self.limit:
+        if record["status"] in ("certified", "not certified") and spent > self.limit:
             assert task is not None
             return stopped_record(task, record, spent, self.limit)
         return record
