@@ -108,7 +108,8 @@ def _siconos_once(server: SiconosServer, problem: iq.FrictionContactProblem, tex
         "file": name, "method": f"siconos:{solver}", "status": None, "error_name": None,
         "message": "", "contacts": problem.n_contacts, "d": problem.contact_dim,
         "mu_min": float(mu.min()), "mu_max": float(mu.max()), "read_seconds": None,
-        "seconds": None, "iterations": None, "abh_error": None, "backend": solver,
+        "seconds": None, "cpu_seconds": None, "iterations": None, "abh_error": None,
+        "backend": solver,
         "r_norm": None, "tol": TOL}
     job = {"path": str(text), "solver": solver, "tol": TOL, "max_iter": MAX_ITER,
            "budget": 0.0, "max_repeats": 1}

@@ -50,7 +50,9 @@ def _spent(records: list[dict]) -> str:
     """The seconds the records say were spent reading and solving, summed."""
     read = sum(r["read_seconds"] or 0.0 for r in records)
     solve = sum(r["seconds"] or 0.0 for r in records)
-    return f"reading {read:.1f} s, solving {solve:.1f} s"
+    cpu = sum(r["cpu_seconds"] or 0.0 for r in records)
+    return (f"reading {read:.1f} s, solving {solve:.1f} s of which {cpu:.1f} s on a processor "
+            f"({cpu / solve:.0%})")
 
 
 def on_cluster(folder: Path, output: Path, workers: int) -> tuple[list[dict], float, float]:

@@ -107,8 +107,9 @@ def solve_task(task: Task, facts: Any = None) -> dict[str, Any]:
     dict
         ``file``, ``method``, ``status`` (:data:`STATUSES`), ``error_name``, ``message``,
         ``contacts``, ``d``, ``mu_min``, ``mu_max``, ``read_seconds``, ``seconds`` (of the
-        solve), ``iterations``, ``abh_error``, ``backend`` (the method that answered),
-        ``r_norm`` (‖r‖₂ of the answer), ``tol``.
+        solve, wall clock), ``cpu_seconds`` (the solving thread's processor time: less than
+        ``seconds`` when the machine was busy), ``iterations``, ``abh_error``, ``backend``
+        (the method that answered), ``r_norm`` (‖r‖₂ of the answer), ``tol``.
     """
     record = blank_record(task)
     start = time.perf_counter()
@@ -123,19 +124,21 @@ def solve_task(task: Task, facts: Any = None) -> dict[str, Any]:
                   read_seconds=time.perf_counter() - start)
     if facts is not None:
         facts(dict(record))
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.thread_time()
     try:
         result = solve_friction(problem, backend=task.method, tol=task.tol)
     except CertificateError as exc:
         record.update(status="not certified", error_name=type(exc).__name__,
-                      message=str(exc), seconds=time.perf_counter() - start)
+                      message=str(exc), seconds=time.perf_counter() - start,
+                      cpu_seconds=time.thread_time() - cpu)
         if exc.best is not None:
             record.update(_answer(exc.best))
         return record
     except Exception as exc:
         record["seconds"] = time.perf_counter() - start
         return failed_record(record, exc)
-    record.update(status="certified", message="", seconds=result.solve_time, **_answer(result))
+    record.update(status="certified", message="", seconds=result.solve_time,
+                  cpu_seconds=time.thread_time() - cpu, **_answer(result))
     return record
 
 
@@ -148,7 +151,8 @@ def blank_record(task: Task) -> dict[str, Any]:
     """The record of ``task`` before anything is known of it (every field, None)."""
     return {"file": task.file, "method": task.method, "status": None, "error_name": None,
             "message": "", "contacts": None, "d": None, "mu_min": None, "mu_max": None,
-            "read_seconds": None, "seconds": None, "iterations": None, "abh_error": None,
+            "read_seconds": None, "seconds": None, "cpu_seconds": None, "iterations": None,
+            "abh_error": None,
             "backend": None, "r_norm": None, "tol": task.tol}
 
 
