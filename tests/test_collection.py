@@ -210,3 +210,19 @@ def test_siconos_answers_are_judged_by_impactqp(tmp_path: Path) -> None:
         assert r["status"] in ("certified", "not certified")
         assert (r["abh_error"] <= 1e-8) == (r["status"] == "certified")
     assert "geometric mean over the 2 problems" in summary(records)
+
+
+def test_summary_by_hand(tmp_path: Path) -> None:
+    from benchmarks.collection import summary
+
+    def rec(file: str, method: str, status: str, seconds: float) -> dict:
+        return {"file": file, "method": method, "status": status, "seconds": seconds, "d": 3}
+
+    records = [rec("a", "auto", "certified", 1.0), rec("a", "siconos:NSGS", "certified", 4.0),
+               rec("b", "auto", "certified", 2.0), rec("b", "siconos:NSGS", "certified", 2.0),
+               rec("c", "auto", "certified", 1.0), rec("c", "siconos:NSGS", "not certified", 9.0)]
+    text = summary(records, tmp_path / "profile.png")
+    # (1/4 · 2/2)^(1/2) = 0.5 over a and b; c is not certified by NSGS
+    assert "over the 2 problems both certify: 0.50×" in text
+    assert "| auto | 3 | 0 | 0 | 0 |" in text and "| siconos:NSGS | 2 | 1 | 0 | 0 |" in text
+    assert (tmp_path / "profile.png").read_bytes()[:4] == b"\x89PNG"
