@@ -7,7 +7,7 @@ Siconos' answers are judged as impactqp's: the ABH error recomputed by
 :func:`impactqp.model.friction.certify_friction` from its r (``"certified"`` at most the
 tolerance). Both sides run each problem once from r = 0 (impactqp's kernels compiled before,
 Siconos reading its file before its timer) under the same time limit; Siconos' solvers run
-here, one after the other, on 3-D problems only (its fc3d driver). The output is resumable:
+here, one after the other (on 2-D problems only those its fc2d driver has). The output is resumable:
 a rerun solves only the (file, method) pairs it lacks.
 """
 
@@ -30,7 +30,15 @@ from impactqp.io.journal import Journal
 from impactqp.io.siconos_text import write_siconos_text
 from impactqp.model.friction import certify_friction
 
-from .friction import MAX_ITER, READ_ALLOWANCE, SICONOS_SOLVERS, TIME_LIMIT, TOL, WORKER
+from .friction import (
+    MAX_ITER,
+    PLANAR_SOLVERS,
+    READ_ALLOWANCE,
+    SICONOS_SOLVERS,
+    TIME_LIMIT,
+    TOL,
+    WORKER,
+)
 from .simulation import SICONOS_PYTHON, SiconosServer
 
 DEFAULT, BASELINE = "auto", "siconos:NSGS"
@@ -57,7 +65,8 @@ def run_fclib_collection(folder: Path, output: Path, *, methods: Sequence[str] =
 def run_siconos(folder: Path, output: Path, iq_records: list[dict], *, python: str,
                 time_limit: float | None,
                 on_record: Callable[[dict], None] | None = None) -> list[dict]:
-    """Siconos' solvers on every 3-D problem impactqp read, records appended to ``output``
+    """Siconos' solvers on every problem impactqp read (on 2-D ones those of its fc2d
+    driver, :data:`~benchmarks.friction.PLANAR_SOLVERS`), records appended to ``output``
     (those there already kept); none when ``python`` cannot import siconos (a notice)."""
     from .peers import siconos_status
 
@@ -68,21 +77,22 @@ def run_siconos(folder: Path, output: Path, iq_records: list[dict], *, python: s
         return []
     journal = Journal(output)
     done = {(r["file"], r["method"]): r for r in journal.records()}
-    files = [f for f in collection_files(folder)
-             if any(r["file"] == f and r["d"] == 3 for r in iq_records)]
+    dims = {r["file"]: r["d"] for r in iq_records if r["d"] is not None}
+    files = [f for f in collection_files(folder) if f in dims]
     server: SiconosServer | None = None
     out = []
     with tempfile.TemporaryDirectory() as tmp:
         try:
             for name in files:
-                todo = [s for s in SICONOS_SOLVERS if (name, f"siconos:{s}") not in done]
+                solvers = PLANAR_SOLVERS if dims[name] == 2 else SICONOS_SOLVERS
+                todo = [s for s in solvers if (name, f"siconos:{s}") not in done]
                 if not todo:
-                    out += [done[(name, f"siconos:{s}")] for s in SICONOS_SOLVERS]
+                    out += [done[(name, f"siconos:{s}")] for s in solvers]
                     continue
                 problem = iq.load_fclib(folder / name)
                 text = Path(tmp) / "problem.dat"
                 write_siconos_text(problem, text)
-                for solver in SICONOS_SOLVERS:
+                for solver in solvers:
                     if solver not in todo:
                         out.append(done[(name, f"siconos:{solver}")])
                         continue
@@ -150,7 +160,8 @@ def summary(records: list[dict], profile: Path | None = None) -> str:
                   for s in ("certified", "not certified", "time limit", "error")]
         lines.append(f"| {m} | " + " | ".join(map(str, counts)) + " |")
     if any(r["d"] == 2 for r in records) and any(m.startswith("siconos:") for m in methods):
-        lines += ["", "Siconos' solvers ran on the 3-D files only (its fc3d driver)."]
+        lines += ["", f"On 2-D files Siconos 4.4 runs {', '.join(PLANAR_SOLVERS)} only (its "
+                  "fc2d driver): its other solvers' counts are of the 3-D files."]
     ratios = [by[(f, DEFAULT)]["seconds"] / by[(f, BASELINE)]["seconds"] for f in files
               if all(by.get((f, m), {}).get("status") == "certified" for m in (DEFAULT, BASELINE))]
     if ratios:

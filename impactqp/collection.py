@@ -34,6 +34,7 @@ from .io.collection import (
 )
 from .io.deadline import SolverProcess
 from .io.journal import Journal
+from .kernels.first_calls import compiling
 from .precompile import STAGES
 
 __all__ = ["CollectionRun", "run_collection", "prepare_worker"]
@@ -43,9 +44,10 @@ Record = dict[str, Any]
 
 def prepare_worker() -> None:
     """Compile the friction kernels, or load them from the cache: the friction stage of
-    :func:`impactqp.precompile.compile_kernels`, run by each worker before its first
-    problem."""
-    dict(STAGES)["friction"]()
+    :func:`impactqp.precompile.compile_kernels` (compiled, not run as their Python text as
+    a process's first small calls may be), run by each worker before its first problem."""
+    with compiling():
+        dict(STAGES)["friction"]()
 
 
 @dataclass(frozen=True)
