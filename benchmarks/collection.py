@@ -167,7 +167,14 @@ def summary(records: list[dict], profile: Path | None = None) -> str:
     if ratios:
         mean = math.exp(float(np.mean(np.log(ratios))))
         lines += ["", f"{DEFAULT} / {BASELINE}, geometric mean over the {len(ratios)} problems "
-                  f"both certify: {mean:.2f}×"]
+                  f"both certify: {mean:.2f}× (one run each)"]
+        own = [by[(f, DEFAULT)] for f in files if by.get((f, DEFAULT), {}).get("cpu_seconds")]
+        share = sum(r["cpu_seconds"] for r in own) / sum(r["seconds"] for r in own) if own \
+            else 1.0
+        if share < 0.9:  # the solves waited for a processor: their times are inflated
+            lines.append(f"{DEFAULT}'s solves were on a processor {share:.0%} of their time "
+                         "(a busy machine, or --n-jobs beside each other): the ratio is "
+                         "pessimistic; --n-jobs 1 on a quiet machine times them fairly")
     if profile is not None and len(methods) > 1:
         from .perf_profile import plot_profile
 
