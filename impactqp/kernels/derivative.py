@@ -159,25 +159,6 @@ def classify_rows(G, s, R, M, Um, Lam, kink_tol, classes, codes):
 
 
 @inline_kernel
-def one_row(um, lam, w, active):
-    """One answer's u⁻, Λ, w and active flags as a batch of one row (:class:`Classes`
-    with cell 0), with its status code."""
-    n, m = um.size, lam.size
-    classes = Classes(w.reshape((1, m)), active.reshape((1, m)),
-                      np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64))
-    return um.reshape((1, n)), lam.reshape((1, m)), classes, np.zeros(1, dtype=np.int64)
-
-
-@inline_kernel
-def classify_row(G, s, R, M, um, lam, kink_tol, w, active):
-    """:func:`classify_rows` for one answer, into ``w`` and ``active``. Returns (status,
-    the active set's bit mask)."""
-    Um, Lam, classes, codes = one_row(um, lam, w, active)
-    classify_rows(G, s, R, M, Um, Lam, kink_tol, classes, codes)
-    return codes[0], classes.keys[0]
-
-
-@inline_kernel
 def factor_cell(G, active, cells, e):
     """Factor the cell of ``active`` into cell number ``e`` of ``cells``: G_AA = LLᵀ (a
     dependent contact is dropped, as in the active-set search) and K_AA = G_AA⁻¹ from it.
@@ -250,16 +231,6 @@ def margin_rows(Um, Lam, classes, codes, grad, margin, start, stop):
             if grad[e, i] > 0.0:
                 best = min(best, (Lam[r, i] if active[r, i] else W[r, i]) * grad[e, i])
         margin[r] = 0.0 if codes[r] == KINK or not unorm > 0.0 else best / np.sqrt(unorm)
-
-
-@inline_kernel
-def row_margin(um, lam, w, active, inverse):
-    """:func:`margin_rows` for one smooth answer whose cell's inverse gradient norms are
-    ``inverse``."""
-    Um, Lam, classes, codes = one_row(um, lam, w, active)
-    margin = np.empty(1)
-    margin_rows(Um, Lam, classes, codes, inverse.reshape((1, lam.size)), margin, 0, 1)
-    return margin[0]
 
 
 @kernel
