@@ -105,7 +105,7 @@ class Cells(NamedTuple):
 class Classes(NamedTuple):
     """The classification of k rows: w = GΛ + q (k × m), the active flags (k × m), the
     active sets' bit masks (k) and each row's cell number (k; −1: none, the row is
-    uncertified or already finished)."""
+    uncertified)."""
 
     w: np.ndarray
     active: np.ndarray
