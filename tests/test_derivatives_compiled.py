@@ -98,7 +98,7 @@ def test_the_certificate_judges_the_linear_solves() -> None:
     assert not bad.ok and bad.linear_solve > 1e-3
 
 
-@pytest.mark.parametrize("m", [10, 18])  # kept cells (m ≤ MASK_BITS) and scratch only
+@pytest.mark.parametrize("m", [10, 18])  # cells kept by active set (m ≤ MASK_BITS), or one
 def test_batch_cells_give_each_row_its_own_derivative(m) -> None:
     assert (m <= cells_kernel.MASK_BITS) == (m == 10)
     p = iq.random_impact(m + 3, m, seed=4, consistent=False)
@@ -117,5 +117,39 @@ def test_batch_cells_give_each_row_its_own_derivative(m) -> None:
         assert np.allclose(b.jvp[i], d.jvp(u_minus=dU[i]).u_plus, atol=1e-11)
         assert np.allclose(b.vjp[i], d.vjp(u_plus=Ub[i])["u_minus"], atol=1e-11)
         assert np.isclose(b.margin[i], d.certificate.margin, rtol=1e-9)
-    if m == 10:  # more cells than a call keeps: the later ones are factored per row
-        assert len(cells) > cells_kernel.CACHED_CELLS
+    if m == 10:  # more cells than a call keeps: the rows met are finished, cells refilled
+        assert len(cells) > cells_kernel.CACHED_CELLS + 1
+
+
+def test_kernel_rows_mark_kinks_and_uncertified_rows() -> None:
+    # 3-ball rows through the kernel itself: kinks, rows the compiled solve does not certify
+    # (NaN u⁻) and rows after them; then cells that miss the tolerance
+    p, law, k = iq.newtons_cradle(3), iq.Moreau(0.0), 60
+    rng = np.random.default_rng(7)
+    U, dU, Ub = (rng.normal(size=(k, 3)) for _ in range(3))
+    U[5], U[6] = [1.0, 0.0, 0.5], [2.0, 0.0, 1.0]  # the three-ball kink, twice
+    U[[10, 30]] = np.nan
+    spec = cells_kernel.Law(np.zeros((2, 2)), 0.0, True, np.eye(2))
+    out = cells_kernel.Rows(np.empty((k, 3)), np.empty((k, 2)), np.empty((k, 6)),
+                            np.empty((k, 3)), np.empty((k, 3)), np.empty(k, dtype=np.int64),
+                            np.empty(k))
+
+    def run(tol: float, solved: bool) -> None:
+        settings = cells_kernel.Settings(tol, 1e-9, True, True, solved)
+        cells_kernel.derivative_rows(p.structure.kernel_pack, U, dU, Ub, spec, settings,
+                                     np.zeros(2, dtype=bool), out)
+
+    run(1e-9, False)
+    names = {cells_kernel.SMOOTH: "smooth", cells_kernel.KINK: "kink"}
+    for i in range(k):
+        if i in (10, 30):
+            assert out.status[i] == cells_kernel.UNCERTIFIED and np.isnan(out.margin[i])
+            continue
+        d = iq.derivative(p.with_u_minus(U[i]), law)
+        assert names[out.status[i]] == d.status == ("kink" if i in (5, 6) else "smooth")
+        assert np.allclose(out.Up[i], d.u_plus, atol=1e-12)
+        assert np.allclose(out.dUp[i], d.jvp(u_minus=dU[i]).u_plus, atol=1e-12)
+        assert np.allclose(out.Ubar[i], d.vjp(u_plus=Ub[i])["u_minus"], atol=1e-12)
+        assert np.isclose(out.margin[i], d.certificate.margin, rtol=1e-9)
+    run(-1.0, True)  # the solved rows again, no cell's residual within the tolerance
+    assert (out.status == cells_kernel.UNCERTIFIED).all() and np.isnan(out.margin).all()

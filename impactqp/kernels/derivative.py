@@ -6,9 +6,10 @@ and classified; its cell (active set A) is factored once — G_AA = LLᵀ, depen
 dropped as in the active-set search, K_AA = G_AA⁻¹ from the factor — with what depends on A
 alone: the gradients in u⁻ of the quantities bounding the cell and the relative residual
 ‖G_AA K_AA R_A − R_A‖ / ‖R_A‖ of its linear solves (a wrong factor shows there). Up to
-:data:`CACHED_CELLS` cells of a call are kept by active set (for at most :data:`MASK_BITS`
-contacts), so rows in a cell already met pay only for their classification, margin, JVP
-and VJP:
+:data:`CACHED_CELLS` + 1 cells of a call are kept by active set (for at most
+:data:`MASK_BITS` contacts; when all are in use, the rows met so far are finished and the
+cells start again), so rows in a cell already met pay only for their classification,
+margin, JVP and VJP:
 
     du⁺ = du⁻ − Y_A K_AA (R du⁻)_A,   ū⁻ = ū − Rᵀ_A K_AAᵀ (Yᵀū)_A,
 
@@ -16,7 +17,13 @@ with Y = M⁻¹W and R = (I + E)Wᵀ = ∂q/∂u⁻. The margin is the distance,
 from u⁻ to the nearest hyperplane where an active Λᵢ or an inactive wᵢ reaches zero
 (docs/theory.md §20); a row with a degenerate contact is a kink (margin 0, the default
 element: degenerate contacts counted as separating). The single impact's derivative
-(:mod:`impactqp.kernels.local_map`) factors its cell by the same functions.
+(:mod:`impactqp.kernels.local_map`) classifies, factors and measures its cell by the same
+functions, as a batch of one row.
+
+Each step runs over a range of rows in one call (:func:`classify_rows`,
+:func:`finish_rows`), never as a compiled call per row: such a call takes a reference to
+each of its array arguments and gives it back (two atomic operations per array), which for
+three balls cost four times the row's arithmetic.
 """
 
 from __future__ import annotations
@@ -37,7 +44,8 @@ MASK_BITS = 16
 """Most contacts for which a call keeps its cells by active set (a table of 2^m slots)."""
 
 CACHED_CELLS = 64
-"""Most cells a call keeps; further ones are factored again for each row."""
+"""Cells a call keeps beside the one it always has (more: the rows met so far are finished
+and the cells refilled)."""
 
 
 class Law(NamedTuple):
@@ -77,11 +85,11 @@ class Rows(NamedTuple):
 
 
 class Cells(NamedTuple):
-    """Factored cells, by number (the last one is scratch, refilled for every row whose
-    cell is not kept): the factor's contacts ``idx[e, :size[e]]``, K_AA = G_AA⁻¹ embedded
-    in ``K[e]`` (m × m, read on idx only), the inverse gradient norms ``grad[e]`` of the
-    bounding quantities, the solves' relative ``residual[e]``; ``slot`` maps an active-set
-    bit mask to its cell (−1: not factored yet); L and y are scratch."""
+    """Factored cells, by number: the factor's contacts ``idx[e, :size[e]]``,
+    K_AA = G_AA⁻¹ embedded in ``K[e]`` (m × m, read on idx only), the inverse gradient norms
+    ``grad[e]`` of the bounding quantities, the solves' relative ``residual[e]``; ``slot``
+    maps an active-set bit mask to its cell (−1: none) and ``key[e]`` is cell e's mask;
+    L and y are scratch."""
 
     idx: np.ndarray
     size: np.ndarray
@@ -89,47 +97,65 @@ class Cells(NamedTuple):
     grad: np.ndarray
     residual: np.ndarray
     slot: np.ndarray
+    key: np.ndarray
     L: np.ndarray
     y: np.ndarray
 
 
+class Classes(NamedTuple):
+    """The classification of k rows: w = GΛ + q (k × m), the active flags (k × m), the
+    active sets' bit masks (k) and each row's cell number (k; −1: none, the row is
+    uncertified)."""
+
+    w: np.ndarray
+    active: np.ndarray
+    keys: np.ndarray
+    cell: np.ndarray
+
+
 @kernel
 def new_cells(m, cached):
-    """Room for ``cached`` kept cells and the scratch one (``cached`` = 0: scratch only)."""
+    """Room for ``cached`` + 1 cells, with the table of active sets when ``cached`` > 0
+    (then m ≤ :data:`MASK_BITS`)."""
     slots = (1 << m) if cached > 0 else 1
     return Cells(np.empty((cached + 1, m), dtype=np.int64),
                  np.zeros(cached + 1, dtype=np.int64), np.zeros((cached + 1, m, m)),
                  np.zeros((cached + 1, m)), np.zeros(cached + 1),
-                 np.full(slots, -1, dtype=np.int64), np.empty((m, m)), np.empty(2 * m))
+                 np.full(slots, -1, dtype=np.int64), np.zeros(cached + 1, dtype=np.int64),
+                 np.empty((m, m)), np.empty(2 * m))
 
 
-@inline_kernel
-def classify_row(G, s, R, M, um, lam, kink_tol, w, active):
-    """w = GΛ + Ru⁻ (= GΛ + q) for the row and its classification (docs/theory.md §19): a
-    contact is degenerate when its scaled Λᵢsᵢ and wᵢ/sᵢ (sᵢ = √Gᵢᵢ) are both at most
-    ``kink_tol``·‖u⁻‖_M, else active when Λᵢsᵢ ≥ wᵢ/sᵢ. Returns (status, the active set's
-    bit mask; 0 beyond :data:`MASK_BITS` contacts)."""
+@kernel
+def classify_rows(G, s, R, M, Um, Lam, kink_tol, classes, codes):
+    """For every row (u⁻, Λ): w = GΛ + Ru⁻ (= GΛ + q) and the classification
+    (docs/theory.md §19): a contact is degenerate when its scaled Λᵢsᵢ and wᵢ/sᵢ
+    (sᵢ = √Gᵢᵢ) are both at most ``kink_tol``·‖u⁻‖_M, else active when Λᵢsᵢ ≥ wᵢ/sᵢ.
+    Fills ``classes`` (:class:`Classes`; bit mask 0 beyond :data:`MASK_BITS` contacts, cell
+    left alone) and ``codes`` (SMOOTH, or KINK for a row with a degenerate contact)."""
     m, n = R.shape
-    V = 0.0
-    for i in range(n):
-        for j in range(n):
-            V += um[i] * M[i, j] * um[j]
-    scale = 1.0 / np.sqrt(V) if V > 0.0 else 1.0
-    degenerate, key = False, 0
-    for i in range(m):
-        total = 0.0
-        for c in range(n):
-            total += R[i, c] * um[c]
-        for j in range(m):
-            total += G[i, j] * lam[j]
-        w[i] = total
-        a, b = lam[i] * s[i] * scale, total / s[i] * scale
-        flat = max(a, b) <= kink_tol
-        on = a >= b and not flat
-        active[i] = on
-        degenerate |= flat
-        key |= np.int64(on) << i  # no branch on the row's data
-    return (KINK if degenerate else SMOOTH), (key if m <= MASK_BITS else 0)
+    W, active, keys = classes.w, classes.active, classes.keys
+    for r in range(Um.shape[0]):
+        V = 0.0
+        for i in range(n):
+            for j in range(n):
+                V += Um[r, i] * M[i, j] * Um[r, j]
+        scale = 1.0 / np.sqrt(V) if V > 0.0 else 1.0
+        degenerate, key = False, 0
+        for i in range(m):
+            total = 0.0
+            for c in range(n):
+                total += R[i, c] * Um[r, c]
+            for j in range(m):
+                total += G[i, j] * Lam[r, j]
+            W[r, i] = total
+            a, b = Lam[r, i] * s[i] * scale, total / s[i] * scale
+            flat = max(a, b) <= kink_tol
+            on = a >= b and not flat
+            active[r, i] = on
+            degenerate |= flat
+            key |= np.int64(on) << i  # no branch on the row's data
+        codes[r] = KINK if degenerate else SMOOTH
+        keys[r] = key if m <= MASK_BITS else 0
 
 
 @inline_kernel
@@ -187,42 +213,64 @@ def measure_cell(G, R, active, cells, e):
     cells.residual[e] = np.sqrt(res) / (np.sqrt(scale) if scale > 0.0 else 1.0)
 
 
-@inline_kernel
-def row_margin(um, lam, w, active, inverse):
-    """The cell's radius relative to ‖u⁻‖ (docs/theory.md §20): min over contacts of the
-    value (Λᵢ active, wᵢ inactive) times the inverse norm of its gradient in u⁻ (0 for a
-    zero gradient, as of a dropped dependent contact: it bounds nothing)."""
-    best, unorm = np.inf, 0.0
-    for c in range(um.size):
-        unorm += um[c] * um[c]
-    for i in range(lam.size):
-        if inverse[i] > 0.0:
-            best = min(best, (lam[i] if active[i] else w[i]) * inverse[i])
-    return best / np.sqrt(unorm) if unorm > 0.0 else 0.0
+@kernel
+def margin_rows(Um, Lam, classes, codes, grad, margin, start, stop):
+    """For the rows start..stop with a cell: the cell's radius relative to ‖u⁻‖
+    (docs/theory.md §20), min over contacts of the value (Λᵢ active, wᵢ inactive) times
+    the inverse norm of its gradient in u⁻ (``grad[cell]``; 0 for a zero gradient, as of a
+    dropped dependent contact: it bounds nothing); 0 at a kink."""
+    W, active, cell = classes.w, classes.active, classes.cell
+    for r in range(start, stop):
+        e = cell[r]
+        if e < 0:
+            continue
+        best, unorm = np.inf, 0.0
+        for c in range(Um.shape[1]):
+            unorm += Um[r, c] * Um[r, c]
+        for i in range(Lam.shape[1]):
+            if grad[e, i] > 0.0:
+                best = min(best, (Lam[r, i] if active[r, i] else W[r, i]) * grad[e, i])
+        margin[r] = 0.0 if codes[r] == KINK or not unorm > 0.0 else best / np.sqrt(unorm)
 
 
-@inline_kernel
-def apply_cell(P, Q, cells, e, transpose, x, out):
-    """out = x − Q_Aᵀ K_AA P_A x (K_AAᵀ with ``transpose``): with P = R, Q = Yᵀ the JVP of
-    u⁻, with P = Yᵀ, Q = R and ``transpose`` its VJP (docs/theory.md §18)."""
+@kernel
+def apply_rows(P, Q, cells, cell, transpose, X, out, start, stop):
+    """For the rows start..stop with a cell: out = x − Q_Aᵀ K_AA P_A x (K_AAᵀ with
+    ``transpose``) on the row's cell; with P = R, Q = Yᵀ the JVP of u⁻, with P = Yᵀ,
+    Q = R and ``transpose`` its VJP (docs/theory.md §18)."""
     m, n = P.shape
-    idx, K, k, y = cells.idx[e], cells.K[e], cells.size[e], cells.y
-    for a in range(k):
-        total = 0.0
-        for c in range(n):
-            total += P[idx[a], c] * x[c]
-        y[a] = total
-    z = y[m:]
-    for a in range(k):
-        total = 0.0
-        for b in range(k):
-            total += (K[idx[b], idx[a]] if transpose else K[idx[a], idx[b]]) * y[b]
-        z[a] = total
-    for c in range(n):
-        total = x[c]
+    idx, K, size, y, z = cells.idx, cells.K, cells.size, cells.y[:m], cells.y[m:]
+    for r in range(start, stop):
+        e = cell[r]
+        if e < 0:
+            continue
+        k = size[e]
         for a in range(k):
-            total -= Q[idx[a], c] * z[a]
-        out[c] = total
+            total = 0.0
+            for c in range(n):
+                total += P[idx[e, a], c] * X[r, c]
+            y[a] = total
+        for a in range(k):
+            total = 0.0
+            for b in range(k):
+                i, j = (idx[e, b], idx[e, a]) if transpose else (idx[e, a], idx[e, b])
+                total += K[e, i, j] * y[b]
+            z[a] = total
+        for c in range(n):
+            total = X[r, c]
+            for a in range(k):
+                total -= Q[idx[e, a], c] * z[a]
+            out[r, c] = total
+
+
+@kernel
+def finish_rows(Um, Lam, classes, cells, R, YT, dU, Ubar, settings, out, start, stop):
+    """Margins, JVP and VJP rows of the rows start..stop that have a cell."""
+    margin_rows(Um, Lam, classes, out.status, cells.grad, out.margin, start, stop)
+    if settings.jvp:
+        apply_rows(R, YT, cells, classes.cell, False, dU, out.dUp, start, stop)
+    if settings.vjp:
+        apply_rows(YT, R, cells, classes.cell, True, Ubar, out.Ubar, start, stop)
 
 
 @kernel
@@ -235,36 +283,43 @@ def derivative_rows(packed, Um, dU, Ubar, law, settings, passive, out):
     ops = _unpack(packed, n, m)
     R = law.IE @ ops.Wt  # ∂q/∂u⁻ and Yᵀ, the same for every row
     YT = np.ascontiguousarray(ops.MinvW.T)
-    # contiguous copies of the packed views: the row loop indexes them faster
+    # contiguous copies of the packed views: the row loops index them faster
     G, s, M = ops.G.copy(), ops.s.copy(), ops.M.copy()
-    kept = CACHED_CELLS if m <= MASK_BITS else 0
-    cells = new_cells(m, kept)
-    work = workspace(n, m)
-    w, active = np.empty(m), np.empty(m, dtype=np.bool_)
-    used = 0
+    Lam, codes, margin = out.Lam, out.status, out.margin
+    solved = np.ones(k_rows, dtype=np.bool_)
+    if not settings.solved:
+        work = workspace(n, m)
+        for r in range(k_rows):
+            solved[r] = _solve_into(ops, Um[r], law.E, law.eps, law.moreau, settings.tol,
+                                    passive, out.Up[r], Lam[r], out.Res[r], work)
+    classes = Classes(np.empty((k_rows, m)), np.empty((k_rows, m), dtype=np.bool_),
+                      np.empty(k_rows, dtype=np.int64), np.full(k_rows, -1, dtype=np.int64))
+    classify_rows(G, s, R, M, Um, Lam, settings.kink_tol, classes, codes)
+    lookup = m <= MASK_BITS
+    cells = new_cells(m, CACHED_CELLS if lookup else 0)
+    slot, owner, residual = cells.slot, cells.key, cells.residual
+    active, keys, cell = classes.active, classes.keys, classes.cell
+    used, start = 0, 0
     for r in range(k_rows):
-        um, lam = Um[r], out.Lam[r]
-        if not settings.solved and not _solve_into(
-                ops, um, law.E, law.eps, law.moreau, settings.tol, passive, out.Up[r], lam,
-                out.Res[r], work):
-            out.status[r], out.margin[r] = UNCERTIFIED, np.nan
+        if not solved[r]:
+            codes[r], margin[r] = UNCERTIFIED, np.nan
             continue
-        status, key = classify_row(G, s, R, M, um, lam, settings.kink_tol, w, active)
-        e = cells.slot[key] if kept else -1
+        e = slot[keys[r]] if lookup else -1
         if e < 0:
-            e = used if used < kept else kept
-            factor_cell(G, active, cells, e)
-            measure_cell(G, R, active, cells, e)
-            if e < kept:
-                cells.slot[key] = e
-                used += 1
-        if not cells.residual[e] <= settings.tol:  # NaN fails
-            out.status[r], out.margin[r] = UNCERTIFIED, np.nan
+            if used == residual.size:  # every cell in use: finish the rows met, refill
+                finish_rows(Um, Lam, classes, cells, R, YT, dU, Ubar, settings, out,
+                            start, r)
+                start, used = r, 0
+                if lookup:
+                    for f in range(residual.size):
+                        slot[owner[f]] = -1
+            e, used = used, used + 1
+            factor_cell(G, active[r], cells, e)
+            measure_cell(G, R, active[r], cells, e)
+            if lookup:
+                slot[keys[r]], owner[e] = e, keys[r]
+        if not residual[e] <= settings.tol:  # NaN fails
+            codes[r], margin[r] = UNCERTIFIED, np.nan
             continue
-        out.status[r] = status
-        out.margin[r] = 0.0 if status == KINK else row_margin(um, lam, w, active,
-                                                             cells.grad[e])
-        if settings.jvp:
-            apply_cell(R, YT, cells, e, False, dU[r], out.dUp[r])
-        if settings.vjp:
-            apply_cell(YT, R, cells, e, True, Ubar[r], out.Ubar[r])
+        cell[r] = e
+    finish_rows(Um, Lam, classes, cells, R, YT, dU, Ubar, settings, out, start, k_rows)

@@ -28,11 +28,12 @@ import numpy as np
 from .derivative import (
     DEPENDENT,
     SMOOTH,
-    classify_row,
+    Classes,
+    classify_rows,
     factor_cell,
+    margin_rows,
     measure_cell,
     new_cells,
-    row_margin,
 )
 from .impact import _unpack
 from .jit import inline_kernel, kernel
@@ -92,10 +93,13 @@ def local_cell(packed, Minv, E, eps, um, lam, kink_tol, out):
     w, flags, figures = out[size:size + m], out[size + m:size + 2 * m], out[size + 2 * m:]
     IE = np.eye(m) * (1.0 + eps) if E.size == 0 else np.eye(m) + E
     R = IE @ ops.Wt
-    active = np.empty(m, dtype=np.bool_)
-    status, _ = classify_row(ops.G, ops.s, R, ops.M, um, lam, kink_tol, w, active)
-    if status != SMOOTH:
-        return status
+    ints = np.zeros(3, dtype=np.int64)  # the batch's classification of one row, in cell 0
+    one = Classes(w.reshape((1, m)), np.empty((1, m), dtype=np.bool_), ints[:1], ints[1:2])
+    Um, Lam, status = um.reshape((1, n)), lam.reshape((1, m)), ints[2:]
+    classify_rows(ops.G, ops.s, R, ops.M, Um, Lam, kink_tol, one, status)
+    if status[0] != SMOOTH:
+        return status[0]
+    active = one.active[0]
     cells = new_cells(m, 0)
     k = factor_cell(ops.G, active, cells, 0)
     count = 0
@@ -131,7 +135,7 @@ def local_cell(packed, Minv, E, eps, um, lam, kink_tol, out):
         for i in range(m):
             total += ops.MinvW[c, i] * lam[i]
         p.v[c] = total
-    figures[0] = row_margin(um, lam, w, active, cells.grad[0])
+    margin_rows(Um, Lam, one, status, cells.grad, figures[:1], 0, 1)
     figures[1] = cells.residual[0]
     figures[2] = gnorm * knorm if k else 1.0
     return SMOOTH
