@@ -172,6 +172,23 @@ def _accept(W, q, mu, d, r, tol):
     return False
 
 
+ROUND_OFF = 1e-14
+"""‖F‖/‖q‖ below which the sweeps' answer is kept as it is; above it, Newton takes one step
+from it and keeps it when better (:func:`_to_round_off`)."""
+
+
+@kernel
+def _to_round_off(W, q, mu, rho, d, r, tol):
+    """One Newton step from the sweeps' r (within tol/2), kept when it is better, unless r is
+    within :data:`ROUND_OFF` already: as :func:`newton_dense` answers, the few contacts of a
+    time step are answered to round-off, not just to the tolerance. Returns the steps."""
+    qn = np.sqrt(np.sum(q * q))
+    if abh_error(W, q, mu, d, r, qn if qn > 0.0 else 1.0) <= ROUND_OFF:
+        return 0
+    steps, _ = newton_dense(W, q, mu, rho, d, r, tol, 1.0, 1)
+    return steps
+
+
 FIRST_SWEEPS = 8
 """Most sweeps of each of the two rounds that open :func:`solve_small` (their rate decides
 whether the sweeps go on)."""
@@ -227,7 +244,8 @@ def sweeps_first(rows, q, mu, d, r, tol, sweeps, local_iters):
 def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
     """A local problem of a few contacts (dense W) in one compiled call, into ``r``: the
     projected Gauss–Seidel on W's nonzero entries while its rate says it finishes within
-    ``sweeps`` (:func:`sweeps_first`), else Newton from r = 0, then the sweeps on from where
+    ``sweeps`` (:func:`sweeps_first`; its answer taken to round-off by
+    :func:`_to_round_off`), else Newton from r = 0, then the sweeps on from where
     they stopped (``sweeps`` in all) followed by Newton, then the damped Newton (shift factor
     10) from r = 0 — the order of ``auto`` without the cone programs (docs/theory.md §15).
     Returns (iterations, whether the projected r left in ``r`` is within tol/2 in ‖F‖/‖q‖);
@@ -235,7 +253,7 @@ def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
     rows = nonzero_rows(W)
     swept_its = sweeps_first(rows, q, mu, d, r, tol, sweeps, local_iters)
     if _accept(W, q, mu, d, r, tol):
-        return swept_its, True
+        return swept_its + _to_round_off(W, q, mu, rho, d, r, tol), True
     swept = r.copy()
     r[:] = 0.0
     steps, ok = newton_dense(W, q, mu, rho, d, r, tol, 1.0, newton_steps)
@@ -248,7 +266,7 @@ def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
                             sweeps - swept_its, local_iters)
         its += done
         if _accept(W, q, mu, d, r, tol):
-            return its, True
+            return its + _to_round_off(W, q, mu, rho, d, r, tol), True
     more, ok = newton_dense(W, q, mu, rho, d, r, tol, 1.0, newton_steps)
     its += more
     if ok:
