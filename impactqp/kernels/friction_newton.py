@@ -216,10 +216,10 @@ def sweep_budget(n, m, entries, sweeps, local_iters):
 def sweeps_first(rows, q, mu, d, r, tol, sweeps, local_iters):
     """The projected Gauss–Seidel from r = 0 on W's nonzero ``rows`` (indptr, indices,
     data), into ``r``, while it costs less than Newton would (:func:`sweep_budget`): a round
-    of a third of the budget (2 to :data:`FIRST_SWEEPS` sweeps), a second one to measure its rate (‖F‖ falling linearly in
-    log scale) where the budget holds a third, and, when that rate predicts tol/2 within the
-    budget, the predicted number and half as many again (docs/theory.md §15). Returns the sweeps done (the caller checks
-    ‖F‖)."""
+    of a third of the budget (2 to :data:`FIRST_SWEEPS` sweeps), a second one to measure
+    its rate (‖F‖ falling linearly in log scale) where the budget holds a third, and, when
+    that rate predicts tol/2 within the budget, the predicted number and half as many again
+    (docs/theory.md §15). Returns the sweeps done (the caller checks ‖F‖)."""
     indptr, indices, data = rows
     budget = sweep_budget(q.size, mu.size, indices.size, sweeps, local_iters)
     first = int(min(max(budget / 3.0, 2.0), FIRST_SWEEPS))
