@@ -18,7 +18,6 @@ from impactqp.kernels.friction_blocks import (
     sticking,
 )
 from impactqp.kernels.friction_newton import (
-    FIRST_SWEEPS,
     scales,
     solve_small,
     sweep_budget,
@@ -114,12 +113,16 @@ def planar_chain(m: int) -> iq.FrictionContactProblem:
     return iq.FrictionContactProblem(W, q, 0.5, contact_dim=d)
 
 
-def stiff_contact() -> iq.FrictionContactProblem:
-    """One 3-D contact sliding, W_cc with a condition number of 10⁴: the projected fixed
-    point contracts by ~1 − 2·10⁻⁴ a step, so the sweeps' rate is slow."""
-    W = np.diag([1.0, 1e-4, 1.0])
-    W[0, 1] = W[1, 0] = 5e-3
-    return iq.FrictionContactProblem(W, np.array([-1.0, 2.0, -0.5]), 0.3)
+def stiff_contacts(m: int) -> iq.FrictionContactProblem:
+    """m 3-D contacts sliding, each W_cc with a condition number of 10⁴, weakly coupled: the
+    projected fixed point contracts by ~1 − 2·10⁻⁴ a step, so the sweeps' rate is slow."""
+    n = 3 * m
+    W = 0.01 * np.ones((n, n))
+    for c in range(m):
+        W[3 * c:3 * c + 3, 3 * c:3 * c + 3] = [[1.0, 5e-3, 0.0], [5e-3, 1e-4, 0.0],
+                                               [0.0, 0.0, 1.0]]
+    q = np.tile([-1.0, 2.0, -0.5], m)
+    return iq.FrictionContactProblem(W, q, 0.3)
 
 
 def test_the_sweeps_answer_where_their_rate_is_fast() -> None:
@@ -139,17 +142,21 @@ def test_the_sweeps_answer_where_their_rate_is_fast() -> None:
 
 
 def test_newton_answers_where_the_sweeps_rate_is_slow() -> None:
-    p = stiff_contact()
-    W, q, mu = p.W, p.q, p.mu
-    r = np.empty(3)
-    done = sweeps_first(nonzero_rows(W), q, mu, 3, r, 1e-8, 100, 10)
-    assert done <= FIRST_SWEEPS and abh(W, q, mu, 3, r) > 1e-8  # handed on to Newton
-    r = np.empty(3)
-    its, ok = solve_small(W, q, mu, scales(W.diagonal(), 3), 3, 1e-8, r, 50, 100, 10)
-    assert ok and its > done and abh(W, q, mu, 3, r) <= 0.5e-8
-    res = iq.solve_friction(p, tol=1e-8)
-    assert res.backend == "kernel" and res.certificate.ok and abh(W, q, mu, 3, res.r) <= 1e-8
-    ut = res.u[1:]  # it slides: r on the cone's rim, against the sliding velocity
-    assert np.linalg.norm(ut) > 1e-3
-    np.testing.assert_allclose(res.r[1:], -mu[0] * res.r[0] * ut / np.linalg.norm(ut),
-                               rtol=1e-6)
+    for m in (1, 4):
+        p = stiff_contacts(m)
+        W, q, mu = p.W, p.q, p.mu
+        budget = sweep_budget(q.size, m, np.count_nonzero(W), 100, 10)
+        assert (budget < 1.0) == (m == 1)  # one 3-D contact: a sweep costs more than Newton
+        r = np.empty(3 * m)
+        done = sweeps_first(nonzero_rows(W), q, mu, 3, r, 1e-8, 100, 10)
+        assert done == (0 if m == 1 else 1) and abh(W, q, mu, 3, r) > 1e-8  # to Newton
+        r = np.empty(3 * m)
+        its, ok = solve_small(W, q, mu, scales(W.diagonal(), 3), 3, 1e-8, r, 50, 100, 10)
+        assert ok and its > done and abh(W, q, mu, 3, r) <= 0.5e-8
+        res = iq.solve_friction(p, tol=1e-8)
+        assert res.backend == "kernel" and res.certificate.ok
+        assert abh(W, q, mu, 3, res.r) <= 1e-8
+        ut = res.u[1:3]  # the first contact slides: r on the cone's rim, against u_T
+        assert np.linalg.norm(ut) > 1e-3
+        np.testing.assert_allclose(res.r[1:3], -mu[0] * res.r[0] * ut / np.linalg.norm(ut),
+                                   rtol=1e-6)

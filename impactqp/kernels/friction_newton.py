@@ -189,9 +189,6 @@ def _to_round_off(W, q, mu, rho, d, r, tol):
     return steps
 
 
-FIRST_SWEEPS = 8
-"""Most sweeps of each of the two rounds that open :func:`solve_small` (their rate decides
-whether the sweeps go on)."""
 NEWTON_EXPECTED = 8
 """Newton steps :func:`sweeps_first` weighs its sweeps against (the dense Newton of a few
 contacts takes 4 to 8 where it converges)."""
@@ -215,29 +212,32 @@ def sweep_budget(n, m, entries, sweeps, local_iters):
 @kernel
 def sweeps_first(rows, q, mu, d, r, tol, sweeps, local_iters):
     """The projected Gauss–Seidel from r = 0 on W's nonzero ``rows`` (indptr, indices,
-    data), into ``r``, while it costs less than Newton would (:func:`sweep_budget`): a round
-    of a third of the budget (2 to :data:`FIRST_SWEEPS` sweeps), a second one to measure
-    its rate (‖F‖ falling linearly in log scale) where the budget holds a third, and, when
-    that rate predicts tol/2 within the budget, the predicted number and half as many again
-    (docs/theory.md §15). Returns the sweeps done (the caller checks ‖F‖)."""
+    data), into ``r``, while it costs less than Newton would (:func:`sweep_budget`; none
+    where the budget is below one sweep): one sweep, then twice the number its rate predicts
+    are left to tol/2 (‖F‖ falling linearly in log scale, from r = 0 or the last check),
+    each time only while that prediction lies within the budget (docs/theory.md §15).
+    Returns the sweeps done (the caller checks ‖F‖)."""
     indptr, indices, data = rows
     budget = sweep_budget(q.size, mu.size, indices.size, sweeps, local_iters)
-    first = int(min(max(budget / 3.0, 2.0), FIRST_SWEEPS))
     r[:] = 0.0
-    done, err = nsgs_rows(indptr, indices, data, q, mu, d, r, 0.5 * tol, first, local_iters)
-    if err <= 0.5 * tol or done < first or done + 2 * first > budget:
-        return done
-    more, err_more = nsgs_rows(indptr, indices, data, q, mu, d, r, 0.5 * tol, first,
-                               local_iters)
-    done += more
-    if err_more <= 0.5 * tol or not 0.0 < err_more < err:
-        return done
-    left = more * np.log(0.5 * tol / err_more) / np.log(err_more / err)
-    if done + left > budget:
-        return done
-    more, _ = nsgs_rows(indptr, indices, data, q, mu, d, r, 0.5 * tol,
-                        min(int(1.5 * left) + 1, sweeps - done), local_iters)
-    return done + more
+    if budget < 1.0:  # one sweep costs more than Newton
+        return 0
+    qn = np.sqrt(np.sum(q * q))
+    F = natural_map(r, q, mu, d)  # at r = 0, u = q
+    last = np.sqrt(np.sum(F * F)) / (qn if qn > 0.0 else 1.0)
+    done, err = nsgs_rows(indptr, indices, data, q, mu, d, r, 0.5 * tol, 1, local_iters)
+    last_at = 0
+    for _ in range(2):
+        if err <= 0.5 * tol or not 0.0 < err < last:
+            return done
+        left = (done - last_at) * np.log(0.5 * tol / err) / np.log(err / last)
+        if done + left > budget:
+            return done
+        more, new = nsgs_rows(indptr, indices, data, q, mu, d, r, 0.5 * tol,
+                              min(int(left) + 1, sweeps - done), local_iters)
+        last, last_at, err = err, done, new
+        done += more
+    return done
 
 
 @kernel(interpretable=True)
