@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .friction_blocks import exact_contact, local_steps, nonzero_rows
 from .jit import inline_kernel, kernel
 
 CHECK_GAP = 8
@@ -221,32 +222,11 @@ def alart_curnier(r, u, mu, rho, d, jac, A, B):
 
 
 @kernel
-def local_steps(Wcc):
-    """The step ρ_c of each contact's projected fixed point in :func:`nsgs_rows`:
-    2/(λ_min + λ_max) of the symmetric part of W_cc (1 where that is not positive or W_cc
-    not finite)."""
-    m = Wcc.shape[0]
-    rhos = np.ones(m)
-    for c in range(m):
-        if not np.all(np.isfinite(Wcc[c])):
-            continue
-        lam = np.linalg.eigvalsh(0.5 * (Wcc[c] + Wcc[c].T))
-        if lam[-1] + lam[0] > 0.0:
-            rhos[c] = 2.0 / (lam[-1] + lam[0])
-    return rhos
-
-
-@kernel
 def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
-    """:func:`nsgs_rows` for a dense W (every entry taken as stored)."""
-    n = r.size
-    indptr = np.arange(0, n * n + 1, n)
-    indices = np.empty(n * n, dtype=np.int64)
-    for i in range(n):
-        for j in range(n):
-            indices[i * n + j] = j
-    return nsgs_rows(indptr, indices, np.ascontiguousarray(W).ravel(), q, mu, d, r, tol,
-                     max_sweeps, local_iters)
+    """:func:`nsgs_rows` for a dense W, on its nonzero entries
+    (:func:`~impactqp.kernels.friction_blocks.nonzero_rows`)."""
+    indptr, indices, data = nonzero_rows(W)
+    return nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters)
 
 
 @kernel
@@ -255,10 +235,12 @@ def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
     W given by its compressed rows (``indptr``, ``indices``, ``data``: scipy's CSR arrays),
     so that a sweep costs the entries of W.
 
-    Each contact's local problem (the others held) is solved by at most ``local_iters``
-    steps of the projected fixed point r_c ← P_{K_μ}(r_c − ρ_c ũ_c) (ρ_c of
-    :func:`local_steps`), fewer once a step moves r_c by less than 10⁻⁶‖r_c‖; the sweeps
-    stop when ‖F‖ ≤ tol·‖q‖.
+    Each contact's local problem (the others held) is solved exactly where a closed form
+    holds (:func:`~impactqp.kernels.friction_blocks.exact_contact`: apart, sticking, a planar
+    contact sliding), else by at most
+    ``local_iters`` steps of the projected fixed point r_c ← P_{K_μ}(r_c − ρ_c ũ_c) (ρ_c of
+    :func:`~impactqp.kernels.friction_blocks.local_steps`), fewer once a step moves r_c by
+    less than 10⁻⁶‖r_c‖; the sweeps stop when ‖F‖ ≤ tol·‖q‖.
     ‖F‖ (a product by W, as dear as a sweep) is evaluated after the first sweep, then after
     as many sweeps as its decrease since the last evaluation predicts are left to reach tol
     (at most :data:`CHECK_GAP`, and one while it does not decrease) and after the last.
@@ -298,7 +280,8 @@ def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
                     v -= Wcc[c, i, j] * r[k + j]
                 base[i] = v
                 rc[i] = r[k + i]
-            for _ in range(local_iters):
+            exact = exact_contact(Wcc[c], base, mu[c], d, rc)
+            for _ in range(0 if exact else local_iters):
                 for i in range(d):
                     v = base[i]
                     for j in range(d):

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction import alart_curnier, natural_map, nsgs, project_cones
+from .friction import alart_curnier, natural_map, nsgs_rows, project_cones
+from .friction_blocks import nonzero_rows
 from .jit import inline_kernel, kernel
 
 
@@ -171,22 +172,101 @@ def _accept(W, q, mu, d, r, tol):
     return False
 
 
+ROUND_OFF = 1e-14
+"""‖F‖/‖q‖ below which the sweeps' answer is kept as it is; above it, Newton takes one step
+from it and keeps it when better (:func:`_to_round_off`)."""
+
+
+@kernel
+def _to_round_off(W, q, mu, rho, d, r, tol):
+    """One Newton step from the sweeps' r (within tol/2), kept when it is better, unless r is
+    within :data:`ROUND_OFF` already: as :func:`newton_dense` answers, the few contacts of a
+    time step are answered to round-off, not just to the tolerance. Returns the steps."""
+    qn = np.sqrt(np.sum(q * q))
+    if abh_error(W, q, mu, d, r, qn if qn > 0.0 else 1.0) <= ROUND_OFF:
+        return 0
+    steps, _ = newton_dense(W, q, mu, rho, d, r, tol, 1.0, 1)
+    return steps
+
+
+NEWTON_EXPECTED = 8
+"""Newton steps :func:`sweeps_first` weighs its sweeps against (the dense Newton of a few
+contacts takes 4 to 8 where it converges)."""
+LOCAL_WORK = 40
+"""Operations one projected fixed-point step on one contact costs, in units of a product by
+one entry of W (measured: a local step ≈ 40 ns, a sweep over 9 contacts of 121 entries with
+10 local steps each ≈ 3.4 µs, a dense Newton step on 27 unknowns ≈ 6 µs)."""
+
+
+@inline_kernel
+def sweep_budget(n, m, entries, sweeps, local_iters):
+    """Most sweeps worth trying before Newton: as many as cost the work of
+    :data:`NEWTON_EXPECTED` dense Newton steps on n unknowns (an LU, n³/3, and J and the line
+    search, 4n²), a sweep costing its ``entries`` and m contacts' ``local_iters`` local steps
+    (planar contacts are solved exactly, in about one); at most ``sweeps``."""
+    local = 1 if m > 0 and n == 2 * m else local_iters
+    newton = NEWTON_EXPECTED * (n * n * n / 3.0 + 4.0 * n * n)
+    return min(float(sweeps), newton / (entries + LOCAL_WORK * local * m))
+
+
+@kernel
+def sweeps_first(rows, q, mu, d, r, tol, sweeps, local_iters):
+    """The projected Gauss–Seidel from r = 0 on W's nonzero ``rows`` (indptr, indices,
+    data), into ``r``, while it costs less than Newton would (:func:`sweep_budget`; none
+    where the budget is below one sweep): one sweep, then twice the number its rate predicts
+    are left to tol/2 (‖F‖ falling linearly in log scale, from r = 0 or the last check),
+    each time only while that prediction lies within the budget (docs/theory.md §15).
+    Returns the sweeps done (the caller checks ‖F‖)."""
+    indptr, indices, data = rows
+    budget = sweep_budget(q.size, mu.size, indices.size, sweeps, local_iters)
+    r[:] = 0.0
+    if budget < 1.0:  # one sweep costs more than Newton
+        return 0
+    qn = np.sqrt(np.sum(q * q))
+    F = natural_map(r, q, mu, d)  # at r = 0, u = q
+    last = np.sqrt(np.sum(F * F)) / (qn if qn > 0.0 else 1.0)
+    done, err = nsgs_rows(indptr, indices, data, q, mu, d, r, 0.5 * tol, 1, local_iters)
+    last_at = 0
+    for _ in range(2):
+        if err <= 0.5 * tol or not 0.0 < err < last:
+            return done
+        left = (done - last_at) * np.log(0.5 * tol / err) / np.log(err / last)
+        if done + left > budget:
+            return done
+        more, new = nsgs_rows(indptr, indices, data, q, mu, d, r, 0.5 * tol,
+                              min(int(left) + 1, sweeps - done), local_iters)
+        last, last_at, err = err, done, new
+        done += more
+    return done
+
+
 @kernel(interpretable=True)
 def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
-    """A local problem of a few contacts (dense W) in one compiled call, into ``r``: Newton
-    from r = 0, then NSGS followed by Newton, then the damped Newton (shift factor 10) from
-    r = 0 — the order of ``auto`` without the cone programs (docs/theory.md §15).
+    """A local problem of a few contacts (dense W) in one compiled call, into ``r``: the
+    projected Gauss–Seidel on W's nonzero entries while its rate says it finishes within
+    ``sweeps`` (:func:`sweeps_first`; its answer taken to round-off by
+    :func:`_to_round_off`), else Newton from r = 0, then the sweeps on from where
+    they stopped (``sweeps`` in all) followed by Newton, then the damped Newton (shift factor
+    10) from r = 0 — the order of ``auto`` without the cone programs (docs/theory.md §15).
     Returns (iterations, whether the projected r left in ``r`` is within tol/2 in ‖F‖/‖q‖);
     the caller certifies it."""
+    rows = nonzero_rows(W)
+    swept_its = sweeps_first(rows, q, mu, d, r, tol, sweeps, local_iters)
+    if _accept(W, q, mu, d, r, tol):
+        return swept_its + _to_round_off(W, q, mu, rho, d, r, tol), True
+    swept = r.copy()
     r[:] = 0.0
-    its, ok = newton_dense(W, q, mu, rho, d, r, tol, 1.0, newton_steps)
+    steps, ok = newton_dense(W, q, mu, rho, d, r, tol, 1.0, newton_steps)
+    its = swept_its + steps
     if ok:
         return its, True
-    r[:] = 0.0
-    done, _ = nsgs(W, q, mu, d, r, 0.5 * tol, sweeps, local_iters)
-    its += done
-    if _accept(W, q, mu, d, r, tol):
-        return its, True
+    r[:] = swept
+    if swept_its < sweeps:
+        done, _ = nsgs_rows(rows[0], rows[1], rows[2], q, mu, d, r, 0.5 * tol,
+                            sweeps - swept_its, local_iters)
+        its += done
+        if _accept(W, q, mu, d, r, tol):
+            return its + _to_round_off(W, q, mu, rho, d, r, tol), True
     more, ok = newton_dense(W, q, mu, rho, d, r, tol, 1.0, newton_steps)
     its += more
     if ok:

@@ -31,7 +31,7 @@ from ..model.friction import (
 from ..qp import backends
 from ..qp.certified import Outcome, solve_certified
 from ..qp.friction import FrictionSolution, methods
-from ..qp.friction.methods import NSGS_LOCAL, NSGS_SHORT
+from ..qp.friction.methods import NSGS_SHORT, SMALL_LOCAL
 from ..qp.friction.newton import NEWTON_STEPS
 from .planner import plan_friction
 from .result import FrictionResult
@@ -117,7 +117,7 @@ def _tiny(problem: FrictionContactProblem, tol: float, start: float) -> Friction
     W = np.ascontiguousarray(problem.dense_W(), dtype=float)  # a sparse W of a few contacts too
     its, outcome, scaled = solve_tiny(W, problem.q, problem.mu,
                                       problem.contact_dim,
-                                      TinyLimits(tol, NEWTON_STEPS, NSGS_SHORT, NSGS_LOCAL),
+                                      TinyLimits(tol, NEWTON_STEPS, NSGS_SHORT, SMALL_LOCAL),
                                       r, u, figures)
     if outcome != CERTIFIED:
         return None

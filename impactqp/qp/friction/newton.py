@@ -22,6 +22,7 @@ from ...kernels.friction import (
     project_cones,
     projection_jacobian,
 )
+from ...kernels.friction_blocks import nonzero_rows
 from ...kernels.friction_newton import scales
 from . import FrictionProgram
 
@@ -108,18 +109,16 @@ class FrictionData:
 
     @property
     def W(self) -> sp.csr_matrix:
-        """W as compressed rows (every entry of a dense W stored: no scan for zeros, which
-        costs more than a sweep)."""
+        """W as compressed rows (a dense W's nonzero entries, found in one compiled pass:
+        the price of one dense sweep, where W of contacts is mostly zeros)."""
         if self._rows is None:
             W = self.program.W
             if sp.issparse(W):
                 self._rows = sp.csr_matrix(W, dtype=float)
                 self._rows.sum_duplicates()
             else:
-                n = self.n
-                self._rows = sp.csr_matrix((np.asarray(W, dtype=float).ravel(),
-                                            np.tile(np.arange(n), n),
-                                            np.arange(0, n * n + 1, n)), shape=(n, n))
+                indptr, indices, data = nonzero_rows(np.ascontiguousarray(W, dtype=float))
+                self._rows = sp.csr_matrix((data, indices, indptr), shape=(self.n, self.n))
         return self._rows
 
     @property
