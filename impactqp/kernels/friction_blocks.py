@@ -70,14 +70,14 @@ def nonzero_rows(W):
     given dense is mostly zeros: 2–8 % of its entries on the FCLib problems of a few dozen
     contacts). One pass over W, the price of one dense sweep."""
     n = W.shape[0]
-    indptr = np.zeros(n + 1, dtype=np.int64)
+    indptr = np.zeros(n + 1, dtype=np.int32)  # scipy's index type: one compiled sweep
     for i in range(n):
         count = 0
         for j in range(n):
             if W[i, j] != 0.0:
                 count += 1
         indptr[i + 1] = indptr[i] + count
-    indices = np.empty(indptr[n], dtype=np.int64)
+    indices = np.empty(indptr[n], dtype=np.int32)
     data = np.empty(indptr[n])
     for i in range(n):
         p = indptr[i]

@@ -185,7 +185,7 @@ def _to_round_off(W, q, mu, rho, d, r, tol):
     qn = np.sqrt(np.sum(q * q))
     if abh_error(W, q, mu, d, r, qn if qn > 0.0 else 1.0) <= ROUND_OFF:
         return 0
-    steps, _ = newton_dense(W, q, mu, rho, d, r, tol, 1.0, 1)
+    steps, _ = newton_dense(W, q, mu, rho, d, r, tol, 1.0, np.int64(1))  # not a literal
     return steps
 
 
@@ -225,7 +225,8 @@ def sweeps_first(rows, q, mu, d, r, tol, sweeps, local_iters):
     qn = np.sqrt(np.sum(q * q))
     F = natural_map(r, q, mu, d)  # at r = 0, u = q
     last = np.sqrt(np.sum(F * F)) / (qn if qn > 0.0 else 1.0)
-    done, err = nsgs_rows(indptr, indices, data, q, mu, d, r, 0.5 * tol, 1, local_iters)
+    done, err = nsgs_rows(indptr, indices, data, q, mu, d, r, 0.5 * tol, np.int64(1),
+                          local_iters)  # an int64, not a literal 1: one compiled sweep
     last_at = 0
     for _ in range(2):
         if err <= 0.5 * tol or not 0.0 < err < last:

@@ -52,6 +52,7 @@ def friction_coefficients(value: Any, n_contacts: int, name: str = "mu") -> np.n
     if (mu < 0).any():
         raise InputError(f"{name} must be ≥ 0, got {mu[mu < 0][0]} at contact "
                          f"{int(np.argmax(mu < 0))}")
+    mu.setflags(write=False)  # a private copy, read-only like the laws' own μ
     return mu
 
 
