@@ -110,7 +110,8 @@ def _local(k, vf, gk, closed, contacts, friction, tol, events, vn, lam):
     W, qt = gather_local(G, units, cols, qa, np.empty((na, na)), np.empty(na))
     mu = friction.mu[cons]
     r = np.zeros(na)
-    done, _ = nsgs(W, qt, mu, d, r, friction.target, friction.sweeps, LOCAL_ITERATIONS)
+    done, _ = nsgs(W, qt, mu, d, r, friction.target, friction.sweeps,
+                   np.int64(LOCAL_ITERATIONS))  # not a literal: the sweeps compile once
     r = project_cones(r, mu, d)
     if not _certified(W, qt, r, mu, d, tol):
         return False

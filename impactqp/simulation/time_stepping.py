@@ -111,10 +111,19 @@ class _FreeVelocity:
         n = self.system.n_dof
         if self.K is not None:
             K = self.K.toarray() if sp.issparse(self.K) else self.K
-            return Force(self.solver.cholesky_factor, np.ascontiguousarray(K, dtype=float),
+            return Force(np.ascontiguousarray(self.solver.cholesky_factor),
+                         np.ascontiguousarray(K, dtype=float),
                          self.constant, np.zeros(n), True)
         shift = self.solver.solve_mass(self.residual(t0, self.system.q0, self.system.v0))
         return Force(np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0), shift, False)
+
+
+def read_only(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a``: the compiled loop's arguments keep one set of array flags
+    (each other set is one more compilation of the loop)."""
+    view = a.view()
+    view.setflags(write=False)
+    return view
 
 
 def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
@@ -283,17 +292,16 @@ class _CompiledLoop(CompiledDriver):
         self.force = free.kernel_force(step.t0)
         E = law.step_restitution(np.arange(m))
         if np.ndim(E) < 2:
-            e, matrix = np.ascontiguousarray(np.broadcast_to(E, (m,)), dtype=float), \
-                np.zeros((0, 0))
+            e, matrix = np.array(np.broadcast_to(E, (m,)), dtype=float), np.zeros((0, 0))
         else:
             e, matrix = np.zeros(0), np.ascontiguousarray(restitution_matrix(E, m))
         self.impacts = Impacts(e, matrix, np.zeros(m, dtype=bool))
         if cache.chain is not None and np.ndim(E) == 0:  # runs of balls: isotonic
             chain = cache.chain
-            self.chain = Chain(True, cache.diagonal, 1.0 / cache.diagonal,
+            self.chain = Chain(True, read_only(cache.diagonal), 1.0 / cache.diagonal,
                                bool(chain.left_wall), bool(chain.right_wall), float(E))
         else:
-            self.chain = Chain(False, np.zeros(0), np.zeros(0), False, False, 0.0)
+            self.chain = Chain(False, read_only(np.zeros(0)), np.zeros(0), False, False, 0.0)
 
     def kernel_data(self) -> tuple:
         return self.contacts, self.force, self.step.scheme, self.impacts, self.chain
