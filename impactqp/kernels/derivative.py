@@ -299,7 +299,7 @@ def derivative_rows(packed, Um, dU, Ubar, law, settings, passive, out):
     cells = new_cells(m, CACHED_CELLS if lookup else 0)
     slot, owner, residual = cells.slot, cells.key, cells.residual
     active, keys, cell = classes.active, classes.keys, classes.cell
-    used, start = 0, 0
+    used, start = 0, np.int64(0)  # start not a literal: finish_rows compiles once
     for r in range(k_rows):
         if not solved[r]:
             codes[r], margin[r] = UNCERTIFIED, np.nan

@@ -135,7 +135,7 @@ def local_cell(packed, Minv, E, eps, um, lam, kink_tol, out):
         for i in range(m):
             total += ops.MinvW[c, i] * lam[i]
         p.v[c] = total
-    margin_rows(Um, Lam, one, status, cells.grad, figures[:1], 0, 1)
+    margin_rows(Um, Lam, one, status, cells.grad, figures[:1], np.int64(0), np.int64(1))
     figures[1] = cells.residual[0]
     figures[2] = gnorm * knorm if k else 1.0
     return SMOOTH
