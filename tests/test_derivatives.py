@@ -345,3 +345,13 @@ def test_coulomb_in_space_against_finite_differences() -> None:
     t = {k: rng.normal(size=s) for k, s in d.inputs.items()}
     tan, cot = d.jvp(**t), d.vjp(u_plus=np.ones(6))
     assert np.isclose(np.ones(6) @ tan.u_plus, sum(np.sum(cot[k] * t[k]) for k in t))
+
+
+def test_the_agreement_benchmark_counts_every_problem_and_finds_no_false_smooth() -> None:
+    """benchmarks/derivatives.py's random-family check (issue 26's first target) on a few
+    problems: every problem is counted once and no smooth derivative misses the differences."""
+    from benchmarks.derivatives import agreement
+
+    a = agreement(12, seed=3)
+    assert a["smooth"] + a["other"] == a["problems"] == 12
+    assert a["agree"] + a["disagree"] == a["smooth"] and a["disagree"] == 0
