@@ -355,3 +355,47 @@ def test_the_agreement_benchmark_counts_every_problem_and_finds_no_false_smooth(
     a = agreement(12, seed=3)
     assert a["smooth"] + a["other"] == a["problems"] == 12
     assert a["agree"] + a["disagree"] == a["smooth"] and a["disagree"] == 0
+
+
+def _onset_in_space(seed: int, mu: float = 0.4, e: float = 0.3):
+    """One contact in space whose answer sticks exactly on the cone's rim (U_T = 0,
+    |Λ_T| = μΛ_n), built backwards from that answer, with M and W coupling every row."""
+    rng = np.random.default_rng(seed)
+    A = rng.normal(size=(3, 3))
+    M = A @ A.T + 3 * np.eye(3)
+    W = rng.normal(size=(3, 3)) + 2 * np.eye(3)
+    G = W.T @ np.linalg.solve(M, W)
+    t_hat = rng.normal(size=2)
+    t_hat /= np.linalg.norm(t_hat)
+    lam = np.array([1.0, *(mu * t_hat)])
+    if (G @ lam)[0] <= 0:
+        lam[1:] *= -1
+    Gl = G @ lam
+    U_minus = np.array([-Gl[0] / (1 + e), -Gl[1], -Gl[2]])  # U⁺ = (−eU⁻_n, 0, 0)
+    u_minus = np.linalg.solve(W.T, U_minus)
+    return iq.ImpactProblem(M, W, u_minus, contact_dim=3), iq.Coulomb(mu, e), lam, rng
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_coulomb_onset_in_space_both_sides(seed: int) -> None:
+    """At the onset of sliding in space the one-sided derivatives follow the solve on each
+    side: along −t̂ the slip starts and stays across t̂ at 0 to first order, so Λ_T turns
+    (the slide's limit, not Λ_T ∥ t̂)."""
+    p, law, lam, rng = _onset_in_space(seed)
+    r = iq.solve(p, law)
+    assert np.allclose(r.impulses, lam, atol=1e-9)
+    d = r.derivative()
+    assert d.status == "kink"
+    seen = set()
+    for _ in range(6):
+        du = rng.normal(size=3)
+        for sign in (1.0, -1.0):
+            h = 1e-7
+            moved = iq.solve(p.with_u_minus(p.u_minus + sign * h * du), law)
+            fd = (moved.u_plus - r.u_plus) / h
+            one_sided = d.directional(u_minus=sign * du).u_plus
+            assert np.allclose(one_sided, fd, atol=2e-5 * np.linalg.norm(du)), (sign, du)
+            W = p.W
+            slip = W.T @ moved.u_plus
+            seen.add(bool(np.linalg.norm(slip[1:]) > 1e-12))
+    assert seen == {True, False}  # both the sticking and the sliding side were crossed

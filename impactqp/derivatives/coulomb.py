@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import DerivativeUnsupportedError, NoSolutionError
+from ..errors import NoSolutionError
 from ..laws.friction import solve_friction
 from ..model.friction import FrictionContactProblem
 from .complementarity import ComplementarityMap, Parameter
@@ -195,12 +195,7 @@ class CoulombMap(ComplementarityMap):
             tl = lt / (np.linalg.norm(lt) or 1.0)
             if modes[c] == SEPARATE:
                 ok = dU[a] >= -scale
-            elif modes[c] == ONSET:
-                if d == 3:
-                    raise DerivativeUnsupportedError(
-                        "the one-sided derivative at the onset of sliding in space is not "
-                        "implemented (the slip direction is free); the limiting Jacobians "
-                        "and the default element are")
+            elif modes[c] == ONSET:  # slides along −t̂, Λ_T's direction: −t̂·dU_T ≥ 0
                 ok = -tl @ dU[a + 1:a + d] >= -scale
             elif self.options[c][0] == SEPARATE:  # the contact closes: Λ_n grows
                 ok = dlam[a] >= -lam_scale
@@ -282,6 +277,12 @@ def mode_equations(modes: np.ndarray, lam: np.ndarray, U: np.ndarray, mu: np.nda
         FL[rows, T, T] = eye
         FL[rows, T, a] = mu[c] * t
         Fmu[rows, T, c] = ln[:, None] * t
+        # sliding that starts at the answer (docs/theory.md §18): the slip leaves along −t̂,
+        # so Λ_T's grip along t̂ follows μΛ_n while across t̂ the slip stays 0 (Λ_T's turn
+        # there is set by the next order): t̂t̂ᵀdΛ_T − μt̂ dΛ_n + (I − t̂t̂ᵀ)dU_T = 0
+        across = eye - np.einsum("si,sj->sij", t[onset], t[onset])
+        FL[rows[onset], T, T] = eye - across
+        FU[rows[onset], T, T] = across
         bend = ~onset & (size > 0)
         FU[rows[bend], T, T] = (mu[c] * ln[bend] / size[bend])[:, None, None] * (
             eye - np.einsum("si,sj->sij", t[bend], t[bend]))
