@@ -11,25 +11,15 @@ import sys
 from pathlib import Path
 
 import pytest
+from compile_count import COUNTER
 
 NOTICE = "impactqp: compiling its numba kernels"
 
 # A later process's routes, with a listener counting every compilation of impactqp's kernels.
-ROUTES = """
-import numba.core.event as ev
+ROUTES = COUNTER + """
 import numpy as np
 import impactqp as iq
 
-class Count(ev.Listener):
-    n = 0
-    def on_start(self, event):
-        d = (event.data or {}).get("dispatcher")
-        if getattr(getattr(d, "py_func", None), "__module__", "").startswith("impactqp."):
-            Count.n += 1
-    def on_end(self, event):
-        pass
-
-ev.register("numba:compile", Count())
 p = iq.newtons_cradle(3, 1.0)
 iq.moreau(p, 1.0); iq.moreau(p, 0.0); iq.sector_law(p)
 iq.solve_batch(p, iq.Moreau(0.5), np.random.default_rng(0).standard_normal((10, 3)))

@@ -23,6 +23,9 @@ import pytest
 
 import impactqp as iq
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "_ext"))
+from dotted_names import exists  # noqa: E402  (the docs' extensions are not a package)
+
 API = Path(__file__).resolve().parents[1] / "docs" / "api.rst"
 
 def _names(entries: list) -> set[str]:
@@ -113,19 +116,9 @@ PUBLIC = {name for _, name in public_names()}  # a bare name may be any public o
 
 
 def _resolve(dotted: str) -> bool:
-    """Does ``a.b.c`` name an importable module or an attribute chain below one?"""
-    parts = dotted.split(".")
-    for cut in range(len(parts), 0, -1):
-        try:
-            obj = importlib.import_module(".".join(parts[:cut]))
-        except ImportError:
-            continue
-        for name in parts[cut:]:
-            if not hasattr(obj, name):
-                return False
-            obj = getattr(obj, name)
-        return True
-    return False
+    """Does ``a.b.c`` name an importable module or an attribute chain below one? (The
+    docs' own test of a dotted name, builtins left out.)"""
+    return exists(dotted, builtin=False)
 
 
 def _members(cls: type) -> set[str]:

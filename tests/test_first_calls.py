@@ -11,24 +11,13 @@ import sys
 
 import numpy as np
 import pytest
+from compile_count import COUNTER
 
 # Runs in a fresh process with an empty cache; prints what happened as "key value" lines.
-PROBE = """
-import numba.core.event as ev
+PROBE = COUNTER + """
 import numpy as np
 import impactqp as iq
 from impactqp.kernels import first_calls, units
-
-class Count(ev.Listener):
-    n = 0
-    def on_start(self, event):
-        d = (event.data or {}).get("dispatcher")
-        if getattr(getattr(d, "py_func", None), "__module__", "").startswith("impactqp."):
-            Count.n += 1
-    def on_end(self, event):
-        pass
-
-ev.register("numba:compile", Count())
 {body}
 print("compilations", Count.n)
 print("interpreted", first_calls.spent()[1])

@@ -13,10 +13,10 @@ type links; anything else still fails the build.
 from __future__ import annotations
 
 import builtins
-import importlib
 import sys
 
 from docutils import nodes
+from dotted_names import exists
 from sphinx.ext.intersphinx import InventoryAdapter
 
 # the top-level modules each inventory documents
@@ -27,22 +27,6 @@ def _offline(env) -> set[str]:
     """The inventories of docs/conf.py that were read empty (their site was unreachable)."""
     named = InventoryAdapter(env).named_inventory
     return {name for name in MODULES if not any(named.get(name, {}).values())}
-
-
-def exists(dotted: str) -> bool:
-    """Does ``a.b.c`` name an importable module or an attribute chain below one?"""
-    parts = dotted.split(".")
-    for cut in range(len(parts), 0, -1):
-        try:
-            obj = importlib.import_module(".".join(parts[:cut]))
-        except ImportError:
-            continue
-        for name in parts[cut:]:
-            if not hasattr(obj, name):
-                return False
-            obj = getattr(obj, name)
-        return True
-    return hasattr(builtins, dotted)
 
 
 def unlinked_offline(app, env, node, contnode):

@@ -50,6 +50,8 @@ of :mod:`impactqp.kernels`, so that their relative imports reach the same module
 
 _lock = threading.Lock()
 _state = {"spent": 0.0, "calls": 0, "compiling": 0}
+_cold: set[CPUDispatcher] = set()
+"""Kernels whose cache this process found without machine code."""
 
 
 def spent() -> tuple[float, int]:
@@ -128,7 +130,13 @@ def _interpret(dispatcher: CPUDispatcher, args: tuple[Any, ...]) -> bool:
     """Run this call of a cold kernel as Python (see the module's rules)?"""
     if _state["compiling"] or _state["spent"] >= BUDGET or _elements(args) > SMALL:
         return False
-    return not dispatcher.signatures and not cached(dispatcher)
+    if dispatcher.signatures:
+        return False
+    if dispatcher not in _cold:  # the cache's index is read once per kernel and process
+        if cached(dispatcher):
+            return False
+        _cold.add(dispatcher)
+    return True
 
 
 def _timed(function: Callable) -> Callable:
