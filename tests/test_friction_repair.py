@@ -7,6 +7,7 @@ best answer and each attempt's work."""
 from __future__ import annotations
 
 import re
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -15,7 +16,9 @@ import scipy.sparse as sp
 import impactqp as iq
 from benchmarks.friction_data import load
 from impactqp.model.friction import certify_friction
-from impactqp.qp.friction.newton import FrictionData
+from impactqp.qp import backends
+from impactqp.qp.friction.newton import FrictionData, newton
+from impactqp.qp.friction.order import REPAIR_FIRST, friction_order
 from impactqp.qp.friction.repair import REPAIR_MAX, repair, residual_cluster
 
 
@@ -112,3 +115,23 @@ def test_a_failure_carries_the_best_answer_and_each_attempts_work() -> None:
     assert {a.split(" ")[0] for a in failed} >= {"nsgs-short", "newton", "newton-repair"}
     for note in failed:  # method, its worst figure, iterations and time of each attempt
         assert re.search(r"certificate failed, \w+ = \S+ after \d+ iterations, \S+ s$", note)
+
+
+def test_the_repairs_come_before_the_cone_programs_on_large_problems_only() -> None:
+    order = backends.AUTO_ORDER["friction"]
+    small, large = (SimpleNamespace(n_contacts=m) for m in (REPAIR_FIRST - 1, REPAIR_FIRST))
+    for program, first in ((small, "clarabel"), (large, "newton-repair")):
+        names = friction_order(order, program)
+        assert sorted(names) == sorted(order)  # the same methods, one place changed
+        pair = [n for n in names if n in ("clarabel", "newton-repair")]
+        assert pair[0] == first and names.index(pair[1]) == names.index(pair[0]) + 1
+
+
+def test_a_newton_probe_stops_where_newton_is_far_from_converging() -> None:
+    p = banded(40, 3, 0.5, seed=5)
+    data = FrictionData(p)
+    start = np.zeros(p.q.size)
+    _, steps, ok = newton(data, start, 1e-8, max_steps=30, probe=(2, 1e30))
+    assert (steps, ok) == (2, False)  # no two steps divide ‖F‖ by 1e30
+    r, steps, ok = newton(data, start, 1e-8, max_steps=30, probe=(2, 1.0))
+    assert ok and steps > 2 and certify_friction(p, r).ok  # any gain lets it go on
