@@ -19,9 +19,9 @@ from .methods import POLISH_STEPS, socp_route
 from .newton import FrictionData, newton
 
 REPAIR_ROUNDS = 6
-"""Most rounds of repair then Newton (on Granular2D-2020 the first round certifies; where the
-residual is spread over the whole problem, as on RockPile, no round gains and the route ends
-after :data:`REPAIR_IDLE`)."""
+"""Most rounds of repair then Newton (on Granular2D-2020 the third certifies; where the
+residual is spread over the whole problem, as on RockPile, the clusters are too large or the
+rounds stop gaining, and the route ends)."""
 REPAIR_IDLE = 3
 """Rounds in a row that do not lower the best ‖F‖ after which the route gives up."""
 REPAIR_SHARE = 0.99
@@ -31,9 +31,6 @@ REPAIR_SEEDS = 16
 REPAIR_MAX = 96
 """Most contacts of a repaired sub-problem (the seeds and their neighbours in W): beyond it
 the residual is not local and a repair would be a whole solve."""
-REPAIR_SHIFT = 10.0
-"""Shift factor of the Newton that repairs a sub-problem where a cone program fails (the
-damped variant's, :data:`~.methods.NEWTON_SHIFT`)."""
 
 
 class SubProblem(NamedTuple):
@@ -78,19 +75,20 @@ def sub_problem(data: FrictionData, r: np.ndarray, rows: np.ndarray) -> Friction
 
 def repair(data: FrictionData, r: np.ndarray, tol: float) -> tuple[np.ndarray, int]:
     """r with its residual's cluster (:func:`residual_cluster`) replaced by the sub-problem's
-    answer from the fixed point of cone programs (:func:`~.methods.socp_route` from 0; where
-    Clarabel does not certify one of its programs, the damped Newton from 0), when that
-    answer lowers ‖F‖ on the sub-problem; also the rounds done (0: no repair)."""
+    answer from the fixed point of cone programs (:func:`~.methods.socp_route`) from the
+    current r_S, finished by Newton (Newton alone where Clarabel does not certify one of its
+    programs), when that answer lowers ‖F‖ on the sub-problem; also the cone programs and
+    Newton steps done (0: no repair)."""
     rows = residual_cluster(data, r)
     if rows.size == 0:
         return r, 0
     sub = sub_problem(data, r, rows)
     before = sub.error(r[rows])
     try:
-        r_sub, rounds, finished = socp_route(sub, r[rows], tol)
+        r_sub, rounds, by_newton = socp_route(sub, r[rows], tol)
     except (CertificateError, SolverError):  # a cone program Clarabel did not certify
-        r_sub, rounds, finished = r[rows], 0, False
-    if not finished:
+        r_sub, rounds, by_newton = r[rows], 0, False
+    if not by_newton:
         r_sub, steps, _ = newton(sub, r_sub, tol)
         rounds += steps
     r_sub = project_cones(r_sub, sub.mu, sub.d)
