@@ -32,7 +32,8 @@ def sphere(mu_velocity=(1.0, -2.0, 0.0)) -> iq.ImpactProblem:
 def test_available_backends_lists_the_friction_methods() -> None:
     listed = {b["name"] for b in iq.available_backends() if "friction" in b["forms"]}
     assert listed == set(METHODS) == {"kernel", "clarabel", "nsgs-short", "newton",
-                                      "newton-damped", "newton-lstsq", "nsgs"}
+                                      "newton-damped", "newton-repair", "newton-lstsq",
+                                      "nsgs"}
     assert set(backends.AUTO_ORDER["friction"]) == listed
     coulomb = {b["name"]: b["laws"]["coulomb"] for b in iq.available_backends()}
     assert {name for name, forms in coulomb.items() if forms} == listed

@@ -3,7 +3,8 @@
 The friction methods are entries of the backend registry (form ``"friction"``,
 :mod:`impactqp.qp.backends`): the compiled call of a few contacts (``"kernel"``), a short and a
 long projected Gauss–Seidel (``"nsgs-short"``, ``"nsgs"``), Alart–Curnier's semismooth Newton
-(``"newton"``, ``"newton-damped"``), the least-squares Newton on the natural map
+(``"newton"``, ``"newton-damped"``), Newton with local repairs of where it stalls
+(``"newton-repair"``, docs/theory.md §22), the least-squares Newton on the natural map
 (``"newton-lstsq"``) and a fixed point of second-order cone programs solved by Clarabel
 (``"clarabel"``). :func:`solve_friction` runs them through the one certified loop
 (:func:`impactqp.qp.certified.solve_certified`), which polishes by Newton where a method leaves
@@ -55,8 +56,9 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     problem : FrictionContactProblem
     backend : str
         ``"auto"``: the friction methods in the registry's order (one compiled call for a
-        few contacts, 100 NSGS sweeps then Newton, Newton from r = 0, the SOCP fixed point,
-        the damped Newton, the least-squares Newton, a long NSGS; docs/theory.md §15), or one
+        few contacts, 100 NSGS sweeps then Newton, Newton from r = 0, the SOCP fixed point
+        and Newton with local repairs (the repairs first from 1000 contacts on), the damped
+        Newton, the least-squares Newton, a long NSGS; docs/theory.md §15, §22), or one
         of them by name (:data:`FRICTION_BACKENDS`, ``iq.available_backends()``), tried
         alone. The result's ``backend`` is always one of these names.
     tol : float

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 import weakref
 from collections.abc import Callable, Sequence
 from typing import Any, NamedTuple
@@ -33,6 +34,7 @@ from ..errors import (
 )
 from . import backends
 from .backends.exact import MAX_CONSTRAINTS
+from .friction.order import friction_order
 from .kinds import kind_of
 from .program import QuadraticProgram
 
@@ -89,6 +91,8 @@ def auto_order(qp: Any, form: str) -> list[str]:
     they apply; NNLS is exact and fastest on dense impulse forms; PIQP is 3–5× faster than
     Clarabel on sparse impacts of 10⁴ contacts and as accurate after polishing; that order
     depends on the program's shape only, so it is kept per owner and tag."""
+    if form == backends.FRICTION:  # the repairs' place depends on the size (§22)
+        return friction_order(backends.AUTO_ORDER[form], qp)
     if form not in backends.FORMS:
         return list(backends.AUTO_ORDER[form])
     if qp.cache_owner is None:
@@ -182,6 +186,14 @@ def solve_in_forms(stages: Sequence[Stage], backend: str,
     raise BackendUnsuitableError("; ".join(dict.fromkeys(unsuitable)))
 
 
+def _work(sol: Any, seconds: float) -> str:
+    """What an attempt cost, for its note: its iterations where the solution counts them,
+    and its time (polish included)."""
+    its = getattr(sol, "iterations", None)
+    return f" after {its} iterations, {seconds:.3g} s" if its is not None else \
+        f" after {seconds:.3g} s"
+
+
 def _better(new: ResidualChecks, old: ResidualChecks) -> bool:
     a, b = new.worst[1], old.worst[1]
     return new.ok and (not old.ok or not math.isfinite(b) or a <= b)
@@ -226,6 +238,7 @@ def solve_certified(planned: Plan, *, named: bool, tol: float = 1e-10,
                 continue
         prepared = kind.prepare(entry, program)
         for attempt_tol in kind.tolerances(entry, tol):
+            began = time.perf_counter()
             try:
                 raw = kind.run(module, entry, sub, prepared, attempt_tol, options, warm)
             except InputError:  # the user's options: theirs to mend, not a solver failure
@@ -261,7 +274,7 @@ def solve_certified(planned: Plan, *, named: bool, tol: float = 1e-10,
                 warm, warm_value = sol, value
                 best = Outcome(answer, cert, sol, sol.backend, form, log)
             _note(log, f"{name} ({form}, tol {attempt_tol:.0e}): certificate failed, "
-                       f"{worst} = {value:.1e}")
+                       f"{worst} = {value:.1e}{_work(sol, time.perf_counter() - began)}")
     failure = kind.failure(program, log)
     if isinstance(failure, CertificateError):
         failure.best, failure.attempts = best, list(log)

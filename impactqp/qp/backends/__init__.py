@@ -125,6 +125,9 @@ REGISTRY: dict[str, Backend] = {b.name: b for b in (
             "friction: Alart–Curnier semismooth Newton from r = 0, sparse LU steps"),
     Backend("newton-damped", "newton_", "scipy", "scipy", (FRICTION,), False,
             "friction: Alart–Curnier Newton with a ten times larger shift of its Jacobian"),
+    Backend("newton-repair", "repair_", "clarabel", "clarabel", (FRICTION,), False,
+            "friction: Newton with local repairs: where it stalls on a few contacts, their "
+            "sub-problem solved by the cone programs' fixed point, then Newton again"),
     Backend("newton-lstsq", "lstsq_", "scipy", "scipy", (FRICTION,), False,
             "friction: least-squares Newton on the natural map, dense, at most 600 unknowns "
             "(rank-deficient W)"),
@@ -134,16 +137,17 @@ REGISTRY: dict[str, Backend] = {b.name: b for b in (
 
 AUTO_ORDER = {
     CONE: ("clarabel", "cvxpy"),
-    FRICTION: ("kernel", "nsgs-short", "newton", "clarabel", "newton-damped", "newton-lstsq",
-               "nsgs"),
+    FRICTION: ("kernel", "nsgs-short", "newton", "newton-repair", "clarabel", "newton-damped",
+               "newton-lstsq", "nsgs"),
 }
 """The order in which ``"auto"`` tries the entries of the cone and friction forms (the
 quadratic programs' order depends on the program, :func:`impactqp.qp.certified.auto_order`).
 Friction: cheapest where each works first — one compiled call for a few contacts, a short
-NSGS on well-conditioned problems, Newton from r = 0 most of the rest, the SOCP fixed point the
-badly conditioned ones, the damped and least-squares Newton some rank-deficient ones, a long
+NSGS on well-conditioned problems, Newton from r = 0 most of the rest, Newton with local
+repairs where it stalls on a few contacts (§22), the SOCP fixed point the badly conditioned
+ones, the damped and least-squares Newton some rank-deficient ones, a long
 NSGS last; the SOCP route, the least-squares Newton and the long NSGS start from the best
-answer so far (docs/theory.md §15)."""
+answer so far (docs/theory.md §15, §22)."""
 
 def sub_solvers(entry: Backend) -> list[dict]:
     """The solvers of :data:`SOLVERS` that ``entry`` runs, as ``"family:solver"``, each with

@@ -51,6 +51,16 @@ rate predicts they need (KaplasTower: 1100 sweeps reach 1e-8 in 0.17 s, while Ne
 QUICK_POLISH = 4
 """Newton steps ``nsgs-short`` tries before sweeping on when its sweeps predict they reach
 the tolerance within :data:`NSGS_MORE` more (Newton converges in a few steps when it does)."""
+QUICK_PROBE = 2
+"""Of the :data:`QUICK_POLISH` steps, those after which Newton must have divided ‖F‖ by
+:data:`QUICK_GAIN` for the rest to be taken (docs/theory.md §22): on KaplasTower and Capsules
+its first steps are cut short by the line search and barely lower ‖F‖ (the sweeps finish
+there), on PerioBox, FC2D-00727 and FC2D-00237 ‖F‖ halves or better in two steps and Newton
+finishes or nearly."""
+QUICK_GAIN = 1.25
+"""Least factor in ‖F‖ the :data:`QUICK_PROBE` steps gain for the quick polish to go on
+(measured after two steps: KaplasTower 1/0.99, Capsules 1/0.96; PerioBox 1/0.52, FC2D-00727
+1/0.26, FC2D-00237 1/0.001)."""
 NSGS_LOCAL = 3
 """Most projected fixed-point steps on one contact's local problem per sweep (more are
 wasted while the other contacts still move: on the FCLib problems 10 took as many sweeps as
@@ -161,7 +171,8 @@ def nsgs_route(data: FrictionData, r0: np.ndarray, tol: float,
 def short_nsgs_route(data: FrictionData, tol: float) -> tuple[np.ndarray, int, bool]:
     """:data:`NSGS_SHORT` sweeps from r = 0, then Newton from there: :data:`QUICK_POLISH`
     steps when the sweeps' rate predicts they reach the tolerance within :data:`NSGS_MORE`
-    more, else up to ``POLISH_STEPS``. When Newton has not succeeded, the sweeps go on from
+    more (:data:`QUICK_PROBE` where those have not divided ‖F‖ by :data:`QUICK_GAIN`), else
+    up to ``POLISH_STEPS``. When Newton has not succeeded, the sweeps go on from
     their r, in rounds of the predicted number, for as long as each round gains a factor
     ten in ‖F‖ and its rate predicts the tolerance within what is left of
     :data:`NSGS_MORE` sweeps (else their r is returned, to the next method), after which
@@ -170,8 +181,11 @@ def short_nsgs_route(data: FrictionData, tol: float) -> tuple[np.ndarray, int, b
     r, its, left = nsgs_route(data, np.zeros_like(data.q), tol, NSGS_SHORT)
     if left == 0.0 and data.error(r) <= 0.5 * tol:
         return r, its, False
-    r_pol, steps, ok = newton(data, r, tol,
-                              max_steps=QUICK_POLISH if left <= NSGS_MORE else POLISH_STEPS)
+    if left <= NSGS_MORE:  # a quick polish, cut short where Newton is far from converging
+        r_pol, steps, ok = newton(data, r, tol, max_steps=QUICK_POLISH,
+                                  probe=(QUICK_PROBE, QUICK_GAIN))
+    else:
+        r_pol, steps, ok = newton(data, r, tol, max_steps=POLISH_STEPS)
     its += steps
     if ok or left > NSGS_MORE or data.error(r_pol) <= 0.5 * tol:
         return r_pol, its, True

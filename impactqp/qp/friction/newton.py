@@ -186,7 +186,8 @@ def backtrack(r: np.ndarray, step: np.ndarray, f: float,
 
 
 def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
-            max_steps: int = NEWTON_STEPS) -> tuple[np.ndarray, int, bool]:
+            max_steps: int = NEWTON_STEPS,
+            probe: tuple[int, float] | None = None) -> tuple[np.ndarray, int, bool]:
     """Semismooth Newton on Alart–Curnier's function Φ (docs/theory.md §15) from r: steps
     (J + λI)Δ = −Φ with J = A + B W (A, B block-diagonal, from
     :func:`impactqp.kernels.friction.alart_curnier`) and λ = κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²) (J is
@@ -195,9 +196,11 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
     :data:`SHIFT_GROWTH` (up to :data:`SHIFT_MAX`); each full step shrinks it back.
 
     Stops when the projected r is within tol/2 in ‖F‖/‖q‖ (projecting moves r by up to ‖F‖,
-    hence u by up to ‖W‖‖F‖), after ``max_steps`` steps (a rejected step counts), or when
-    the line search fails at the largest shift. Returns r projected onto the cones, the steps
-    done, and whether that r is within tol/2 (the certificate's figure)."""
+    hence u by up to ‖W‖‖F‖), after ``max_steps`` steps (a rejected step counts), when
+    the line search fails at the largest shift, or, with ``probe`` = (k, g), after k steps
+    that have not divided ‖F‖ by g (Newton still far from its fast convergence). Returns r
+    projected onto the cones, the steps done, and whether that r is within tol/2 (the
+    certificate's figure)."""
     q, mu, d, rho = data.q, data.mu, data.d, data.rho
     n, m = data.n, mu.size
     A = np.empty((m, d, d))
@@ -208,11 +211,15 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
     f = float(np.linalg.norm(phi))
     steps = 0
     boost = 1.0
+    first = -1.0
     while True:
-        rp = data.finished(r, float(np.linalg.norm(natural_map(r, u, mu, d))), tol)
+        f_nat = float(np.linalg.norm(natural_map(r, u, mu, d)))
+        rp = data.finished(r, f_nat, tol)
         if rp is not None:
             return rp, steps, True
-        if steps == max_steps:
+        first = f_nat if first < 0.0 else first
+        if steps == max_steps or (probe is not None and steps == probe[0]
+                                  and not f_nat * probe[1] <= first):
             break
         steps += 1
         shift = boost * kappa * min(f / (scale or 1.0), 1e-2)
