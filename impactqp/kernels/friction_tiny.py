@@ -19,9 +19,10 @@ from typing import NamedTuple
 import numpy as np
 
 from .coulomb_certificate import FRICTION_FIGURES, friction_figures
-from .friction import natural_map
+from .friction import natural_map, nsgs_rows
+from .friction_blocks import nonzero_rows
 from .friction_newton import scales, solve_small
-from .jit import kernel
+from .jit import inline_kernel, kernel
 from .units import contact_units
 
 CERTIFIED, NOT_CERTIFIED, NEEDS_SCALING = 0, 1, 2
@@ -48,6 +49,48 @@ class TinyLimits(NamedTuple):
     newton_steps: int
     sweeps: int
     local_iters: int
+
+
+@inline_kernel(interpretable=True)
+def _units(diagonal, q, d):
+    """The contacts' units s of W's ``diagonal``
+    (:func:`impactqp.kernels.units.contact_units`), whether one is not 1, and whether q̂ = q/s
+    is posed as it is (the binary exponent of max|q̂ᵢ| within :data:`LOG2_RANGE`; 0 when
+    q = 0)."""
+    s = contact_units(diagonal, d)
+    scaled = False
+    for i in range(q.size):
+        scaled = scaled or s[i] != 1.0
+    top = 0
+    found = False
+    for i in range(q.size):
+        if q[i] != 0.0:
+            e = math.frexp(q[i])[1] - math.frexp(s[i])[1]
+            top = e if not found else max(top, e)
+            found = True
+    return s, scaled, LOG2_RANGE[0] < top < LOG2_RANGE[1]
+
+
+@inline_kernel(interpretable=True)
+def _judged(rw, uw, u, s, qu, mu, d, tol, figures):
+    """The certificate of an answer (r, u) as given, from r̂ = s∘r in ``rw`` and
+    û = W̃r̂ + q̂ in ``uw`` recomputed by the caller from W̃ and q̂: the figures of
+    :func:`~impactqp.kernels.coulomb_certificate.friction_figures` into ``figures``, with
+    ‖F(r̂, û)‖ and ‖u/s − û‖. Returns :data:`CERTIFIED` when each residual is within
+    ``tol`` (a NaN fails), else :data:`NOT_CERTIFIED`."""
+    mismatch = 0.0
+    for i in range(u.size):
+        gap = u[i] / s[i] - uw[i]
+        mismatch += gap * gap
+    F = natural_map(rw, uw, mu, d)
+    f_norm = 0.0
+    for i in range(u.size):
+        f_norm += F[i] * F[i]
+    friction_figures(rw, uw, qu, mu, d, (np.sqrt(f_norm), np.sqrt(mismatch)), figures)
+    for i in range(5):
+        if not figures[i] <= tol:  # NaN fails
+            return NOT_CERTIFIED
+    return CERTIFIED
 
 
 @kernel(interpretable=True)
@@ -79,18 +122,8 @@ def solve_tiny(W, q, mu, d, limits, r, u, figures):
     diagonal = np.empty(size)
     for i in range(size):
         diagonal[i] = W[i, i]
-    s = contact_units(diagonal, d)
-    scaled = False
-    for i in range(size):
-        scaled = scaled or s[i] != 1.0
-    top = 0  # the binary exponent of max|qᵢ/sᵢ| (0 when q = 0)
-    found = False
-    for i in range(size):
-        if q[i] != 0.0:
-            e = math.frexp(q[i])[1] - math.frexp(s[i])[1]
-            top = e if not found else max(top, e)
-            found = True
-    if not LOG2_RANGE[0] < top < LOG2_RANGE[1]:
+    s, scaled, posable = _units(diagonal, q, d)
+    if not posable:
         return 0, NEEDS_SCALING, True
     Wu = np.empty((size, size))
     qu = np.empty(size)
@@ -112,28 +145,144 @@ def solve_tiny(W, q, mu, d, limits, r, u, figures):
         for j in range(size):
             total += Wu[i, j] * ru[j]
         u[i] = total * s[i]
-    # its certificate, from r and u as given: r̂ = s∘r, û = W̃r̂ + q̂, ‖u/s − û‖
+    # its certificate, from r and u as given: r̂ = s∘r, û = W̃r̂ + q̂
     for i in range(size):
         ru[i] = r[i] * s[i]
     uw = np.empty(size)
-    mismatch = 0.0
     for i in range(size):
         total = qu[i]
         for j in range(size):
             total += Wu[i, j] * ru[j]
         uw[i] = total
-        gap = u[i] / s[i] - total
-        mismatch += gap * gap
-    f_norm = 0.0
-    F = natural_map(ru, uw, mu, d)
+    return its, _judged(ru, uw, u, s, qu, mu, d, limits.tol, figures), scaled
+
+
+@inline_kernel(interpretable=True)
+def _row_products(indptr, indices, data, x, q, out):
+    """out = A x + q for A given by its compressed rows."""
+    for i in range(q.size):
+        total = q[i]
+        for p in range(indptr[i], indptr[i + 1]):
+            total += data[p] * x[indices[p]]
+        out[i] = total
+
+
+@kernel(interpretable=True)
+def sweep_given(W, rows, q, mu, d, limits, out):
+    """The projected Gauss–Seidel's first sweeps on a problem of a few dozen contacts, posed
+    in its contacts' units and certified, in one call (docs/theory.md §15): the sweeps of
+    :func:`~impactqp.kernels.friction.nsgs_rows` from r = 0 on W̃'s nonzero entries, stopped
+    at ‖F‖/‖q̂‖ ≤ tol/2 or after ``sweeps``; their answer scaled back (r = r̂/s,
+    u = s∘(W̃r̂ + q̂)) and its certificate recomputed from r as given, as
+    :func:`solve_tiny` does.
+
+    Parameters
+    ----------
+    W, rows, q, mu, d, out
+        As for :func:`solve_given`.
+    limits : (tol, sweeps, local_iters)
+        The certificate's tolerance, the most sweeps, the most local steps per contact
+        and sweep.
+
+    Returns
+    -------
+    (sweeps, outcome, scaled), as :func:`solve_tiny`.
+    """
+    size = q.size
+    tol, sweeps, local_iters = limits
+    indptr, indices, data, by_columns = rows
+    diagonal = np.zeros(size)
+    if indptr.size == 0:  # dense: its nonzero entries by rows
+        for i in range(size):
+            diagonal[i] = W[i, i]
+        indptr, indices, data = nonzero_rows(W)
+    else:
+        for a in range(size):
+            for p in range(indptr[a], indptr[a + 1]):
+                if indices[p] == a:
+                    diagonal[a] += data[p]
+        if by_columns:  # the rows of W from its columns, a counting pass
+            count = np.zeros(size + 1, dtype=np.int32)
+            for p in range(indices.size):
+                count[indices[p] + 1] += 1
+            for i in range(size):
+                count[i + 1] += count[i]
+            at = count[:size].copy()
+            by_row = np.empty(indices.size, dtype=np.int32)
+            values = np.empty(indices.size)
+            for j in range(size):
+                for p in range(indptr[j], indptr[j + 1]):
+                    i = indices[p]
+                    by_row[at[i]] = j
+                    values[at[i]] = data[p]
+                    at[i] += 1
+            indptr, indices, data = count, by_row, values
+        else:
+            data = data.copy()
+    s, scaled, posable = _units(diagonal, q, d)
+    if not posable:
+        return 0, NEEDS_SCALING, True
+    for i in range(size):  # W̃ = DWD in place, D = diag(1/s)
+        for p in range(indptr[i], indptr[i + 1]):
+            data[p] = data[p] * (1.0 / s[i]) * (1.0 / s[indices[p]])
+            if not math.isfinite(data[p]):
+                return 0, NEEDS_SCALING, True
+    qu = np.empty(size)
     for i in range(size):
-        f_norm += F[i] * F[i]
-    friction_figures(ru, uw, qu, mu, d, (np.sqrt(f_norm), np.sqrt(mismatch)), figures)
-    for i in range(5):
-        if not figures[i] <= limits.tol:  # NaN fails
-            return its, NOT_CERTIFIED, scaled
-    return its, CERTIFIED, scaled
+        qu[i] = q[i] / s[i]
+    r, u, figures = out[:size], out[size:2 * size], out[2 * size:]
+    ru = np.zeros(size)
+    done, _ = nsgs_rows(indptr, indices, data, qu, mu, d, ru, 0.5 * tol, sweeps, local_iters)
+    uw = np.empty(size)
+    _row_products(indptr, indices, data, ru, qu, uw)
+    for i in range(size):  # the answer as given
+        r[i] = ru[i] / s[i]
+        u[i] = uw[i] * s[i]
+    for i in range(size):  # its certificate, from r and u as given
+        ru[i] = r[i] * s[i]
+    _row_products(indptr, indices, data, ru, qu, uw)
+    return done, _judged(ru, uw, u, s, qu, mu, d, tol, figures), scaled
+
+
+@kernel(interpretable=True)
+def solve_given(W, rows, q, mu, d, limits, out):
+    """:func:`solve_tiny` on W as the problem holds it, dense or compressed, in one call.
+
+    Parameters
+    ----------
+    W : (d·m, d·m) float array
+        W when it is dense; ignored (any 2-D float array) when ``rows`` hold it.
+    rows : (indptr, indices, data, by_columns)
+        W compressed as scipy keeps it (CSR rows, or CSC columns when ``by_columns``),
+        duplicates summed; empty arrays (``indptr`` of size 0) when W is dense.
+    q, mu, d
+        As for :func:`solve_tiny`.
+    limits : (tol, newton_steps, sweeps, local_iters)
+        The fields of :class:`TinyLimits` as a plain tuple: numba types a NamedTuple at each
+        call in about 2 µs, a plain tuple in a few hundred ns.
+    out : (2·d·m + 7,) float array
+        Receives r, u and the figures of the certificate, in that order.
+
+    Returns
+    -------
+    (iterations, outcome, scaled), as :func:`solve_tiny`.
+    """
+    size = q.size
+    indptr, indices, data, by_columns = rows
+    if indptr.size > 0:  # W compressed: the dense W of a few contacts, duplicates summed
+        dense = np.zeros((size, size))
+        for a in range(size):
+            for p in range(indptr[a], indptr[a + 1]):
+                if by_columns:
+                    dense[indices[p], a] += data[p]
+                else:
+                    dense[a, indices[p]] += data[p]
+    else:
+        dense = W
+    return solve_tiny(dense, q, mu, d,
+                      TinyLimits(limits[0], limits[1], limits[2], limits[3]),
+                      out[:size], out[size:2 * size], out[2 * size:])
 
 
 __all__ = ["CERTIFIED", "FRICTION_FIGURES", "LOG2_RANGE", "NEEDS_SCALING", "NOT_CERTIFIED",
-           "TinyLimits", "solve_tiny"]
+           "TinyLimits", "solve_given", "solve_tiny", "sweep_given"]
