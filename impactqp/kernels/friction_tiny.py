@@ -20,8 +20,7 @@ import numpy as np
 
 from .coulomb_certificate import FRICTION_FIGURES, friction_figures
 from .friction import natural_map, nsgs_rows
-from .friction_blocks import nonzero_rows
-from .friction_newton import scales, solve_small
+from .friction_newton import ROUND_OFF, scales, solve_small, sweep_budget
 from .jit import inline_kernel, kernel
 from .units import contact_units
 
@@ -167,122 +166,144 @@ def _row_products(indptr, indices, data, x, q, out):
         out[i] = total
 
 
-@kernel(interpretable=True)
-def sweep_given(W, rows, q, mu, d, limits, out):
-    """The projected Gauss–Seidel's first sweeps on a problem of a few dozen contacts, posed
-    in its contacts' units and certified, in one call (docs/theory.md §15): the sweeps of
-    :func:`~impactqp.kernels.friction.nsgs_rows` from r = 0 on W̃'s nonzero entries, stopped
-    at ‖F‖/‖q̂‖ ≤ tol/2 or after ``sweeps``; their answer scaled back (r = r̂/s,
-    u = s∘(W̃r̂ + q̂)) and its certificate recomputed from r as given, as
-    :func:`solve_tiny` does.
-
-    Parameters
-    ----------
-    W, rows, q, mu, d, out
-        As for :func:`solve_given`.
-    limits : (tol, sweeps, local_iters)
-        The certificate's tolerance, the most sweeps, the most local steps per contact
-        and sweep.
+@inline_kernel(interpretable=True)
+def _posed(W, rows, q, d):
+    """The problem in its contacts' units, W̃ = DWD by its nonzero compressed rows and
+    q̂ = Dq (D = diag(1/s), s of :func:`_units`), from W dense or compressed (as
+    :func:`solve_given` takes it): one pass over W's entries.
 
     Returns
     -------
-    (sweeps, outcome, scaled), as :func:`solve_tiny`.
+    (s, scaled, posed, indptr, indices, data, q̂)
+        ``posed`` False where q̂ needs the scale-first rule or an entry of W̃ is not finite
+        (the rest is then not to be used).
     """
     size = q.size
-    tol, sweeps, local_iters = limits
     indptr, indices, data, by_columns = rows
     diagonal = np.zeros(size)
-    if indptr.size == 0:  # dense: its nonzero entries by rows
+    dense = indptr.size == 0
+    if dense:
         for i in range(size):
             diagonal[i] = W[i, i]
-        indptr, indices, data = nonzero_rows(W)
     else:
         for a in range(size):
             for p in range(indptr[a], indptr[a + 1]):
                 if indices[p] == a:
                     diagonal[a] += data[p]
-        if by_columns:  # the rows of W from its columns, a counting pass
-            count = np.zeros(size + 1, dtype=np.int32)
-            for p in range(indices.size):
-                count[indices[p] + 1] += 1
-            for i in range(size):
-                count[i + 1] += count[i]
-            at = count[:size].copy()
-            by_row = np.empty(indices.size, dtype=np.int32)
-            values = np.empty(indices.size)
-            for j in range(size):
-                for p in range(indptr[j], indptr[j + 1]):
-                    i = indices[p]
-                    by_row[at[i]] = j
-                    values[at[i]] = data[p]
-                    at[i] += 1
-            indptr, indices, data = count, by_row, values
-        else:
-            data = data.copy()
-    s, scaled, posable = _units(diagonal, q, d)
-    if not posable:
-        return 0, NEEDS_SCALING, True
-    for i in range(size):  # W̃ = DWD in place, D = diag(1/s)
-        for p in range(indptr[i], indptr[i + 1]):
-            data[p] = data[p] * (1.0 / s[i]) * (1.0 / s[indices[p]])
-            if not math.isfinite(data[p]):
-                return 0, NEEDS_SCALING, True
+    s, scaled, posed = _units(diagonal, q, d)
     qu = np.empty(size)
     for i in range(size):
         qu[i] = q[i] / s[i]
-    r, u, figures = out[:size], out[size:2 * size], out[2 * size:]
-    ru = np.zeros(size)
-    done, _ = nsgs_rows(indptr, indices, data, qu, mu, d, ru, 0.5 * tol, sweeps, local_iters)
-    uw = np.empty(size)
-    _row_products(indptr, indices, data, ru, qu, uw)
-    for i in range(size):  # the answer as given
-        r[i] = ru[i] / s[i]
-        u[i] = uw[i] * s[i]
-    for i in range(size):  # its certificate, from r and u as given
-        ru[i] = r[i] * s[i]
-    _row_products(indptr, indices, data, ru, qu, uw)
-    return done, _judged(ru, uw, u, s, qu, mu, d, tol, figures), scaled
+    if dense:  # its nonzero entries by rows, room for all of them
+        starts = np.zeros(size + 1, dtype=np.int32)
+        columns = np.empty(size * size, dtype=np.int32)
+        values = np.empty(size * size)
+        p = 0
+        for i in range(size):
+            for j in range(size):
+                w = W[i, j]
+                if w != 0.0:
+                    columns[p] = j
+                    values[p] = w
+                    p += 1
+            starts[i + 1] = p
+    elif by_columns:  # the rows of W from its columns, a counting pass
+        starts = np.zeros(size + 1, dtype=np.int32)
+        for p in range(indices.size):
+            starts[indices[p] + 1] += 1
+        for i in range(size):
+            starts[i + 1] += starts[i]
+        at = starts[:size].copy()
+        columns = np.empty(indices.size, dtype=np.int32)
+        values = np.empty(indices.size)
+        for j in range(size):
+            for p in range(indptr[j], indptr[j + 1]):
+                i = indices[p]
+                columns[at[i]] = j
+                values[at[i]] = data[p]
+                at[i] += 1
+    else:
+        starts, columns, values = indptr.copy(), indices.copy(), data.copy()
+    for i in range(size):  # W̃ = DWD
+        for p in range(starts[i], starts[i + 1]):
+            values[p] = values[p] * (1.0 / s[i]) * (1.0 / s[columns[p]])
+            posed = posed and math.isfinite(values[p])
+    return s, scaled, posed, starts, columns, values, qu
 
 
 @kernel(interpretable=True)
 def solve_given(W, rows, q, mu, d, limits, out):
-    """:func:`solve_tiny` on W as the problem holds it, dense or compressed, in one call.
+    """Solve and certify a problem of a few contacts, W as the problem holds it (dense or
+    compressed), in one call (docs/theory.md §15): posed in its contacts' units by its
+    nonzero entries (:func:`_posed`), one sweep of the projected Gauss–Seidel from r = 0
+    (:func:`~impactqp.kernels.friction.nsgs_rows`) where the ``"kernel"`` method starts by
+    sweeping (:func:`~impactqp.kernels.friction_newton.sweep_budget`), kept where it ends
+    within :data:`~impactqp.kernels.friction_newton.ROUND_OFF` (the answer the method
+    returns then, without the dense W̃ or a Newton step); otherwise, with ``whole``, the
+    method whole by :func:`solve_tiny`. The answer is scaled back (r = r̂/s,
+    u = s∘(W̃r̂ + q̂)) and its certificate recomputed from r as given.
 
     Parameters
     ----------
     W : (d·m, d·m) float array
         W when it is dense; ignored (any 2-D float array) when ``rows`` hold it.
     rows : (indptr, indices, data, by_columns)
-        W compressed as scipy keeps it (CSR rows, or CSC columns when ``by_columns``),
-        duplicates summed; empty arrays (``indptr`` of size 0) when W is dense.
+        W compressed as scipy keeps it (CSR rows, or CSC columns when ``by_columns``; int32
+        indices), duplicates summed; empty arrays (``indptr`` of size 0) when W is dense.
     q, mu, d
         As for :func:`solve_tiny`.
-    limits : (tol, newton_steps, sweeps, local_iters)
-        The fields of :class:`TinyLimits` as a plain tuple: numba types a NamedTuple at each
-        call in about 2 µs, a plain tuple in a few hundred ns.
+    limits : (tol, newton_steps, sweeps, local_iters, whole)
+        The fields of :class:`TinyLimits` as a plain tuple (numba types a NamedTuple at
+        each call in about 2 µs, a plain tuple in a few hundred ns), and ``whole``: False to
+        end after the first sweep (then kept where it is within tol/2, the first sweep of
+        the ``"nsgs-short"`` method, with ``local_iters`` of that method).
     out : (2·d·m + 7,) float array
         Receives r, u and the figures of the certificate, in that order.
 
     Returns
     -------
-    (iterations, outcome, scaled), as :func:`solve_tiny`.
+    (iterations, outcome, scaled), as :func:`solve_tiny`; :data:`NOT_CERTIFIED` without
+    ``whole`` where the first sweep did not reach tol/2 (``out`` then unspecified).
     """
     size = q.size
-    indptr, indices, data, by_columns = rows
-    if indptr.size > 0:  # W compressed: the dense W of a few contacts, duplicates summed
+    tol, newton_steps, sweeps, local_iters, whole = limits
+    s, scaled, posed, indptr, indices, data, qu = _posed(W, rows, q, d)
+    if not posed:
+        return 0, NEEDS_SCALING, True
+    r, u, figures = out[:size], out[size:2 * size], out[2 * size:]
+    done = 0
+    if not whole or sweep_budget(size, mu.size, indices.size, sweeps, local_iters) >= 1.0:
+        ru = np.zeros(size)
+        done, err = nsgs_rows(indptr, indices, data, qu, mu, d, ru, 0.5 * tol, np.int64(1),
+                              local_iters)  # an int64, not a literal 1: one compiled sweep
+        if err <= (ROUND_OFF if whole else 0.5 * tol):
+            uw = np.empty(size)
+            _row_products(indptr, indices, data, ru, qu, uw)
+            for i in range(size):  # the answer as given
+                r[i] = ru[i] / s[i]
+                u[i] = uw[i] * s[i]
+            for i in range(size):  # its certificate, from r and u as given
+                ru[i] = r[i] * s[i]
+            _row_products(indptr, indices, data, ru, qu, uw)
+            return done, _judged(ru, uw, u, s, qu, mu, d, tol, figures), scaled
+        if not whole:
+            return done, NOT_CERTIFIED, scaled
+    given, positions, entries, by_columns = rows
+    if given.size == 0:  # W dense: solve_tiny poses it again
+        dense = W
+    else:  # W as given, dense, duplicates summed
         dense = np.zeros((size, size))
         for a in range(size):
-            for p in range(indptr[a], indptr[a + 1]):
+            for p in range(given[a], given[a + 1]):
                 if by_columns:
-                    dense[indices[p], a] += data[p]
+                    dense[positions[p], a] += entries[p]
                 else:
-                    dense[a, indices[p]] += data[p]
-    else:
-        dense = W
-    return solve_tiny(dense, q, mu, d,
-                      TinyLimits(limits[0], limits[1], limits[2], limits[3]),
-                      out[:size], out[size:2 * size], out[2 * size:])
+                    dense[a, positions[p]] += entries[p]
+    its, outcome, scaled = solve_tiny(dense, q, mu, d,
+                                      TinyLimits(tol, newton_steps, sweeps, local_iters),
+                                      r, u, figures)
+    return done + its, outcome, scaled
 
 
 __all__ = ["CERTIFIED", "FRICTION_FIGURES", "LOG2_RANGE", "NEEDS_SCALING", "NOT_CERTIFIED",
-           "TinyLimits", "solve_given", "solve_tiny", "sweep_given"]
+           "TinyLimits", "solve_given", "solve_tiny"]
