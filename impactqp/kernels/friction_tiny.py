@@ -20,13 +20,22 @@ import numpy as np
 
 from .coulomb_certificate import FRICTION_FIGURES, friction_figures
 from .friction import natural_map, nsgs_rows
-from .friction_newton import ROUND_OFF, scales, solve_small, sweep_budget
+from .friction_newton import ROUND_OFF, scales, solve_small
 from .jit import inline_kernel, kernel
 from .units import contact_units
 
 CERTIFIED, NOT_CERTIFIED, NEEDS_SCALING = 0, 1, 2
 """The outcomes of :func:`solve_tiny`."""
 
+FIRST_SWEEPS = 12
+"""Most sweeps :func:`solve_given` tries before the ``"kernel"`` method whole: while their
+rate says they reach :data:`~impactqp.kernels.friction_newton.ROUND_OFF` within this many
+(a sweep of a few contacts costs less than a microsecond, the dense Newton steps the method
+takes a few microseconds: CubeH8 and FC3D-1c, one contact, reach round-off in 5–7 sweeps)."""
+SWEEP_GATE = 1e-6
+"""‖F‖/‖q̂‖ the first sweep must reach for :func:`solve_given` to sweep on (on the FCLib
+problems of a few contacts the first sweep ends at 2e-10…2e-7 where the sweeps reach
+round-off within :data:`FIRST_SWEEPS`, at 1e-2…2e-1 where they take hundreds)."""
 LOG2_RANGE = (-333, 333)
 """The binary exponents (``math.frexp``) of max|q̂ᵢ|, strictly between these two, for which
 q̂ is posed as it is: those of :data:`impactqp.model.friction.QUANTITY_RANGE`, 1e-100…1e100
@@ -236,11 +245,12 @@ def solve_given(W, rows, q, mu, d, limits, out):
     """Solve and certify a problem of a few contacts, W as the problem holds it (dense or
     compressed), in one call (docs/theory.md §15): posed in its contacts' units by its
     nonzero entries (:func:`_posed`), one sweep of the projected Gauss–Seidel from r = 0
-    (:func:`~impactqp.kernels.friction.nsgs_rows`) where the ``"kernel"`` method starts by
-    sweeping (:func:`~impactqp.kernels.friction_newton.sweep_budget`), kept where it ends
-    within :data:`~impactqp.kernels.friction_newton.ROUND_OFF` (the answer the method
-    returns then, without the dense W̃ or a Newton step); otherwise, with ``whole``, the
-    method whole by :func:`solve_tiny`. The answer is scaled back (r = r̂/s,
+    (:func:`~impactqp.kernels.friction.nsgs_rows`) and, where it ends within
+    :data:`SWEEP_GATE`, more while their rate says they reach
+    :data:`~impactqp.kernels.friction_newton.ROUND_OFF` within :data:`FIRST_SWEEPS`; their
+    answer is kept where it is within round-off (as the ``"kernel"`` method answers, without
+    the dense W̃ or a Newton step); otherwise, with ``whole``, the method whole by
+    :func:`solve_tiny`. The answer is scaled back (r = r̂/s,
     u = s∘(W̃r̂ + q̂)) and its certificate recomputed from r as given.
 
     Parameters
@@ -271,23 +281,32 @@ def solve_given(W, rows, q, mu, d, limits, out):
     if not posed:
         return 0, NEEDS_SCALING, True
     r, u, figures = out[:size], out[size:2 * size], out[2 * size:]
-    done = 0
-    if not whole or sweep_budget(size, mu.size, indices.size, sweeps, local_iters) >= 1.0:
-        ru = np.zeros(size)
-        done, err = nsgs_rows(indptr, indices, data, qu, mu, d, ru, 0.5 * tol, np.int64(1),
-                              local_iters)  # an int64, not a literal 1: one compiled sweep
-        if err <= (ROUND_OFF if whole else 0.5 * tol):
-            uw = np.empty(size)
-            _row_products(indptr, indices, data, ru, qu, uw)
-            for i in range(size):  # the answer as given
-                r[i] = ru[i] / s[i]
-                u[i] = uw[i] * s[i]
-            for i in range(size):  # its certificate, from r and u as given
-                ru[i] = r[i] * s[i]
-            _row_products(indptr, indices, data, ru, qu, uw)
-            return done, _judged(ru, uw, u, s, qu, mu, d, tol, figures), scaled
-        if not whole:
-            return done, NOT_CERTIFIED, scaled
+    target = ROUND_OFF if whole else 0.5 * tol
+    ru = np.zeros(size)
+    ask = np.int64(1)  # an int64, not a literal 1: one compiled sweep
+    done, err = nsgs_rows(indptr, indices, data, qu, mu, d, ru, target, ask, local_iters)
+    last, last_done = np.inf, 0
+    while whole and target < err < min(last, SWEEP_GATE) and done < FIRST_SWEEPS:
+        if last < np.inf:  # the sweeps left to round-off at the rate of the last ones
+            left = np.log(target / err) / np.log(err / last) * (done - last_done)
+            if done + left > FIRST_SWEEPS:
+                break
+            ask = min(int(left) + 1, FIRST_SWEEPS - done)
+        more, new = nsgs_rows(indptr, indices, data, qu, mu, d, ru, target, ask, local_iters)
+        last, last_done, err = err, done, new
+        done += more
+    if err <= target:
+        uw = np.empty(size)
+        _row_products(indptr, indices, data, ru, qu, uw)
+        for i in range(size):  # the answer as given
+            r[i] = ru[i] / s[i]
+            u[i] = uw[i] * s[i]
+        for i in range(size):  # its certificate, from r and u as given
+            ru[i] = r[i] * s[i]
+        _row_products(indptr, indices, data, ru, qu, uw)
+        return done, _judged(ru, uw, u, s, qu, mu, d, tol, figures), scaled
+    if not whole:
+        return done, NOT_CERTIFIED, scaled
     given, positions, entries, by_columns = rows
     if given.size == 0:  # W dense: solve_tiny poses it again
         dense = W

@@ -41,11 +41,11 @@ time on the FCLib problems of 52 to 60 contacts (65 µs of 2.4 ms on Confeti-ex0
 
 
 class SmallFrictionResult(FrictionResult):
-    """A :class:`~impactqp.FrictionResult` of :func:`solve_few`: the same attributes, those
+    """A :class:`~impactqp.friction.FrictionResult` of :func:`solve_few`: the same attributes, those
     the verdict does not need read from the compiled call's array when first asked for.
 
     ``ok`` (hence ``success`` and ``status``) is the compiled call's verdict on the figures
-    it computed; ``certificate`` is the :class:`~impactqp.FrictionCertificate` of the same
+    it computed; ``certificate`` is the :class:`~impactqp.friction.FrictionCertificate` of the same
     figures, whose ``ok`` is that verdict (the same comparisons, NaN failing both).
     """
 
