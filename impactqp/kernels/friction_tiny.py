@@ -32,10 +32,12 @@ FIRST_SWEEPS = 12
 rate says they reach :data:`~impactqp.kernels.friction_newton.ROUND_OFF` within this many
 (a sweep of a few contacts costs less than a microsecond, the dense Newton steps the method
 takes a few microseconds: CubeH8 and FC3D-1c, one contact, reach round-off in 5–7 sweeps)."""
-SWEEP_GATE = 1e-6
-"""‖F‖/‖q̂‖ the first sweep must reach for :func:`solve_given` to sweep on (on the FCLib
-problems of a few contacts the first sweep ends at 2e-10…2e-7 where the sweeps reach
-round-off within :data:`FIRST_SWEEPS`, at 1e-2…2e-1 where they take hundreds)."""
+SWEEP_GATE = 1e-7
+"""‖F‖/‖q̂‖ the first sweep must reach for :func:`solve_given` to sweep on. Measured on the
+FCLib problems of a few contacts: the first sweep ends at 2e-10…2e-8 on those whose sweeps
+reach round-off within :data:`FIRST_SWEEPS` (CubeH8, FC3D-1c, FC3D-Example1,
+Confeti-ex13-4c: 4–7 sweeps), at 2e-7 on TwoRods1-condensed (19 sweeps, where sweeping on
+cost 4 µs before the method whole), at 1e-2…2e-1 on the rest (hundreds)."""
 LOG2_RANGE = (-333, 333)
 """The binary exponents (``math.frexp``) of max|q̂ᵢ|, strictly between these two, for which
 q̂ is posed as it is: those of :data:`impactqp.model.friction.QUANTITY_RANGE`, 1e-100…1e100
