@@ -252,8 +252,9 @@ def solve_given(W, rows, q, mu, d, limits, out):
     :data:`~impactqp.kernels.friction_newton.ROUND_OFF` within :data:`FIRST_SWEEPS`; their
     answer is kept where it is within round-off (as the ``"kernel"`` method answers, without
     the dense W̃ or a Newton step); otherwise, with ``whole``, the method whole by
-    :func:`solve_tiny`. The answer is scaled back (r = r̂/s,
-    u = s∘(W̃r̂ + q̂)) and its certificate recomputed from r as given.
+    :func:`solve_tiny`. The answer is scaled back (r = r̂/s) and certified from r as given
+    (r̂ = s∘r, û = W̃r̂ + q̂ recomputed, the velocity given u = s∘û: W r + q, the product
+    the sweeps' own ‖F‖ did not share).
 
     Parameters
     ----------
@@ -298,14 +299,13 @@ def solve_given(W, rows, q, mu, d, limits, out):
         last, last_done, err = err, done, new
         done += more
     if err <= target:
-        uw = np.empty(size)
-        _row_products(indptr, indices, data, ru, qu, uw)
-        for i in range(size):  # the answer as given
+        for i in range(size):  # the answer as given, r = r̂/s, and r̂ = s∘r from it
             r[i] = ru[i] / s[i]
-            u[i] = uw[i] * s[i]
-        for i in range(size):  # its certificate, from r and u as given
             ru[i] = r[i] * s[i]
+        uw = np.empty(size)  # û = W̃r̂ + q̂ of the certificate; u = s∘û (W r + q as given)
         _row_products(indptr, indices, data, ru, qu, uw)
+        for i in range(size):
+            u[i] = uw[i] * s[i]
         return done, _judged(ru, uw, u, s, qu, mu, d, tol, figures), scaled
     if not whole:
         return done, NOT_CERTIFIED, scaled
