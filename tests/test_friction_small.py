@@ -166,3 +166,22 @@ def test_the_first_sweep_alone_is_not_certified_where_it_does_not_reach_tol() ->
                                 (TOL, 50, 100, 10, True), out)
     assert outcome == CERTIFIED
     assert certify_friction(problem, out[:n], out[n:2 * n], tol=TOL).ok
+
+
+def test_the_benchmark_table_judges_each_target() -> None:
+    """benchmarks/friction_tiny.py: ≤ NSGS + 10 µs below five contacts, ≤ 1× from five on."""
+    from benchmarks.friction_tiny import meets, summary
+
+    assert meets(1, 11e-6, 2e-6) and not meets(1, 12.5e-6, 2e-6)
+    assert meets(4, 11e-6, 1.5e-6) and not meets(5, 11e-6, 1.5e-6)
+    assert meets(9, 15e-6, 16e-6) and not meets(9, 17e-6, 16e-6)
+    rows = [{"problem": name, "contacts": m, "d": 3, "iq_us": ours, "nsgs_us": theirs,
+             "ratio": ours / theirs, "minus_us": ours - theirs, "target": "t",
+             "met": meets(m, ours * 1e-6, theirs * 1e-6), "backend": "kernel",
+             "iq_error": 1e-16, "nsgs_status": "ok"}
+            for name, m, ours, theirs in [("a", 1, 11.0, 2.0), ("b", 1, 13.0, 2.0),
+                                          ("c", 9, 15.0, 16.0), ("d", 9, 17.0, 16.0)]]
+    text = summary(rows, 3)
+    assert "Targets met on 2 of 4 problems." in text
+    assert "| a | 1 | 3 | 11.0 µs (1e-16) | 2.0 µs (ok) | +9.0 µs | 5.50 |" in text
+    assert "| b | 1 | 3 | 13.0 µs (1e-16) | 2.0 µs (ok) | +11.0 µs | 6.50 | t | no |" in text
