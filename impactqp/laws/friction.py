@@ -21,19 +21,16 @@ import numpy as np
 
 from ..base.arrays import check_tol
 from ..errors import CertificateError, InputError, OutOfRangeError
-from ..kernels.friction_tiny import CERTIFIED, FRICTION_FIGURES, TinyLimits, solve_tiny
 from ..model.friction import (
     ContactUnits,
     FrictionCertificate,
     FrictionContactProblem,
     certify_friction,
-    friction_certificate,
 )
 from ..qp import backends
 from ..qp.certified import Outcome, solve_certified
-from ..qp.friction import FrictionSolution, methods
-from ..qp.friction.methods import NSGS_SHORT, SMALL_LOCAL
-from ..qp.friction.newton import NEWTON_STEPS
+from ..qp.friction import FrictionSolution
+from .friction_small import solve_few
 from .planner import plan_friction
 from .result import FrictionResult
 
@@ -89,9 +86,9 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
     tol = check_tol(tol)
     start = time.perf_counter()
     if backend in ("auto", "kernel"):
-        tiny = _tiny(problem, tol, start)
-        if tiny is not None:
-            return tiny
+        few = solve_few(problem, tol, start, sweeps=backend == "auto")
+        if few is not None:
+            return few
     # units and the registry's plan, in one Route
     route = plan_friction(problem, backend, lambda units: _finisher(problem, units, tol))
     note = () if route.units is None else (f"solved in its contacts' units (2^{route.units.k})",)
@@ -105,28 +102,6 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
                                "the exception's .best)", best=best,
                                attempts=exc.attempts) from None
     return _result(out, time.perf_counter() - start, note)
-
-
-def _tiny(problem: FrictionContactProblem, tol: float, start: float) -> FrictionResult | None:
-    """The ``"kernel"`` method's answer by the route of a few dense contacts in one compiled
-    call (:func:`impactqp.kernels.friction_tiny.solve_tiny`: units, solve, answer as given
-    and its certificate), or None where that route does not apply or its answer fails: the
-    general route then runs (and tries the method again among the others)."""
-    if problem.n_contacts > methods.SMALL_CONTACTS:  # the "kernel" method's own limit
-        return None
-    size = problem.q.size
-    r, u, figures = np.empty(size), np.empty(size), np.empty(len(FRICTION_FIGURES))
-    W = np.ascontiguousarray(problem.dense_W(), dtype=float)  # a sparse W of a few contacts too
-    its, outcome, scaled = solve_tiny(W, problem.q, problem.mu,
-                                      problem.contact_dim,
-                                      TinyLimits(tol, NEWTON_STEPS, NSGS_SHORT, SMALL_LOCAL),
-                                      r, u, figures)
-    if outcome != CERTIFIED:
-        return None
-    cert = friction_certificate(figures, tol)
-    note = ["solved in its contacts' units (2^0)"] if scaled else []
-    return FrictionResult(r, u, cert.error, cert, int(its), time.perf_counter() - start,
-                          "kernel", [*note, "kernel (friction): certified"])
 
 
 def _finisher(problem: FrictionContactProblem, units: ContactUnits | None,
