@@ -151,8 +151,11 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
                     law.eps if moreau else 0.0, moreau)
     elif fast is not None:
         module = backends.load(backends.REGISTRY[fast[0]])
-    if fast in ("chain", "compiled"):
-        names = RESIDUALS if fast == "chain" or compiled[3] else RESIDUALS[:4]
+    if fast == "chain":  # the residual columns are written where the batch keeps them
+        columns = np.empty((len(RESIDUALS), k))
+        res.update(zip(RESIDUALS, columns))
+    elif fast == "compiled":
+        names = RESIDUALS if compiled[3] else RESIDUALS[:4]
         res.update({key: np.empty(k) for key in names})
 
     def work(a: int, b: int) -> np.ndarray:
@@ -164,9 +167,7 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
                 Up[a:b, j] = col
             for i, col in enumerate(lam):
                 Lam[a:b, i] = col
-            table = rows.residuals(Ua, Up[a:b], Lam[a:b])
-            for i, key in enumerate(RESIDUALS):
-                res[key][a:b] = table[:, i]
+            rows.residuals(Ua, Up[a:b], Lam[a:b], columns[:, a:b])
         elif fast == "compiled":  # each chunk warm-starts from its own cold support
             packed, E, eps, moreau = compiled
             Up[a:b], Lam[a:b], table, done = solve_impact_rows(
