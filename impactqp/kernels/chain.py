@@ -152,8 +152,9 @@ def solve_chain(packed, um, left, right, eps, tol, out, starts, weight):
         Receives u⁺ (N), the impulses L_j left of each ball j (N + 1: Λ is
         ``L[0 if left else 1:][:m]``) and the residuals (order of
         :data:`impactqp.kernels.residuals.RESIDUALS`).
-    starts, weight : int (N + 1,) and float (N,) arrays
-        Scratch of :func:`project`.
+    starts, weight : int and float arrays
+        Scratch of :func:`project` (N + 1 and N entries), or shorter ones (empty) to have the
+        call allocate its own (a short chain: fewer arguments to pass than bytes to allocate).
 
     Returns
     -------
@@ -168,6 +169,9 @@ def solve_chain(packed, um, left, right, eps, tol, out, starts, weight):
     masses = packed[:n]
     up = out[:n]
     L = out[n:2 * n + 1]
+    if weight.size < n:
+        starts = np.empty(n + 1, dtype=np.int64)
+        weight = np.empty(n)
     project(masses, um, left, right, up, L, starts, weight)
     if eps != 0.0:
         for j in range(n):  # u⁺ = z − ε(u⁻ − z)

@@ -195,26 +195,27 @@ class CompiledImpactResult(ImpactResult):
 
     The compiled call has already recomputed every residual of the certificate and checked
     it against the tolerance (a result is only formed when it passed); what is left is
-    bookkeeping, done lazily: u⁺, Λ and the residuals are views of ``out`` (u⁺ its first n
-    entries, Λ the m from ``impulses_at``, the residuals from ``residuals_at``), the
+    bookkeeping, done lazily: u⁺, Λ and the residuals are views of ``out`` (``at`` says
+    where: n, where Λ starts and ends, where the residuals start; u⁺ is ``out[:n]``), the
     :class:`Certificate` is built from those residuals on first read, z by the law's
     projection. The attributes are those of :class:`ImpactResult`.
     """
 
-    def __init__(self, problem: ImpactProblem, impact_law: Any, out: np.ndarray, n: int,
-                 m: int, impulses_at: int, residuals_at: int, names: tuple[str, ...],
-                 tol: float, backend: str, form: str, solve_time: float) -> None:
+    _certificate = None
+    _z = None
+
+    def __init__(self, problem: ImpactProblem, impact_law: Any, out: np.ndarray,
+                 at: tuple[int, int, int, int], names: tuple[str, ...], tol: float,
+                 backend: str, form: str, solve_time: float) -> None:
         self.problem = problem
         self.impact_law = impact_law
         self.solve_time = solve_time
         self.backend = backend
         self.form = form
         self._out = out
-        self._at = (n, impulses_at, impulses_at + m, residuals_at)
+        self._at = at
         self._names = names
         self._tol = tol
-        self._certificate = None
-        self._z = None
 
     @property
     def law(self) -> str:  # type: ignore[override]

@@ -96,15 +96,13 @@ def first_try(problem: Any, law: Any, tol: Any) -> ImpactResult | None:
     start = time.perf_counter()
     if type(problem) is not ImpactProblem or ImpactLaw not in type(law).__mro__:
         return None
-    if type(tol) is not float or not 0.0 < tol < 1.0 or law.family not in FAMILIES:
+    if type(tol) is not float or not 0.0 < tol < 1.0:
         return None
     st = problem.structure
-    if st.contact_dim != 1 or st.m > st.n:
+    if st.m > st.n or not applies(problem, law, "auto", "auto") or st.contact_dim != 1:
         return None
     scale = problem.peak_minus
-    if scale > 0 and law.homogeneous and not UNIT_RANGE[0] <= scale <= UNIT_RANGE[1]:
-        return None
-    if not applies(problem, law, "auto", "auto"):
+    if law.homogeneous and scale > 0 and not UNIT_RANGE[0] <= scale <= UNIT_RANGE[1]:
         return None
     law.check(problem)
     return solve_small(problem, law, tol, start)
@@ -124,9 +122,16 @@ def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float, start: float
     if not solve_impact(st.kernel_pack, problem.u_minus, restitution_for(law, m), eps, moreau,
                         tol, st.warm_support, out):
         return None
-    return CompiledImpactResult(problem, law, out, n, m, n, n + m,
+    return CompiledImpactResult(problem, law, out, (n, n, n + m, n + m),
                                 RESIDUALS if moreau else RESIDUALS[:4], tol, "kernel",
                                 "impulse", time.perf_counter() - start)
+
+
+SCRATCH_FROM = 256
+"""Balls from which the chain's call reuses the thread's kept scratch (shorter chains have the
+call allocate its own)."""
+
+_NO_INTS, _NO_FLOATS = np.empty(0, dtype=np.int64), np.empty(0)
 
 
 def _solve_chain(problem: ImpactProblem, law: ImpactLaw, tol: float,
@@ -136,10 +141,11 @@ def _solve_chain(problem: ImpactProblem, law: ImpactLaw, tol: float,
     n = st.n
     chain = st.chain
     out = np.empty(2 * n + 1 + len(RESIDUALS))
-    starts, weight = _scratch(n)
+    starts, weight = _scratch(n) if n >= SCRATCH_FROM else (_NO_INTS, _NO_FLOATS)
     if not solve_chain(st.chain_pack, problem.u_minus, chain.left_wall, chain.right_wall,
                        law.eps, tol, out, starts, weight):
         return None
-    return CompiledImpactResult(problem, law, out, n, st.m, n + (0 if chain.left_wall else 1),
-                                2 * n + 1, RESIDUALS, tol, "isotonic", "velocity",
+    first = n if chain.left_wall else n + 1  # Λ: L from the left wall's (or the first gap's)
+    return CompiledImpactResult(problem, law, out, (n, first, first + st.m, 2 * n + 1),
+                                RESIDUALS, tol, "isotonic", "velocity",
                                 time.perf_counter() - start)
