@@ -58,7 +58,9 @@ def test_compiled_path_at_every_velocity_scale(scale) -> None:
     np.testing.assert_allclose(dense.u_plus, r.u_plus, rtol=1e-12)
     assert not small.applies(p, iq.SectorLaw(), "auto", "auto")
     assert not small.applies(p, iq.Moreau(1.0), "clarabel", "auto")
-    assert not small.applies(p, iq.Moreau(1.0), "auto", "velocity")
+    assert small.applies(p, iq.Moreau(1.0), "auto", "velocity")  # the chain's call
+    assert not small.applies(p, iq.Newton(0.5), "auto", "velocity")
+    assert not small.applies(p, iq.Moreau(1.0), "nnls", "auto")
 
 
 def test_a_corrupted_compiled_solve_is_not_returned() -> None:

@@ -150,7 +150,7 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         return _collapsed(problem, law, planned.groups, backend, form, tol, start, options)
     way = planned.path
     if way == "compiled":
-        result = small.solve_small(problem, law, tol, start, backend=backend, form=form)
+        result = small.solve_small(problem, law, tol, start, backend, form)
         if result is not None:
             return result
         LOG.info("%s: the compiled path declined (certificate not met), trying the general "

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..base.checks import UNIT_RANGE
-from ..kernels.chain import solve_chain
+from ..kernels.chain import pack_chain, solve_chain
 from ..kernels.impact import solve_impact
 from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
@@ -63,10 +63,11 @@ def restitution_for(law: ImpactLaw, m: int) -> np.ndarray:
 
 def on_chain(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str) -> bool:
     """Whether the chain's compiled call answers: Moreau's family (``law.family``) on a chain
-    with at least one contact, asked with ``backend="auto"`` and ``form="auto"``."""
+    with at least one contact, asked with backend ``"auto"`` or ``"isotonic"`` (the call's
+    answer is that backend's) and form ``"auto"`` or ``"velocity"``."""
     st = problem.structure
-    return (backend == "auto" and form == "auto" and st.chain is not None and st.m > 0
-            and law.family == MOREAU_FAMILY)
+    return (backend in ("auto", "isotonic") and form in ("auto", "velocity")
+            and st.chain is not None and st.m > 0 and law.family == MOREAU_FAMILY)
 
 
 def applies(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str) -> bool:
@@ -108,7 +109,7 @@ def first_try(problem: Any, law: Any, tol: Any) -> ImpactResult | None:
     return solve_small(problem, law, tol, start)
 
 
-def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float, start: float, *,
+def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float, start: float,
                 backend: str = "auto", form: str = "auto") -> ImpactResult | None:
     """The certified result by the compiled path (the chain's call where :func:`on_chain`,
     else the dense one), or None to go on to the general path."""
@@ -142,8 +143,11 @@ def _solve_chain(problem: ImpactProblem, law: ImpactLaw, tol: float,
     chain = st.chain
     out = np.empty(2 * n + 1 + len(RESIDUALS))
     starts, weight = _scratch(n) if n >= SCRATCH_FROM else (_NO_INTS, _NO_FLOATS)
-    if not solve_chain(st.chain_pack, problem.u_minus, chain.left_wall, chain.right_wall,
-                       law.eps, tol, out, starts, weight):
+    packed = getattr(st, "chain_pack", None)  # kept by a ChainStructure
+    if packed is None:  # a structure marked as a chain by its builder
+        packed = pack_chain(chain.masses, st.inverse_masses, st.contact_scale)
+    if not solve_chain(packed, problem.u_minus, chain.left_wall, chain.right_wall, law.eps,
+                       tol, out, starts, weight):
         return None
     first = n if chain.left_wall else n + 1  # Λ: L from the left wall's (or the first gap's)
     return CompiledImpactResult(problem, law, out, (n, first, first + st.m, 2 * n + 1),
