@@ -176,3 +176,22 @@ def test_the_rest_shortcut_answers_only_when_certified() -> None:
     assert step.certificate.ok
     np.testing.assert_allclose(step.u_plus, [-0.5, 0.5])  # γ⁺ = −e·γ_prev = 1
     np.testing.assert_allclose(step.impulses, [0.5])
+
+
+@pytest.mark.parametrize("n", [8, 40])
+def test_batches_of_chains_keep_their_paths(n, monkeypatch) -> None:
+    """The chain's call serves single impacts: a batch of a chain beyond the dense call's
+    reach does not run the dense call row by row, and every row equals the single impact's
+    answer."""
+    import impactqp.laws.batch as batch
+
+    p = iq.newtons_cradle(n)
+    if not small.dense(p, iq.Moreau(0.3), "auto", "auto"):
+        def refuse(*args):
+            raise AssertionError("the dense compiled call ran on a chain beyond its reach")
+        monkeypatch.setattr(batch, "solve_impact_rows", refuse)
+    U = np.random.default_rng(n).standard_normal((20, n))
+    b = iq.moreau_batch(p, U, 0.3)
+    assert b.ok.all() and b.resolved == 0
+    single = np.array([iq.moreau(p.with_u_minus(u), 0.3).u_plus for u in U])
+    np.testing.assert_allclose(b.u_plus, single, rtol=1e-12, atol=1e-12)

@@ -235,9 +235,9 @@ def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: s
     way = plan(problem, law, backend, mode="batch").path
     if way == "chain":
         fast, used = "chain", "isotonic"
-    elif way == "compiled":
+    elif way == "compiled" and small.dense(problem, law, backend, "auto"):  # row by row
         fast, used = "compiled", "kernel"
-    elif way == "programs":
+    elif way in ("compiled", "programs"):  # (the chain's call serves single impacts only)
         fast = _fast_path(problem, law, backend)
         used = backend if fast is None else fast[0]
     else:

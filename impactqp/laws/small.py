@@ -70,15 +70,22 @@ def on_chain(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str) ->
             and st.chain is not None and st.m > 0 and law.family == MOREAU_FAMILY)
 
 
-def applies(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str) -> bool:
-    """Whether the compiled path may answer (it may still decline after trying)."""
+def dense(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str) -> bool:
+    """Whether the dense compiled call may answer: a dense structure within
+    :data:`MAX_CONTACTS` (:data:`SHORT_CHAIN` for a chain) and :data:`MAX_DOF`, a law of a
+    compiled family, backend ``"auto"`` or ``"kernel"``, form ``"auto"`` or ``"impulse"``
+    (a batch runs it row by row)."""
     st = problem.structure
-    if on_chain(problem, law, backend, form):
-        return True
     return (backend in ("auto", "kernel") and form in ("auto", "impulse") and not st.sparse
             and 0 < st.m <= (MAX_CONTACTS if st.chain is None else SHORT_CHAIN)
             and st.n <= MAX_DOF
             and law.family in FAMILIES)
+
+
+def applies(problem: ImpactProblem, law: ImpactLaw, backend: str, form: str) -> bool:
+    """Whether the compiled path may answer one impact, by the chain's call or the dense one
+    (it may still decline after trying)."""
+    return on_chain(problem, law, backend, form) or dense(problem, law, backend, form)
 
 
 def first_try(problem: Any, law: Any, tol: Any) -> ImpactResult | None:
