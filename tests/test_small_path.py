@@ -105,7 +105,7 @@ def test_a_corrupted_chain_call_is_not_returned() -> None:
 
 
 @pytest.mark.parametrize("walls", [(False, False), (True, False), (False, True), (True, True)])
-@pytest.mark.parametrize("n", [1, 2, 3, 7, 40])
+@pytest.mark.parametrize("n", [1, 2, 3, 7, 40, 300])
 def test_the_chain_call_is_the_isotonic_backend(walls, n) -> None:
     """The chain's compiled call gives the isotonic backend's numbers digit for digit (the same
     regression, recovery and certificate), on every wall layout, with and without restitution."""

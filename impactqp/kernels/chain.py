@@ -152,9 +152,8 @@ def solve_chain(packed, um, left, right, eps, tol, out, starts, weight):
         Receives u⁺ (N), the impulses L_j left of each ball j (N + 1: Λ is
         ``L[0 if left else 1:][:m]``) and the residuals (order of
         :data:`impactqp.kernels.residuals.RESIDUALS`).
-    starts, weight : int and float arrays
-        Scratch of :func:`project` (N + 1 and N entries), or shorter ones (empty) to have the
-        call allocate its own (a short chain: fewer arguments to pass than bytes to allocate).
+    starts, weight : int (N + 1,) and float (N,) arrays
+        Scratch of :func:`project` (a long chain's caller keeps them between solves).
 
     Returns
     -------
@@ -164,14 +163,26 @@ def solve_chain(packed, um, left, right, eps, tol, out, starts, weight):
     u⁺ = z − εz⊥ and Λ = (1 + ε)Λ_z as the velocity program's recovery forms them; the
     certificate then reads u⁺ and Λ back from memory in a pass of its own.
     """
+    return _solve_chain_into(packed, um, left, right, eps, tol, out, starts, weight)
+
+
+@kernel(interpretable=True)
+def solve_short_chain(packed, um, left, right, eps, tol, out):
+    """:func:`solve_chain` with its scratch allocated by the call: for short chains, whose
+    scratch costs less to allocate than to pass (each array argument adds to the call)."""
+    n = um.size
+    return _solve_chain_into(packed, um, left, right, eps, tol, out,
+                             np.empty(n + 1, dtype=np.int64), np.empty(n))
+
+
+@inline_kernel
+def _solve_chain_into(packed, um, left, right, eps, tol, out, starts, weight):
+    """The body of :func:`solve_chain`."""
     n = um.size
     m = packed.size - 2 * n
     masses = packed[:n]
     up = out[:n]
     L = out[n:2 * n + 1]
-    if weight.size < n:
-        starts = np.empty(n + 1, dtype=np.int64)
-        weight = np.empty(n)
     project(masses, um, left, right, up, L, starts, weight)
     if eps != 0.0:
         for j in range(n):  # u⁺ = z − ε(u⁻ − z)

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..base.checks import UNIT_RANGE
-from ..kernels.chain import pack_chain, solve_chain
+from ..kernels.chain import pack_chain, solve_chain, solve_short_chain
 from ..kernels.impact import solve_impact
 from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
@@ -137,9 +137,7 @@ def solve_small(problem: ImpactProblem, law: ImpactLaw, tol: float, start: float
 
 SCRATCH_FROM = 256
 """Balls from which the chain's call reuses the thread's kept scratch (shorter chains have the
-call allocate its own)."""
-
-_NO_INTS, _NO_FLOATS = np.empty(0, dtype=np.int64), np.empty(0)
+call allocate its own: :func:`impactqp.kernels.chain.solve_short_chain`)."""
 
 
 def _solve_chain(problem: ImpactProblem, law: ImpactLaw, tol: float,
@@ -149,12 +147,16 @@ def _solve_chain(problem: ImpactProblem, law: ImpactLaw, tol: float,
     n = st.n
     chain = st.chain
     out = np.empty(2 * n + 1 + len(RESIDUALS))
-    starts, weight = _scratch(n) if n >= SCRATCH_FROM else (_NO_INTS, _NO_FLOATS)
     packed = getattr(st, "chain_pack", None)  # kept by a ChainStructure
     if packed is None:  # a structure marked as a chain by its builder
         packed = pack_chain(chain.masses, st.inverse_masses, st.contact_scale)
-    if not solve_chain(packed, problem.u_minus, chain.left_wall, chain.right_wall, law.eps,
-                       tol, out, starts, weight):
+    if n < SCRATCH_FROM:
+        done = solve_short_chain(packed, problem.u_minus, chain.left_wall, chain.right_wall,
+                                 law.eps, tol, out)
+    else:
+        done = solve_chain(packed, problem.u_minus, chain.left_wall, chain.right_wall,
+                           law.eps, tol, out, *_scratch(n))
+    if not done:
         return None
     first = n if chain.left_wall else n + 1  # Λ: L from the left wall's (or the first gap's)
     return CompiledImpactResult(problem, law, out, (n, first, first + st.m, 2 * n + 1),
