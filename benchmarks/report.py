@@ -257,11 +257,12 @@ def why_missed(key: str, rows: list[dict]) -> str:
 
 
 WHY_3_BALL = (
-        "one impact through iq.solve costs 5–7 µs: validation and routing "
-        "~0.5 µs, the compiled call that solves and certifies ~2 µs (about half of it numba's "
-        "dispatch of five arrays), the result object with its lazily built certificate "
-        "~1.5 µs; Siconos' Lemke is one call into C returning bare arrays (~2.4 µs). Many "
-        "impacts belong in the batch API.")
+        "one impact through iq.solve is one compiled call with ~1 µs of Python around it "
+        "(the route planned in short, a thin result read off the call's buffer): for a "
+        "cradle the chain's isotonic regression and certificate, for other dense impacts "
+        "the active-set search and dense certificate, whose helpers are separate kernel "
+        "calls (~2 µs of the ~7 µs on 4 contacts); Siconos' Lemke is one call into C "
+        "returning bare arrays (~2.4 µs). Many impacts belong in the batch API.")
 #: per target (its text before the first colon): why it is missed, shown when it is
 WHY_MISSED = {
     "Siconos' BouncingBallTS, 2000 steps, same trajectory (≤ 1e-12)": (
@@ -296,20 +297,22 @@ WHY_MISSED = {
     "3-ball cradle": WHY_3_BALL,
     "chain N=10⁶, warm": (
         "isotonic_regression is one pass in C (~3.4 ms) that returns neither impulses nor a "
-        "certificate; impactqp's compiled projection with its impulses (PAVA and compensated "
-        "sums, ~6 ms) and its compiled O(N) certificate pass (momentum, signs, "
-        "complementarity, energy balance, duality gap: ~5 ms) each read the 8 MB arrays "
-        "again. Fusing the certificate into the projection's pass would check the answer "
+        "certificate; impactqp's one compiled call runs the projection with its impulses "
+        "(PAVA, the blocks' values, compensated sums) and then its O(N) certificate pass "
+        "(momentum, signs, complementarity, energy balance, duality gap), which reads u⁺, Λ, "
+        "the masses, their inverses and the scales again, and it writes a fresh 16 MB "
+        "output. Fusing the certificate into the projection's pass would check the answer "
         "with the numbers that produced it, which a certificate must not do."),
     "chain N=10⁶, cold build + solve": (
         "the problem validates and copies the masses and u⁻ (finite, positive) and its first "
         "solve computes the contact scales, on top of the warm solve."),
     "batch iq": (
-        "each row's certificate is the one compiled chain pass, ~95 ns for a 3-ball row "
-        "(scalar code with a branch and a division per contact and six residuals), on top of "
-        "~30 ns of column formulas for the solve; the earlier 2.5·10⁷/s came from numpy "
-        "column formulas for the residuals, a second definition of the certificate that "
-        "went with the one compiled core."),
+        "each row's certificate is the one compiled chain pass, ~55–80 ns for a 3-ball row "
+        "(scalar code with a division per contact and six residuals; the rows within the "
+        "unit range are passed first, the rescaled ones after), on top of ~30 ns of column "
+        "formulas for the solve; the earlier 2.5·10⁷/s came from numpy column formulas for "
+        "the residuals, a second definition of the certificate that went with the one "
+        "compiled core."),
 }
 EXPLAINED = {*WHY_MISSED, "friction"}
 """The targets (text before the first colon) whose misses the summary explains."""

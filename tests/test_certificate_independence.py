@@ -10,6 +10,7 @@ import pytest
 
 import impactqp as iq
 import impactqp.qp.backends.isotonic as isotonic_backend
+from impactqp.laws import small
 
 COMPILED = "kernel (compiled): certified"
 """The attempt of an impact answered by the compiled single-impact path."""
@@ -75,6 +76,7 @@ def test_a_wrong_chain_projection_is_not_certified(monkeypatch):
         return z, lam
 
     monkeypatch.setattr(isotonic_backend, "chain_projection", off_by_a_little)
+    monkeypatch.setattr(small, "on_chain", lambda *args: False)  # the general path's backend
     with pytest.raises(iq.CertificateError, match="momentum"):
         iq.moreau(p, 0.5, backend="isotonic")
     fallback = iq.moreau(p, 0.5)
@@ -87,8 +89,6 @@ def test_the_compiled_path_measures_momentum_with_its_own_operand():
     # N with WᵀN = 0 there: its candidate satisfies every contact condition and the impact
     # equation as measured with the planted operand, so only the pack's own LU-solved M⁻¹W
     # (docs/theory.md §8, "Independence") refuses it; the general path then answers right
-    from impactqp.laws import small
-
     p = dense_problem()
     st = p.structure
     law = iq.Newton(0.5)

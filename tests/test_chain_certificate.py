@@ -61,6 +61,7 @@ def test_a_failing_chain_certificate_fails_fast(monkeypatch):
     # isotonic answer fail its certificate; on 10⁵ balls the solve stops at once with a
     # CertificateError naming the fast path, instead of minutes in general solvers
     import impactqp.model.residuals as residuals
+    from impactqp.laws import small
     true_pass = residuals.chain_residuals
 
     def broken(*args):
@@ -68,6 +69,9 @@ def test_a_failing_chain_certificate_fails_fast(monkeypatch):
         args[-1][0] += 1.0
 
     monkeypatch.setattr(residuals, "chain_residuals", broken)
+    # the general path's fail-fast: the chain's compiled call (tested in test_small_path) is
+    # set aside
+    monkeypatch.setattr(small, "on_chain", lambda *args: False)
     n = 10**5
     u = np.zeros(n)
     u[0] = 1.0

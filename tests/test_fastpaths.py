@@ -33,7 +33,8 @@ def test_isotonic_matches_qp_on_chains(walls):
 
 
 def test_auto_picks_fast_paths():
-    assert iq.moreau(iq.newtons_cradle(), 1.0).backend == "kernel"  # least overhead
+    assert iq.moreau(iq.newtons_cradle(), 1.0).backend == "isotonic"  # the chain's call
+    assert iq.moreau(iq.newtons_cradle(), 1.0, form="impulse").backend == "kernel"
     assert iq.moreau(iq.newtons_cradle(20), 1.0).backend == "isotonic"
     assert iq.moreau(iq.random_impact(5, 4, seed=0), 1.0).backend == "kernel"
     assert iq.newton(iq.newtons_cradle(), [1.0, 0.5]).backend == "kernel"

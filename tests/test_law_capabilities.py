@@ -74,11 +74,12 @@ def test_a_declared_user_law_is_solved_exactly_as_the_built_in_one():
 
 def test_a_declared_moreau_law_takes_the_compiled_and_chain_paths():
     p = iq.newtons_cradle(4, 1.0)
-    one = iq.solve(p, DeclaredMoreau(0.3))
-    ref = iq.solve(p, iq.Moreau(0.3))
-    assert one.attempts == ref.attempts == [COMPILED]
-    np.testing.assert_array_equal(one.u_plus, ref.u_plus)
-    np.testing.assert_allclose(one.z, ref.z)  # the family's projection
+    for form, path in (("auto", "isotonic (compiled): certified"), ("impulse", COMPILED)):
+        one = iq.solve(p, DeclaredMoreau(0.3), form=form)  # the chain's call, the dense one
+        ref = iq.solve(p, iq.Moreau(0.3), form=form)
+        assert one.attempts == ref.attempts == [path]
+        np.testing.assert_array_equal(one.u_plus, ref.u_plus)
+        np.testing.assert_allclose(one.z, ref.z)  # the family's projection
     U = np.random.default_rng(1).standard_normal((50, 4))
     rows = iq.solve_batch(p, DeclaredMoreau(0.3), U)
     same = iq.solve_batch(p, iq.Moreau(0.3), U)

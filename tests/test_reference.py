@@ -52,7 +52,9 @@ def test_classification_of_section5():
     for eps in (0.0, 0.5, 1.0):
         c = iq.moreau(p, eps).classification
         assert c.alpha_deg == pytest.approx(0.0, abs=1e-6)
-        assert c.dissipation == pytest.approx(eps, abs=1e-9)
+        # the dissipation is a square root (of an energy ratio): a rounding of 1e-16 in the
+        # energies of an exact u⁺ shows as 1e-8 in it
+        assert c.dissipation == pytest.approx(eps, abs=1e-7)
     # both ε = 1 points lie on the same energy sphere
     assert iq.moreau(p, 1.0).classification.dissipation == pytest.approx(observed.dissipation)
 

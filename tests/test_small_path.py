@@ -1,5 +1,6 @@
-"""The compiled path for single dense impacts against the general path: same answers, the same
-certificate (its residuals recomputed independently), and a corrupted solve never returned."""
+"""The compiled path for single impacts (dense, and Moreau's law on chains) against the general
+path: same answers, the same certificate (its residuals recomputed independently), and a
+corrupted solve never returned."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import impactqp as iq
 from impactqp.laws import small
 
 COMPILED = "kernel (compiled): certified"
+CHAIN = "isotonic (compiled): certified"
 
 
 def cases():
@@ -48,12 +50,17 @@ def test_compiled_path_matches_the_general_path(case) -> None:
 def test_compiled_path_at_every_velocity_scale(scale) -> None:
     p = iq.newtons_cradle(3, v=scale)
     r = iq.moreau(p, 1.0)
-    assert r.attempts[-1] == COMPILED  # in order-one units beyond 1e±100
+    assert r.attempts[-1] == CHAIN  # in order-one units beyond 1e±100
     np.testing.assert_allclose(r.u_plus, np.array([-1, 2, 2]) / 3 * scale, rtol=1e-12)
     assert r.certificate.ok
+    dense = iq.moreau(p, 1.0, form="impulse")  # the dense compiled call
+    assert dense.attempts[-1] == COMPILED and dense.certificate.ok
+    np.testing.assert_allclose(dense.u_plus, r.u_plus, rtol=1e-12)
     assert not small.applies(p, iq.SectorLaw(), "auto", "auto")
     assert not small.applies(p, iq.Moreau(1.0), "clarabel", "auto")
-    assert not small.applies(p, iq.Moreau(1.0), "auto", "velocity")
+    assert small.applies(p, iq.Moreau(1.0), "auto", "velocity")  # the chain's call
+    assert not small.applies(p, iq.Newton(0.5), "auto", "velocity")
+    assert not small.applies(p, iq.Moreau(1.0), "nnls", "auto")
 
 
 def test_a_corrupted_compiled_solve_is_not_returned() -> None:
@@ -67,14 +74,56 @@ def test_a_corrupted_compiled_solve_is_not_returned() -> None:
     packed[start:start + n * m] *= 0.5
     st.__dict__["kernel_pack"] = packed
     try:
-        assert small.solve_small(p, iq.Moreau(1.0), 1e-9, 0.0) is None
+        assert small.solve_small(p, iq.Moreau(1.0), 1e-9, 0.0, form="impulse") is None
         assert small.solve_small(p, iq.Newton(0.5), 1e-9, 0.0) is None
-        r = iq.moreau(p, 1.0)
+        r = iq.moreau(p, 1.0, form="impulse")
         assert r.attempts[-1] != COMPILED and r.certificate.ok
         np.testing.assert_allclose(r.u_plus, [-1 / 3, 2 / 3, 2 / 3])
     finally:
         del st.__dict__["kernel_pack"]
-    assert iq.moreau(p, 1.0).attempts == [COMPILED]
+    assert iq.moreau(p, 1.0, form="impulse").attempts == [COMPILED]
+
+
+def test_a_corrupted_chain_call_is_not_returned() -> None:
+    """The chain's compiled call with its certificate's M⁻¹ corrupted (one inverse mass of
+    the pack NaN, which only the impact equation's measure reads): that residual fails, the
+    call declines, and the general path answers."""
+    p = iq.chain([1.0, 2.0, 3.0, 1.5], [2.0, 0.5, -1.0, 0.0], left_wall=True)
+    st = p.structure
+    packed = st.chain_pack.copy()
+    packed[st.n + 1] = np.nan
+    st.__dict__["chain_pack"] = packed
+    try:
+        assert small.solve_small(p, iq.Moreau(0.5), 1e-9, 0.0) is None
+        r = iq.moreau(p, 0.5)
+        assert r.attempts[-1] != CHAIN and r.certificate.ok
+    finally:
+        del st.__dict__["chain_pack"]
+    again = iq.moreau(p, 0.5)
+    assert again.attempts == [CHAIN]
+    np.testing.assert_allclose(again.u_plus, r.u_plus, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize("walls", [(False, False), (True, False), (False, True), (True, True)])
+@pytest.mark.parametrize("n", [1, 2, 3, 7, 40, 300])
+def test_the_chain_call_is_the_isotonic_backend(walls, n) -> None:
+    """The chain's compiled call gives the isotonic backend's numbers digit for digit (the same
+    regression, recovery and certificate), on every wall layout, with and without restitution."""
+    if n == 1 and walls == (False, False):
+        return  # no contact
+    rng = np.random.default_rng(n)
+    p = iq.chain(rng.uniform(0.5, 3.0, n), rng.standard_normal(n), left_wall=walls[0],
+                 right_wall=walls[1])
+    for eps in (0.0, 0.4, 1.0):
+        general = iq.moreau(p, eps, backend="isotonic")
+        r = small.solve_small(p, iq.Moreau(eps), 1e-9, 0.0)
+        assert r is not None and r.attempts == [CHAIN] and r.form == "velocity"
+        np.testing.assert_array_equal(r.u_plus, general.u_plus)
+        np.testing.assert_array_equal(r.impulses, general.impulses)
+        assert r.certificate.residuals == general.certificate.residuals
+        np.testing.assert_allclose(r.z, general.z, rtol=1e-15, atol=1e-15)
+        if p.n_contacts <= p.n_dof:  # (two walls on one ball are collapsed first)
+            assert iq.moreau(p, eps).attempts == [CHAIN]
 
 
 def test_warm_starts_do_not_change_answers() -> None:
@@ -111,7 +160,8 @@ def test_compiled_solves_of_every_shape(n, m) -> None:
         r = iq.solve(p, law)
         ref = iq.solve(p, law, backend="exact" if m <= 14 else "clarabel")
         np.testing.assert_allclose(r.u_plus, ref.u_plus, rtol=1e-8, atol=1e-10)
-        assert r.attempts == [COMPILED]
+        on_chain = p.chain is not None and isinstance(law, iq.Moreau)
+        assert r.attempts == [CHAIN if on_chain else COMPILED]
 
 
 def test_the_rest_shortcut_answers_only_when_certified() -> None:
@@ -126,3 +176,22 @@ def test_the_rest_shortcut_answers_only_when_certified() -> None:
     assert step.certificate.ok
     np.testing.assert_allclose(step.u_plus, [-0.5, 0.5])  # γ⁺ = −e·γ_prev = 1
     np.testing.assert_allclose(step.impulses, [0.5])
+
+
+@pytest.mark.parametrize("n", [8, 40])
+def test_batches_of_chains_keep_their_paths(n, monkeypatch) -> None:
+    """The chain's call serves single impacts: a batch of a chain beyond the dense call's
+    reach does not run the dense call row by row, and every row equals the single impact's
+    answer."""
+    import impactqp.laws.batch as batch
+
+    p = iq.newtons_cradle(n)
+    if not small.dense(p, iq.Moreau(0.3), "auto", "auto"):
+        def refuse(*args):
+            raise AssertionError("the dense compiled call ran on a chain beyond its reach")
+        monkeypatch.setattr(batch, "solve_impact_rows", refuse)
+    U = np.random.default_rng(n).standard_normal((20, n))
+    b = iq.moreau_batch(p, U, 0.3)
+    assert b.ok.all() and b.resolved == 0
+    single = np.array([iq.moreau(p.with_u_minus(u), 0.3).u_plus for u in U])
+    np.testing.assert_allclose(b.u_plus, single, rtol=1e-12, atol=1e-12)

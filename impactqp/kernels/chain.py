@@ -10,6 +10,10 @@ impulse left of ball j, M(z − u⁻) = WΛ reads L_j − L_{j+1} = dⱼ. Over a
 the contact before each block start carries none (L = 0 there, an anchor) and L is a running
 sum from the anchor; clipped blocks hang from the first free block start. Running sums are
 compensated (Neumaier), so their rounding does not grow with the length of a block.
+
+:func:`solve_chain` is one impact of Moreau's law in one compiled call: the projection, u⁺
+and Λ, then the chain certificate recomputed from them in a pass of its own
+(:func:`impactqp.kernels.residuals.chain_residuals`, docs/theory.md §8).
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import inline_kernel, kernel
+from .residuals import RESIDUALS, chain_residuals
 
 
 @inline_kernel
@@ -121,3 +126,74 @@ def project_rows(m, U, left, right):
     for r in range(k):
         project(m, U[r], left, right, Z[r], L[r], starts, weight)
     return Z, L
+
+
+def pack_chain(masses: np.ndarray, inverse: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """The masses mⱼ, their inverses 1/mⱼ and the contact scales sᵢ of a chain in one flat
+    array: the one operand of :func:`solve_chain` that describes the structure."""
+    return np.concatenate((masses, inverse, scale)).astype(float)
+
+
+@kernel(interpretable=True)
+def solve_chain(packed, um, left, right, eps, tol, out, starts, weight):
+    """Moreau's impact with restitution ε on one chain (docs/theory.md §3, §5), certified.
+
+    Parameters
+    ----------
+    packed : float array
+        :func:`pack_chain` of the chain (N masses, N inverses, m contact scales).
+    um : (N,) float array
+        u⁻.
+    left, right : bool
+        Walls.
+    eps, tol : float
+        Restitution and the certificate's tolerance.
+    out : (2N + 7,) float array
+        Receives u⁺ (N), the impulses L_j left of each ball j (N + 1: Λ is
+        ``L[0 if left else 1:][:m]``) and the residuals (order of
+        :data:`impactqp.kernels.residuals.RESIDUALS`).
+    starts, weight : int (N + 1,) and float (N,) arrays
+        Scratch of :func:`project` (a long chain's caller keeps them between solves).
+
+    Returns
+    -------
+    bool
+        Whether every residual is within ``tol`` (NaN fails).
+
+    u⁺ = z − εz⊥ and Λ = (1 + ε)Λ_z as the velocity program's recovery forms them; the
+    certificate then reads u⁺ and Λ back from memory in a pass of its own.
+    """
+    return _solve_chain_into(packed, um, left, right, eps, tol, out, starts, weight)
+
+
+@kernel(interpretable=True)
+def solve_short_chain(packed, um, left, right, eps, tol, out):
+    """:func:`solve_chain` with its scratch allocated by the call: for short chains, whose
+    scratch costs less to allocate than to pass (each array argument adds to the call)."""
+    n = um.size
+    return _solve_chain_into(packed, um, left, right, eps, tol, out,
+                             np.empty(n + 1, dtype=np.int64), np.empty(n))
+
+
+@inline_kernel
+def _solve_chain_into(packed, um, left, right, eps, tol, out, starts, weight):
+    """The body of :func:`solve_chain`."""
+    n = um.size
+    m = packed.size - 2 * n
+    masses = packed[:n]
+    up = out[:n]
+    L = out[n:2 * n + 1]
+    project(masses, um, left, right, up, L, starts, weight)
+    if eps != 0.0:
+        for j in range(n):  # u⁺ = z − ε(u⁻ − z)
+            up[j] = (up[j] - um[j]) * eps + up[j]
+        for j in range(n + 1):
+            L[j] = (1.0 + eps) * L[j]
+    lo = 0 if left else 1
+    res = out[2 * n + 1:2 * n + 1 + len(RESIDUALS)]
+    chain_residuals(um, up, L[lo:lo + m], masses, packed[n:2 * n], packed[2 * n:], left, right,
+                    eps, eps, True, res)
+    for i in range(res.size):
+        if not res[i] <= tol:
+            return False
+    return True

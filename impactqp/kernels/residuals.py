@@ -258,14 +258,21 @@ def chain_residuals(um, up, lam, masses, inverse, s, left_wall, right_wall, E, e
 
 
 @inline_kernel
+def in_unit_range(um):
+    """Whether the largest entry of u⁻ lies within :data:`SCALE_RANGE` (then the residuals
+    are computed on the inputs as they are: :func:`unit_of` is 1)."""
+    top = 0.0
+    for j in range(um.size):
+        top = max(top, abs(um[j]))
+    return SCALE_RANGE[0] < top < SCALE_RANGE[1]
+
+
+@inline_kernel
 def chain_step_residuals(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, eps,
                          moreau, out):
     """:func:`chain_residuals` with the restitution acting on the contact velocities of
     ``ur`` instead of u⁻ (a Moreau–Jean step: ur = v_k, docs/theory.md §14)."""
-    top = 0.0
-    for j in range(um.size):
-        top = max(top, abs(um[j]))
-    f = 1.0 if SCALE_RANGE[0] < top < SCALE_RANGE[1] else 1.0 / unit_of(um, up, lam)
+    f = 1.0 if in_unit_range(um) else 1.0 / unit_of(um, up, lam)
     _chain_pass(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, eps, moreau,
                 f, out)
 
@@ -273,12 +280,40 @@ def chain_step_residuals(um, up, lam, ur, masses, inverse, s, left_wall, right_w
 @kernel
 def chain_residual_rows(Um, Up, Lam, masses, inverse, s, left_wall, right_wall, E, eps,
                         moreau):
-    """:func:`chain_residuals` for every row of (U⁻, U⁺, Λ): a (k, 6) array."""
-    out = np.empty((Um.shape[0], 6))
-    for r in range(Um.shape[0]):
-        chain_residuals(Um[r], Up[r], Lam[r], masses, inverse, s, left_wall, right_wall, E,
-                        eps, moreau, out[r])
-    return out
+    """:func:`chain_residuals` for every row of (U⁻, U⁺, Λ): a (k, 6) array (a view of the
+    residual columns of :func:`chain_residual_columns`)."""
+    out = np.empty((6, Um.shape[0]))
+    chain_residual_columns(Um, Up, Lam, masses, inverse, s, left_wall, right_wall, E, eps,
+                           moreau, out)
+    return out.T
+
+
+@kernel
+def chain_residual_columns(Um, Up, Lam, masses, inverse, s, left_wall, right_wall, E, eps,
+                           moreau, out):
+    """:func:`chain_residuals` for every row of (U⁻, U⁺, Λ), residual i of row r into
+    ``out[i, r]`` (one contiguous column per residual: a batch keeps them as they are).
+
+    The rows within :data:`SCALE_RANGE` are passed first with the unit 1, the others after
+    them with their :func:`unit_of`: a loop that may call the rescaling at every row costs
+    twice as much per row on short chains (measured on 3 balls: ~120 → ~55 ns)."""
+    k = Um.shape[0]
+    row = np.empty(6)
+    plain = np.empty(k, dtype=np.bool_)
+    for r in range(k):
+        plain[r] = in_unit_range(Um[r])
+    for r in range(k):
+        if plain[r]:
+            _chain_pass(Um[r], Up[r], Lam[r], Um[r], masses, inverse, s, left_wall,
+                        right_wall, E, eps, moreau, 1.0, row)
+            for i in range(6):
+                out[i, r] = row[i]
+    for r in range(k):
+        if not plain[r]:
+            chain_residuals(Um[r], Up[r], Lam[r], masses, inverse, s, left_wall, right_wall,
+                            E, eps, moreau, row)
+            for i in range(6):
+                out[i, r] = row[i]
 
 
 @kernel

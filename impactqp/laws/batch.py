@@ -151,8 +151,11 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
                     law.eps if moreau else 0.0, moreau)
     elif fast is not None:
         module = backends.load(backends.REGISTRY[fast[0]])
-    if fast in ("chain", "compiled"):
-        names = RESIDUALS if fast == "chain" or compiled[3] else RESIDUALS[:4]
+    if fast == "chain":  # the residual columns are written where the batch keeps them
+        columns = np.empty((len(RESIDUALS), k))
+        res.update(zip(RESIDUALS, columns))
+    elif fast == "compiled":
+        names = RESIDUALS if compiled[3] else RESIDUALS[:4]
         res.update({key: np.empty(k) for key in names})
 
     def work(a: int, b: int) -> np.ndarray:
@@ -164,9 +167,7 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
                 Up[a:b, j] = col
             for i, col in enumerate(lam):
                 Lam[a:b, i] = col
-            table = rows.residuals(Ua, Up[a:b], Lam[a:b])
-            for i, key in enumerate(RESIDUALS):
-                res[key][a:b] = table[:, i]
+            rows.residuals(Ua, Up[a:b], Lam[a:b], columns[:, a:b])
         elif fast == "compiled":  # each chunk warm-starts from its own cold support
             packed, E, eps, moreau = compiled
             Up[a:b], Lam[a:b], table, done = solve_impact_rows(
@@ -234,9 +235,9 @@ def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: s
     way = plan(problem, law, backend, mode="batch").path
     if way == "chain":
         fast, used = "chain", "isotonic"
-    elif way == "compiled":
+    elif way == "compiled" and small.dense(problem, law, backend, "auto"):  # row by row
         fast, used = "compiled", "kernel"
-    elif way == "programs":
+    elif way in ("compiled", "programs"):  # (the chain's call serves single impacts only)
         fast = _fast_path(problem, law, backend)
         used = backend if fast is None else fast[0]
     else:

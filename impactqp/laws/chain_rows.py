@@ -19,7 +19,7 @@ from functools import reduce
 
 import numpy as np
 
-from ..kernels.residuals import chain_residual_rows
+from ..kernels.residuals import chain_residual_columns
 from ..model.problem import ImpactProblem
 from ..model.structure import ImpactStructure
 from .base import MOREAU_FAMILY, ImpactLaw
@@ -118,9 +118,14 @@ class ChainRows:
             return ([(1.0 + e) * zj - e * uj for zj, uj in zip(z, u)],
                     [(1.0 + e) * col for col in lam])
 
-    def residuals(self, U: np.ndarray, Up: np.ndarray, Lam: np.ndarray) -> np.ndarray:
-        """Moreau's residuals (docs/theory.md §8) of the rows, a (k, 6) array in the order of
-        :data:`impactqp.kernels.residuals.RESIDUALS`, by the one definition of the chain certificate
+    def residuals(self, U: np.ndarray, Up: np.ndarray, Lam: np.ndarray,
+                  out: np.ndarray | None = None) -> np.ndarray:
+        """Moreau's residuals (docs/theory.md §8) of the rows, a (6, k) array, one column per
+        residual in the order of :data:`impactqp.kernels.residuals.RESIDUALS` (written into
+        ``out`` when given), by the one definition of the chain certificate
         (:func:`impactqp.kernels.residuals.chain_residuals`)."""
-        return chain_residual_rows(U, Up, Lam, self.masses, self.inverse, self.scale,
-                                   self.left, self.right, self.eps, self.eps, True)
+        if out is None:
+            out = np.empty((6, U.shape[0]))
+        chain_residual_columns(U, Up, Lam, self.masses, self.inverse, self.scale, self.left,
+                               self.right, self.eps, self.eps, True, out)
+        return out

@@ -130,6 +130,10 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
     CertificateError
         No backend produced an answer that passes the certificate.
     """
+    if backend == "auto" and form == "auto" and options is None and not verbose:
+        result = small.first_try(problem, law, tol)  # the compiled path, planned in short
+        if result is not None:
+            return result
     if verbose:
         with verbosity(verbose):
             return solve(problem, law, backend, form=form, tol=tol, options=options)
@@ -146,7 +150,7 @@ def solve(problem: ImpactProblem, law: ImpactLaw, backend: str = "auto", *,
         return _collapsed(problem, law, planned.groups, backend, form, tol, start, options)
     way = planned.path
     if way == "compiled":
-        result = small.solve_small(problem, law, tol, start)
+        result = small.solve_small(problem, law, tol, start, backend, form)
         if result is not None:
             return result
         LOG.info("%s: the compiled path declined (certificate not met), trying the general "

@@ -13,12 +13,14 @@ from typing import Any
 
 import numpy as np
 
-from ..base.checks import ResidualChecks
+from ..base.checks import Certificate, ResidualChecks
 from ..derivatives.impact import derivative_of
+from ..kernels.residuals import RESIDUALS
 from ..model.admissible import Membership
 from ..model.classify import Classification, classify
 from ..model.friction import FrictionCertificate
 from ..model.problem import ImpactProblem
+from .base import MOREAU_FAMILY
 
 
 class CertifiedResult:
@@ -185,6 +187,74 @@ class ImpactResult(CertifiedResult):
         return (f"ImpactResult(law={self.law!r}, backend={self.backend!r}, "
                 f"u_plus={np.array2string(self.u_plus, precision=6)}, "
                 f"certificate={self.certificate.summary()})")
+
+
+class CompiledImpactResult(ImpactResult):
+    """An :class:`ImpactResult` of one compiled call (:mod:`impactqp.laws.small`), its
+    fields read off the call's output buffer when first asked for.
+
+    The compiled call has already recomputed every residual of the certificate and checked
+    it against the tolerance (a result is only formed when it passed); what is left is
+    bookkeeping, done lazily: u⁺, Λ and the residuals are views of ``out`` (``at`` says
+    where: n, where Λ starts and ends, where the residuals start; u⁺ is ``out[:n]``), the
+    :class:`Certificate` is built from those residuals on first read, z by the law's
+    projection. The attributes are those of :class:`ImpactResult`.
+    """
+
+    _certificate = None
+    _z = None
+
+    def __init__(self, problem: ImpactProblem, impact_law: Any, out: np.ndarray,
+                 at: tuple[int, int, int, int], names: tuple[str, ...], tol: float,
+                 backend: str, form: str, solve_time: float) -> None:
+        self.problem = problem
+        self.impact_law = impact_law
+        self.solve_time = solve_time
+        self.backend = backend
+        self.form = form
+        self._out = out
+        self._at = at
+        self._names = names
+        self._tol = tol
+
+    @property
+    def law(self) -> str:  # type: ignore[override]
+        return self.impact_law.name
+
+    @cached_property
+    def coefficients(self) -> Any:  # type: ignore[override]
+        return self.impact_law.coefficients_for(self.problem)
+
+    @cached_property
+    def u_plus(self) -> np.ndarray:  # type: ignore[override]
+        return self._out[:self._at[0]]
+
+    @cached_property
+    def impulses(self) -> np.ndarray:  # type: ignore[override]
+        return self._out[self._at[1]:self._at[2]]
+
+    @property
+    def attempts(self) -> list[str]:  # type: ignore[override]
+        return [f"{self.backend} (compiled): certified"]
+
+    @property
+    def certificate(self) -> ResidualChecks:
+        cert = self._certificate
+        if cert is None:
+            start = self._at[3]
+            values = self._out[start:start + len(self._names)].tolist()
+            cert = self._certificate = Certificate(dict(zip(self._names, values)), self._tol,
+                                                   names=RESIDUALS)
+        return cert
+
+    @property
+    def z(self) -> np.ndarray:
+        z = self._z
+        if z is None:
+            law = self.impact_law
+            z = self._z = (law.projection(self.problem, self.u_plus)
+                           if law.family == MOREAU_FAMILY else self.problem.moreau_split[0])
+        return z
 
 
 @dataclass(frozen=True, repr=False)

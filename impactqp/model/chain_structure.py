@@ -15,6 +15,7 @@ import scipy.sparse as sp
 
 from ..base.arrays import Matrix
 from ..errors import MassMatrixError, NonFiniteError, ShapeError
+from ..kernels.chain import pack_chain
 from .structure import ChainInfo, ImpactStructure
 
 
@@ -94,6 +95,12 @@ class ChainStructure(ImpactStructure):
         c = self.chain
         return chain_directions(self.n, left_wall=c.left_wall, right_wall=c.right_wall,
                                 sparse=self.sparse)
+
+    @cached_property
+    def chain_pack(self) -> np.ndarray:
+        """Masses, their inverses and the contact scales in one array, for the compiled impact
+        of a chain (:func:`!impactqp.kernels.chain.pack_chain`)."""
+        return pack_chain(self.chain.masses, self.inverse_masses, self.contact_scale)
 
     @cached_property
     def _chol(self) -> np.ndarray:
