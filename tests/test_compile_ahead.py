@@ -113,4 +113,6 @@ def test_compile_command_names_a_bad_jobs_flag():
 def test_a_parallel_compile_starts_every_stage():
     from impactqp import precompile
 
-    assert sorted(precompile.LONGEST_FIRST) == sorted(name for name, _ in precompile.STAGES)
+    names = sorted(name for name, _ in precompile.STAGES)
+    assert sorted(precompile.LONGEST_FIRST) == names
+    assert sorted(name for group in precompile.PAIRED for name in group) == names

@@ -164,7 +164,7 @@ def factor_cell(G, active, cells, e):
     dependent contact is dropped, as in the active-set search) and K_AA = G_AA⁻¹ from it.
     Returns the factor's size."""
     idx, K, L, y = cells.idx[e], cells.K[e], cells.L, cells.y
-    k = 0
+    k = np.int64(0)  # not a literal: _append compiles for int64 only (one signature)
     for i in range(active.size):
         if active[i] and _append(L, idx, k, G, i):
             k += 1
@@ -267,10 +267,12 @@ def apply_rows(P, Q, cells, cell, transpose, X, out, start, stop):
 def finish_rows(Um, Lam, classes, cells, R, YT, dU, Ubar, settings, out, start, stop):
     """Margins, JVP and VJP rows of the rows start..stop that have a cell."""
     margin_rows(Um, Lam, classes, out.status, cells.grad, out.margin, start, stop)
+    # run-time flags (np.bool_): one compiled apply_rows for both directions
     if settings.jvp:
-        apply_rows(R, YT, cells, classes.cell, False, dU, out.dUp, start, stop)
+        apply_rows(R, YT, cells, classes.cell, np.bool_(False), dU, out.dUp, start, stop)
     if settings.vjp:
-        apply_rows(YT, R, cells, classes.cell, True, Ubar, out.Ubar, start, stop)
+        apply_rows(YT, R, cells, classes.cell, np.bool_(True), Ubar, out.Ubar, start,
+                   stop)
 
 
 @kernel

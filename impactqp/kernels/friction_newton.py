@@ -92,18 +92,21 @@ def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
     n = r.size
     m = mu.size
     qn = np.sqrt(np.sum(q * q))
+    # run-time flags (np.bool_): one compiled alart_curnier serves these calls and Python's,
+    # where literal True/False would compile one specialization each
+    jac, value = np.bool_(True), np.bool_(False)
     if qn == 0.0:
         qn = 1.0
     A = np.empty((m, d, d))
     B = np.empty((m, d, d))
     J = np.empty((n, n))
-    scale = np.sqrt(np.sum(alart_curnier(np.zeros(n), q, mu, rho, d, False, A, B) ** 2))
+    scale = np.sqrt(np.sum(alart_curnier(np.zeros(n), q, mu, rho, d, value, A, B) ** 2))
     if scale == 0.0:
         scale = 1.0
     u = affine(W, r, q, np.empty(n))
     u_try = np.empty(n)
     r_try = np.empty(n)
-    phi = alart_curnier(r, u, mu, rho, d, True, A, B)
+    phi = alart_curnier(r, u, mu, rho, d, jac, A, B)
     f = np.sqrt(np.sum(phi * phi))
     steps = 0
     kept = np.empty(n)  # the first projected r within tolerance
@@ -144,7 +147,7 @@ def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
             for i in range(n):
                 r_try[i] = r[i] + t * step[i]
             affine(W, r_try, q, u_try)
-            phi_try = alart_curnier(r_try, u_try, mu, rho, d, False, A, B)
+            phi_try = alart_curnier(r_try, u_try, mu, rho, d, value, A, B)
             f_try = np.sqrt(np.sum(phi_try * phi_try))
             if f_try <= (1.0 - 1e-4 * t) * f:
                 break
@@ -153,7 +156,7 @@ def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
             break  # no descent: stalled
         r[:] = r_try
         u[:] = u_try
-        phi = alart_curnier(r, u, mu, rho, d, True, A, B)
+        phi = alart_curnier(r, u, mu, rho, d, jac, A, B)
         f = f_try
     if kept_error <= 0.5 * tol:  # the step more failed: the r within tolerance
         r[:] = kept
