@@ -131,7 +131,7 @@ def contact_velocities(indptr, indices, data, gamma0, P, out):
         out[i] = _gamma_row(indptr, indices, data, gamma0, P, i)
 
 
-@kernel
+@kernel(refcounted=False)
 def rates(x, k, live, nlive, indptr, indices, data, gamma0, law, gamma, out):
     """dx of the state x = (z, P, D) against time (k < 0) or against the impulse of the
     primary contact k (docs/theory.md §13), for the contacts ``live[:nlive]`` into ``out``
@@ -256,7 +256,7 @@ def piece_events(k, frozen, gamma, law, indptr, indices, kinds, contacts, direct
     return n, nlive
 
 
-@kernel
+@kernel(refcounted=False)
 def event_value(kind, j, k, x, level, live, nlive, law, indptr, indices, data, gamma0):
     """The function whose zero is event ``kind`` of contact j, at state x of a piece with
     primary k (k < 0: against time) and contacts ``live[:nlive]`` (the others store
@@ -285,6 +285,16 @@ def event_value(kind, j, k, x, level, live, nlive, law, indptr, indices, data, g
     if kind == PLASTIC_STOP:
         return g - VELOCITY_LEVEL
     return g  # TURN
+
+
+@kernel(refcounted=False)
+def event_values(events, k, x, level, live, nlive, impact, out):
+    """out[e] = :func:`event_value` of each of a piece's ``events``
+    (:class:`~impactqp.kernels.lzb_groups.PieceEvents`) at x."""
+    indptr, indices, data, gamma0, law = impact
+    for e in range(events.n):
+        out[e] = event_value(events.kinds[e], events.contacts[e], k, x, level, live, nlive,
+                             law, indptr, indices, data, gamma0)
 
 
 @kernel
