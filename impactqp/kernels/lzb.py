@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from .jit import inline_kernel, kernel
 from .lzb_dop853 import dense_output, error_norm, evaluate, interpolate, rk_step, scatter
 from .lzb_groups import Piece, PieceEvents
 from .lzb_model import (
@@ -112,7 +112,7 @@ def _step_to_kink(x, tau, kind, j, g0, piece, impact, tableau, stages, out, full
             return
 
 
-@kernel(refcounted=False)
+@inline_kernel
 def _next_step(h, norm, rejected, predict, h_prev, norm_prev):
     """The next step after an accepted one of length h and error ``norm`` (< 1): scipy's
     factor, and, with ``predict`` and an accepted step (h_prev, norm_prev) before it in the
@@ -125,7 +125,7 @@ def _next_step(h, norm, rejected, predict, h_prev, norm_prev):
     return h * (min(1.0, factor) if rejected else factor)
 
 
-@kernel(refcounted=False)
+@inline_kernel
 def _piece(x, k, live, nlive, events, rtol, fixed, h_start, max_steps, impact, tableau,
            istate, fstate, work):
     """Integrate one piece from x until its first event (against time when k < 0), x
@@ -153,7 +153,7 @@ def _piece(x, k, live, nlive, events, rtol, fixed, h_start, max_steps, impact, t
     h_abs = fixed if fixed > 0.0 else (h_start if h_start > 0.0 else FIRST_STEP * PIECE_SPAN)
     h_prev, norm_prev = 0.0, 0.0
     piece = Piece(k, live, nlive, comps, nc, fstate[LEVEL])
-    evaluate(xc, 0, piece, impact, stages)
+    evaluate(xc, piece, impact, stages, K[0])
     istate[EVALUATIONS] += 1
     event_values(events, k, x, piece.level, live, nlive, impact, g_old)
     while True:
@@ -168,7 +168,7 @@ def _piece(x, k, live, nlive, events, rtol, fixed, h_start, max_steps, impact, t
             t_new = min(t + h_abs, PIECE_SPAN)
             h = t_new - t
             rk_step(xc, h, piece, impact, tableau, stages, x_new)
-            evaluate(x_new, 12, piece, impact, stages)
+            evaluate(x_new, piece, impact, stages, K[12])
             istate[EVALUATIONS] += 12
             unit = error_norm(xc, x_new, h, nc, n, tableau, K, e5, e3)
             if fixed > 0.0:
@@ -217,29 +217,22 @@ def _piece(x, k, live, nlive, events, rtol, fixed, h_start, max_steps, impact, t
             return DONE, -1, h_abs
 
 
-@kernel
+@kernel(refcounted=False)
 def integrate_impact(impact, tableau, rtol, max_steps, max_pieces, y, P, D, left, istate,
-                     fstate, primaries, work):
+                     fstate, primaries, buffers, work):
     """Integrate one multiple ``impact`` (:class:`~impactqp.kernels.lzb_model.Impact`) with
     DOP853's ``tableau`` (:class:`~impactqp.kernels.lzb_groups.Tableau`) piece by piece
     until every contact is open (docs/theory.md §13): y, P, D and ``left`` (energy still
     stored when a contact opened) updated in place, the primary contact of each piece into
     ``primaries`` (max_pieces + 1 entries), counters into ``istate``/``fstate``
-    (:func:`impactqp.kernels.lzb_model.new_state`), ``work`` the pieces' scratch
-    (:func:`impactqp.kernels.lzb_groups.piece_work`). fstate[FIXED_STEP] > 0 takes fixed
+    (:func:`impactqp.kernels.lzb_model.new_state`), ``buffers`` and ``work`` the pieces'
+    scratch (:func:`impactqp.kernels.lzb_groups.piece_buffers`, :func:`piece_work
+    <impactqp.kernels.lzb_groups.piece_work>`). fstate[FIXED_STEP] > 0 takes fixed
     steps of that (dimensionless) length in the primary impulse, the pieces against time
     staying adaptive. Returns DONE, OUT_OF_STEPS (``max_steps`` accepted steps spent),
     OUT_OF_PIECES or STEP_TOO_SMALL."""
     indptr, indices, data, gamma0, law = impact
-    m = gamma0.size
-    n = 3 * m
-    frozen = np.zeros(m, dtype=np.bool_)
-    live = np.empty(m, dtype=np.int64)
-    gamma = np.empty(m)
-    kinds = np.empty(3 * m + 3, dtype=np.int64)
-    contacts = np.empty(3 * m + 3, dtype=np.int64)
-    directions = np.empty(3 * m + 3)
-    x = np.empty(n)
+    frozen, live, gamma, kinds, contacts, directions, x = buffers
     h_next, k_last = 0.0, -1
     while True:
         primary = begin_piece(y, P, D, frozen, gamma, istate, fstate, law, indptr, indices,

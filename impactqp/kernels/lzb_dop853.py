@@ -16,60 +16,63 @@ from .lzb_model import rates
 
 
 @inline_kernel
-def combine(K, coefficients, rows, nc, out):
-    """out[c] = Σ_{q<rows} coefficients[q] K[q, c] for c < nc (row by row, skipping the
-    tableau's zeros)."""
+def combine(K, coefficients, nc, out):
+    """out[c] = Σ_q coefficients[q] K[q, c] for c < nc (row by row, skipping the tableau's
+    zeros). The number of rows is read from the array, not written as a constant, so that
+    the compiler does not unroll the rows into a copy of the loop each (the code, and its
+    compile time, grow tenfold)."""
     for c in range(nc):
         out[c] = 0.0
-    for q in range(rows):
+    for q in range(coefficients.size):
         a = coefficients[q]
         if a != 0.0:
             for c in range(nc):
                 out[c] += a * K[q, c]
 
 
-@kernel(refcounted=False)
-def evaluate(xc, s, piece, impact, stages):
-    """K[s] = the rates at the components xc (scattered into the full state)."""
+@inline_kernel
+def evaluate(xc, piece, impact, stages, row):
+    """row = the rates at the components xc (scattered into the full state), on the
+    components."""
     k, live, nlive, comps, nc = piece.k, piece.live, piece.nlive, piece.comps, piece.nc
     indptr, indices, data, gamma0, law = impact
-    K, xs, rate = stages.K, stages.xs, stages.rate
+    xs, rate = stages.xs, stages.rate
     for c in range(nc):
         xs[comps[c]] = xc[c]
     rates(xs, k, live, nlive, indptr, indices, data, gamma0, law, stages.gamma, rate)
     for c in range(nc):
-        K[s, c] = rate[comps[c]]
+        row[c] = rate[comps[c]]
 
 
 @kernel(refcounted=False)
-def stages_from(first, last, x, h, piece, impact, A, stages):
-    """Stages first … last − 1 of a step of length h from x: xc = x + h Σ_{q<s} A[s, q] K[q],
-    then K[s] there."""
+def stage(s, x, h, piece, impact, A, stages):
+    """Stage s of a step of length h from x: xc = x + h Σ_{q<s} A[s, q] K[q], then K[s]
+    there (one compiled stage serves the step and its dense output)."""
     K, xc, nc = stages.K, stages.xc, piece.nc
-    for s in range(first, last):
-        combine(K, A[s], s, nc, xc)
-        for c in range(nc):
-            xc[c] = x[c] + h * xc[c]
-        evaluate(xc, s, piece, impact, stages)
+    combine(K, A[s], nc, xc)  # A is strictly lower triangular
+    for c in range(nc):
+        xc[c] = x[c] + h * xc[c]
+    evaluate(xc, piece, impact, stages, K[s])
 
 
 @kernel(refcounted=False)
 def rk_step(x, h, piece, impact, tableau, stages, out):
     """One DOP853 step of length h from x (K[0] = its rates) into ``out``, stages into K."""
-    stages_from(1, 12, x, h, piece, impact, tableau.A, stages)
+    for s in range(1, tableau.B.size):
+        stage(s, x, h, piece, impact, tableau.A, stages)
     nc = piece.nc
-    combine(stages.K, tableau.B, 12, nc, out)
+    combine(stages.K, tableau.B, nc, out)
     for c in range(nc):
         out[c] = x[c] + h * out[c]
 
 
-@kernel(refcounted=False)
+@inline_kernel
 def error_norm(x, x_new, h, nc, n, tableau, K, e5, e3):
     """h‖err‖ of the step from x to x_new: scipy's RMS over all n components of the 5th-order
     estimate, corrected by the 3rd-order one, relative to 1 + |x| (the frozen components
     count, with no error)."""
-    combine(K, tableau.E5, 13, nc, e5)
-    combine(K, tableau.E3, 13, nc, e3)
+    combine(K, tableau.E5, nc, e5)
+    combine(K, tableau.E3, nc, e3)
     err5, err3 = 0.0, 0.0
     for c in range(nc):
         scale = 1.0 + max(abs(x[c]), abs(x_new[c]))
@@ -80,23 +83,24 @@ def error_norm(x, x_new, h, nc, n, tableau, K, e5, e3):
     return h * err5 / np.sqrt((err5 + 0.01 * err3) * n)
 
 
-@kernel(refcounted=False)
+@inline_kernel
 def dense_output(x, x_new, h, piece, impact, tableau, stages, F):
     """F = the coefficients of the step's 7th-order dense output (three more stages)."""
     K, nc = stages.K, piece.nc
-    stages_from(13, 16, x, h, piece, impact, tableau.A, stages)
-    for r in range(4):
-        combine(K, tableau.D[r], 16, nc, F[3 + r])
+    for s in range(tableau.E5.size, tableau.A.shape[0]):
+        stage(s, x, h, piece, impact, tableau.A, stages)
+    for r in range(tableau.D.shape[0]):
+        combine(K, tableau.D[r], nc, F[3 + r])
     for c in range(nc):
         delta = x_new[c] - x[c]
         F[0, c] = delta
         F[1, c] = h * K[0, c] - delta
         F[2, c] = 2.0 * delta - h * (K[12, c] + K[0, c])
-        for r in range(3, 7):
+        for r in range(3, F.shape[0]):
             F[r, c] *= h
 
 
-@kernel(refcounted=False)
+@inline_kernel
 def interpolate(F, x_old, theta, nc, out):
     """DOP853's dense output at θ ∈ [0, 1] of the step (scipy's Dop853DenseOutput)."""
     rows = F.shape[0]
@@ -108,7 +112,7 @@ def interpolate(F, x_old, theta, nc, out):
         out[c] = v + x_old[c]
 
 
-@kernel(refcounted=False)
+@inline_kernel
 def scatter(xc, comps, nc, out):
     """out[comps[c]] = xc[c] for c < nc."""
     for c in range(nc):

@@ -147,6 +147,41 @@ def piece_work(m: int) -> PieceWork:
                      np.empty(n + 3), np.empty(n, dtype=np.int64))
 
 
+class PieceBuffers(NamedTuple):
+    """What the piece-by-piece logic of :func:`impactqp.kernels.lzb.integrate_impact` keeps
+    between pieces (:mod:`impactqp.kernels.lzb_model`).
+
+    Attributes
+    ----------
+    frozen : (m,) bool array
+        The open contacts.
+    live : (m,) int array
+        The others, ``live[:nlive]``.
+    gamma : (m,) float array
+        The contact velocities at the start of the piece.
+    kinds, contacts, directions : (3m + 3,) int, int, float arrays
+        The piece's events (:class:`PieceEvents`).
+    x : (3m,) float array
+        The state x = (z, P, D) of the piece.
+    """
+
+    frozen: np.ndarray
+    live: np.ndarray
+    gamma: np.ndarray
+    kinds: np.ndarray
+    contacts: np.ndarray
+    directions: np.ndarray
+    x: np.ndarray
+
+
+def piece_buffers(m: int) -> PieceBuffers:
+    """The :class:`PieceBuffers` of an impact of m contacts."""
+    return PieceBuffers(np.zeros(m, dtype=np.bool_), np.empty(m, dtype=np.int64), np.empty(m),
+                        np.empty(3 * m + 3, dtype=np.int64),
+                        np.empty(3 * m + 3, dtype=np.int64), np.empty(3 * m + 3),
+                        np.empty(3 * m))
+
+
 def dop853_tableau() -> Tableau:
     """DOP853's :class:`Tableau`, as :func:`impactqp.kernels.lzb.integrate_impact` takes it."""
     return Tableau(*(np.ascontiguousarray(a, dtype=float) for a in

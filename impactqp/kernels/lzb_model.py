@@ -124,7 +124,7 @@ def _energy(y, eta):
     return _power(y, eta + 1.0) if y > 0.0 else 0.0
 
 
-@kernel
+@kernel(refcounted=False)
 def contact_velocities(indptr, indices, data, gamma0, P, out):
     """γ = γ⁻ + GP into ``out``."""
     for i in range(gamma0.size):
@@ -173,7 +173,7 @@ def rates(x, k, live, nlive, indptr, indices, data, gamma0, law, gamma, out):
             out[2 * m + k] = (law[EXPANSION, k] - 1.0) * g
 
 
-@kernel
+@kernel(refcounted=False)
 def begin_piece(y, P, D, frozen, gamma, istate, fstate, law, indptr, indices, data, gamma0):
     """Start the next piece: empty the plastic contacts past compression (their energy is
     dissipated), mark the open contacts ``frozen``, set the energy level and whether the
@@ -213,7 +213,7 @@ def begin_piece(y, P, D, frozen, gamma, istate, fstate, law, indptr, indices, da
     return k
 
 
-@kernel
+@kernel(refcounted=False)
 def piece_events(k, frozen, gamma, law, indptr, indices, kinds, contacts, directions, live):
     """The events that end a piece with primary k (k < 0: against time), into ``kinds``,
     ``contacts`` and ``directions`` (−1: the value falls through 0, +1: rises), and the
@@ -297,7 +297,7 @@ def event_values(events, k, x, level, live, nlive, impact, out):
                              law, indptr, indices, data, gamma0)
 
 
-@kernel
+@kernel(refcounted=False)
 def piece_state(y, P, D, k, law, x):
     """x = (z, P, D) at the start of a piece: z = y, with zₖ = Eₖ against Pₖ (k ≥ 0)."""
     m = y.size
@@ -309,7 +309,7 @@ def piece_state(y, P, D, k, law, x):
         x[k] = _energy(y[k], law[ETA, k])
 
 
-@kernel
+@kernel(refcounted=False)
 def end_piece(kind, j, k, primary, before, x, y, P, D, left, istate, fstate, law):
     """Take the state x at the end of a piece with rates against ``k`` (−1: time) and apply
     the event ``kind`` of contact j that ended it (−1: none): an opened contact keeps the
@@ -346,7 +346,7 @@ def end_piece(kind, j, k, primary, before, x, y, P, D, left, istate, fstate, law
     fstate[IMPULSE_VARIABLE] += P[primary] - before
 
 
-@kernel
+@kernel(refcounted=False)
 def stored_energies(y, law, out):
     """out += Eᵢ = max(yᵢ, 0)^(ηᵢ+1): what the contacts still store at the end."""
     for i in range(y.size):
