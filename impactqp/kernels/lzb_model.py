@@ -29,7 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .jit import inline_kernel, kernel
+from .jit import kernel
 
 TINY = 1e-30
 """Floor of the primary contact's dimensionless force: its energy is zero only at the event
@@ -93,7 +93,7 @@ def new_state() -> tuple[np.ndarray, np.ndarray]:
     return istate, np.zeros(4)
 
 
-@inline_kernel
+@kernel(refcounted=False)
 def _gamma_row(indptr, indices, data, gamma0, P, i):
     """γᵢ = γ⁻ᵢ + (GP)ᵢ."""
     s = gamma0[i]
@@ -102,7 +102,7 @@ def _gamma_row(indptr, indices, data, gamma0, P, i):
     return s
 
 
-@inline_kernel
+@kernel(refcounted=False)
 def _power(y, a):
     """y^a for y ≥ 0, without the general power where a is a Hertz or linear exponent."""
     if a == 1.0:
@@ -118,7 +118,7 @@ def _power(y, a):
     return y ** a
 
 
-@inline_kernel
+@kernel(refcounted=False)
 def _energy(y, eta):
     """E = max(y, 0)^(η+1)."""
     return _power(y, eta + 1.0) if y > 0.0 else 0.0
