@@ -66,7 +66,7 @@ def rk_step(x, h, piece, impact, tableau, stages, out):
         out[c] = x[c] + h * out[c]
 
 
-@inline_kernel
+@kernel(refcounted=False)
 def error_norm(x, x_new, h, nc, n, tableau, K, e5, e3):
     """h‖err‖ of the step from x to x_new: scipy's RMS over all n components of the 5th-order
     estimate, corrected by the 3rd-order one, relative to 1 + |x| (the frozen components
@@ -83,7 +83,7 @@ def error_norm(x, x_new, h, nc, n, tableau, K, e5, e3):
     return h * err5 / np.sqrt((err5 + 0.01 * err3) * n)
 
 
-@inline_kernel
+@kernel(refcounted=False)
 def dense_output(x, x_new, h, piece, impact, tableau, stages, F):
     """F = the coefficients of the step's 7th-order dense output (three more stages)."""
     K, nc = stages.K, piece.nc
