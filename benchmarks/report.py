@@ -281,12 +281,13 @@ WHY_MISSED = {
         "the flights are exact and each impact takes the compiled path (~0.1 ms per impact "
         "measured); a slower run means a loaded machine."),
     "LZB 10-ball steel chain": (
-        "the compiled LZB integration takes ~1.3 ms on a quiet machine (238 DOP853 steps); "
-        "a slower run means a loaded machine."),
+        "the compiled LZB integration takes 1.4–2.6 ms on the shared two-core machine (221 "
+        "DOP853 steps; the row gives the CPU time); a slower run means a loaded machine."),
     "LZB 100-ball steel chain": (
-        "the wave through 100 balls takes ~2,300 DOP853 steps, each costing in proportion to "
-        "the contacts it covers: 16–24 ms measured alone on a quiet machine, more when "
-        "another process shares the two cores."),
+        "the wave through 100 balls takes ~1,840 DOP853 steps over ~290 pieces, each step "
+        "costing in proportion to the ~11 contacts it covers: 12–22 ms measured on the "
+        "shared two-core machine (the row gives the CPU time), more when other processes "
+        "hold both cores."),
     "first calls in a fresh process, numba cache filled": (
         "the first calls load numba's cached kernels and fill impactqp's caches (see the "
         "per-case first-call times in the measured column)."),

@@ -195,6 +195,7 @@ def test_per_impact_rows(monkeypatch):
     assert len(ball["times"]) == 1 and "1 certified impacts" in ball["reference"]
     assert lzb["family"] == "lzb" and lzb["size"] == 3 and lzb["status"] == "ok"
     assert len(lzb["times"]) == 1 and lzb["times"][0] > 0
+    assert "CPU" in lzb["reference"] and "DOP853 steps" in lzb["reference"]
     assert dynamics.run_per_impact("smoke") == []
     assert dynamics.run_startup("quick") == []
 

@@ -51,7 +51,7 @@ inf/NaN (which every certificate then rejects) instead of raising."""
 
 
 def kernel(function: F | None = None, *, interpretable: bool = False,
-           inline: bool = False) -> Any:
+           inline: bool = False, refcounted: bool = True) -> Any:
     """Compile ``function`` with numba on its first call, caching the machine code on disk
     (in :func:`cache_dir`).
 
@@ -59,13 +59,19 @@ def kernel(function: F | None = None, *, interpretable: bool = False,
     the kernel's work is bounded by the sizes of its arrays (no loop over time steps or
     rows): its first small calls in a process that holds no machine code for it run its
     Python text instead (:mod:`.first_calls`). ``inline`` inlines it into every kernel
-    calling it. Used bare (``@kernel``) or with arguments.
+    calling it. ``refcounted=False`` compiles it without numba's reference counting: for a
+    kernel called in an inner loop that allocates no array and returns none, whose every
+    call would otherwise pay two atomic counts per array argument. Used bare (``@kernel``)
+    or with arguments.
     """
     if function is None:
-        return lambda f: kernel(f, interpretable=interpretable, inline=inline)
+        return lambda f: kernel(f, interpretable=interpretable, inline=inline,
+                                refcounted=refcounted)
     if numba.config.DISABLE_JIT:
         return function
     options = {**OPTIONS, "inline": "always"} if inline else dict(OPTIONS)
+    if not refcounted:
+        options["_nrt"] = False
     with _cached_in_user_dir():
         if interpretable:
             dispatcher = InterpretableDispatcher(py_func=function, locals={},

@@ -1,11 +1,16 @@
 """The LZB integration of one multiple impact in one compiled call (docs/theory.md §13).
 
 :func:`integrate_impact` runs the piece-by-piece logic of :mod:`impactqp.kernels.lzb_model`
-with its own stepper: DOP853 (Dormand–Prince 8(5,3), Hairer's coefficients as scipy ships
-them, and scipy's step-size control) with error control at rtol = atol in the dimensionless
-variables, or fixed steps of the primary impulse without error control; each step's sign
-changes of the piece's events are located on the 7th-order dense output by Illinois' regula
-falsi, and the piece ends at the earliest. Only the live contacts of a piece are stepped.
+with its own stepper (:mod:`impactqp.kernels.lzb_dop853`): DOP853 (Dormand–Prince 8(5,3),
+Hairer's coefficients as scipy ships them) with error control at rtol = atol in the
+dimensionless variables, or fixed steps of the primary impulse without error control; each
+step's sign changes of the piece's events are located on the 7th-order dense output by
+Illinois' regula falsi, and the piece ends at the earliest. Only the live contacts of a
+piece are stepped. The step size follows scipy's control, and, against the primary impulse,
+also Gustafsson's prediction from the last two steps' errors (the error grows steadily
+towards the events that end a piece, where scipy's control alternates accepted and
+rejected steps); a piece against the primary impulse starts with the step the last one
+proposed, not with scipy's first guess again.
 """
 
 from __future__ import annotations
@@ -13,7 +18,8 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import inline_kernel, kernel
-from .lzb_groups import Piece, PieceEvents, Stages
+from .lzb_dop853 import dense_output, error_norm, evaluate, interpolate, rk_step, scatter
+from .lzb_groups import Piece, PieceEvents
 from .lzb_model import (
     DONE,
     ERROR,
@@ -33,56 +39,23 @@ from .lzb_model import (
     begin_piece,
     end_piece,
     event_value,
+    event_values,
     piece_events,
     piece_state,
-    rates,
 )
 
 EPS = float(np.finfo(float).eps)
 KINK_ITERATIONS = 4
 """Secant steps that place the end of a piece on a kink of the rates."""
+SAFETY, MIN_FACTOR, MAX_FACTOR, EXPONENT = 0.9, 0.2, 10.0, -1.0 / 8.0
+"""scipy's step-size control for DOP853 (error estimator of order 7)."""
 
 
-@inline_kernel
-def _combine(K, coefficients, rows, comps, nc, out):
-    """out = Σ_{q<rows} coefficients[q] K[q] on the components ``comps[:nc]`` (row by row,
-    skipping the tableau's zeros)."""
-    for c in range(nc):
-        out[comps[c]] = 0.0
-    for q in range(rows):
-        a = coefficients[q]
-        if a != 0.0:
-            for c in range(nc):
-                i = comps[c]
-                out[i] += a * K[q, i]
-
-
-@inline_kernel
-def _stage(K, A, s, x, h, comps, nc, xs):
-    """xs = x + h Σ_{q<s} A[s, q] K[q] on the components ``comps[:nc]``."""
-    _combine(K, A[s], s, comps, nc, xs)
-    for c in range(nc):
-        i = comps[c]
-        xs[i] = x[i] + h * xs[i]
-
-
-@inline_kernel
-def _interpolate(F, x_old, theta, comps, nc, out):
-    """DOP853's dense output at θ ∈ [0, 1] of the step (scipy's Dop853DenseOutput)."""
-    rows = F.shape[0]
-    for c in range(nc):
-        i = comps[c]
-        v = 0.0
-        for r in range(rows - 1, -1, -1):
-            v += F[r, i]
-            v *= theta if (rows - 1 - r) % 2 == 0 else 1.0 - theta
-        out[i] = v + x_old[i]
-
-
-@kernel
-def _root(kind, j, ga, gb, F, x_old, piece, impact, xt):
+@kernel(refcounted=False)
+def _root(kind, j, ga, gb, F, x_old, piece, impact, xt, full):
     """θ ∈ [0, 1] where the event's value on the dense output crosses zero (Illinois' regula
-    falsi until the bracket is 4 ulp wide), on the far side of the crossing."""
+    falsi until the bracket is 4 ulp wide), on the far side of the crossing; ``xt`` and
+    ``full`` are scratch (components, full state)."""
     k, live, nlive, comps, nc, level = piece
     indptr, indices, data, gamma0, law = impact
     if ga == 0.0:
@@ -95,8 +68,9 @@ def _root(kind, j, ga, gb, F, x_old, piece, impact, xt):
         c = (a * gb - b * ga) / (gb - ga)
         if not a < c < b:
             c = 0.5 * (a + b)
-        _interpolate(F, x_old, c, comps, nc, xt)
-        gc = event_value(kind, j, k, xt, level, live, nlive, law, indptr, indices, data,
+        interpolate(F, x_old, c, nc, xt)
+        scatter(xt, comps, nc, full)
+        gc = event_value(kind, j, k, full, level, live, nlive, law, indptr, indices, data,
                          gamma0)
         if gc == 0.0:
             return c
@@ -115,36 +89,21 @@ def _root(kind, j, ga, gb, F, x_old, piece, impact, xt):
     return b
 
 
-@kernel
-def _rk_step(x, h, piece, impact, tableau, stages, out):
-    """One DOP853 step of length h from x (K[0] = its rates) into ``out``, stages into K."""
-    k, live, nlive, comps, nc = piece.k, piece.live, piece.nlive, piece.comps, piece.nc
-    indptr, indices, data, gamma0, law = impact
-    A, B = tableau.A, tableau.B
-    K, xs, gamma = stages
-    for s in range(1, 12):
-        _stage(K, A, s, x, h, comps, nc, xs)
-        rates(xs, k, live, nlive, indptr, indices, data, gamma0, law, gamma, K[s])
-    _combine(K, B, 12, comps, nc, out)
-    for c in range(nc):
-        i = comps[c]
-        out[i] = x[i] + h * out[i]
-
-
-@kernel
-def _step_to_kink(x, tau, kind, j, g0, piece, impact, tableau, stages, out, istate):
-    """The state where a kink of the rates (a turn, a plastic stop) lies, into ``out``: the
-    dense output of the step that crossed it is polluted by the stages past it, so the
-    kink is reached by real steps from x, whose stages see only the rates before it; their
-    length τ (first guess from the dense output) is refined by the secant method on the
-    event's value (docs/theory.md §13)."""
+@kernel(refcounted=False)
+def _step_to_kink(x, tau, kind, j, g0, piece, impact, tableau, stages, out, full, istate):
+    """The state where a kink of the rates (a turn, a plastic stop) lies, into ``out``
+    (components; ``full`` the full state): the dense output of the step that crossed it is
+    polluted by the stages past it, so the kink is reached by real steps from x, whose
+    stages see only the rates before it; their length τ (first guess from the dense output)
+    is refined by the secant method on the event's value (docs/theory.md §13)."""
     k, live, nlive, level = piece.k, piece.live, piece.nlive, piece.level
     indptr, indices, data, gamma0, law = impact
     t0, ga = 0.0, g0
     for _ in range(KINK_ITERATIONS):
-        _rk_step(x, tau, piece, impact, tableau, stages, out)
+        rk_step(x, tau, piece, impact, tableau, stages, out)
+        scatter(out, piece.comps, piece.nc, full)
         istate[EVALUATIONS] += 11
-        g = event_value(kind, j, k, out, level, live, nlive, law, indptr, indices, data,
+        g = event_value(kind, j, k, full, level, live, nlive, law, indptr, indices, data,
                         gamma0)
         if g == 0.0 or g == ga:
             return
@@ -153,147 +112,128 @@ def _step_to_kink(x, tau, kind, j, g0, piece, impact, tableau, stages, out, ista
             return
 
 
-@kernel
-def _piece(x, k, live, nlive, events, rtol, fixed, max_steps, impact, tableau, istate, fstate,
-           work):
+@inline_kernel
+def _next_step(h, norm, rejected, predict, h_prev, norm_prev):
+    """The next step after an accepted one of length h and error ``norm`` (< 1): scipy's
+    factor, and, with ``predict`` and an accepted step (h_prev, norm_prev) before it in the
+    piece, no more than Gustafsson's predictive factor (the error's growth along the piece
+    extrapolated from the two steps)."""
+    factor = MAX_FACTOR if norm == 0.0 else min(MAX_FACTOR, SAFETY * norm ** EXPONENT)
+    if predict and norm > 0.0 and norm_prev > 0.0:
+        factor = min(factor, max(MIN_FACTOR, SAFETY * norm ** EXPONENT * (h / h_prev)
+                                 * (norm_prev / norm) ** (-EXPONENT)))
+    return h * (min(1.0, factor) if rejected else factor)
+
+
+@inline_kernel
+def _piece(x, k, live, nlive, events, rtol, fixed, h_start, max_steps, impact, tableau,
+           istate, fstate, work):
     """Integrate one piece from x until its first event (against time when k < 0), x
     replaced by the state there. Returns (status, index of the event or −1 at the end of
-    the span). DOP853 with scipy's step-size control at rtol = atol, or, with ``fixed``
-    > 0, steps of that length without error control; every step's error estimate (scipy's
-    RMS over all 3m components, relative to 1 + |x|) is added to fstate[ERROR]."""
-    indptr, indices, data, gamma0, law = impact
-    A, E3, E5, Dd = tableau.A, tableau.E3, tableau.E5, tableau.D
+    the span, the step proposed next). DOP853 at rtol = atol (scipy's error norm, scale
+    rtol·(1 + |x|), step control :func:`_next_step`) from h_start (0: scipy's first guess),
+    or, with ``fixed`` > 0, steps of that length without error control; every step's error
+    estimate is added to fstate[ERROR]."""
     kinds, contacts, directions, ne = events
-    m = gamma0.size
+    m = impact.gamma0.size
     n = 3 * m
-    K, xs, x_new, gamma, g_old, g_new, F, xt, comps, e5, e3 = work
-    stages = Stages(K, xs, gamma)
+    stages, xc, x_new, x_try, e5, e3, F, full_new, full_try, g_old, g_new, comps = work
+    K = stages.K
     nc = 3 * nlive
     for a in range(nlive):
         for r in range(3):
             comps[3 * a + r] = r * m + live[a]
-    K[:, :] = 0.0  # the frozen components' rates stay zero
-    xs[:] = x
-    x_new[:] = x
-    xt[:] = x
-    safety, min_factor, max_factor, exponent = 0.9, 0.2, 10.0, -1.0 / 8.0
+    for i in range(n):  # the frozen components, which the rates and events read, stay x's
+        stages.xs[i] = x[i]
+        full_new[i] = x[i]
+        full_try[i] = x[i]
+    for c in range(nc):
+        xc[c] = x[comps[c]]
     t = 0.0
-    h_abs = fixed if fixed > 0.0 else FIRST_STEP * PIECE_SPAN
-    rates(x, k, live, nlive, indptr, indices, data, gamma0, law, gamma, K[0])
+    h_abs = fixed if fixed > 0.0 else (h_start if h_start > 0.0 else FIRST_STEP * PIECE_SPAN)
+    h_prev, norm_prev = 0.0, 0.0
+    piece = Piece(k, live, nlive, comps, nc, fstate[LEVEL])
+    evaluate(xc, piece, impact, stages, K[0])
     istate[EVALUATIONS] += 1
-    level = fstate[LEVEL]
-    piece = Piece(k, live, nlive, comps, nc, level)
-    for e in range(ne):
-        g_old[e] = event_value(kinds[e], contacts[e], k, x, level, live, nlive, law, indptr,
-                               indices, data, gamma0)
+    event_values(events, k, x, piece.level, live, nlive, impact, g_old)
     while True:
         if istate[STEPS] >= max_steps:
-            return OUT_OF_STEPS, -1
+            return OUT_OF_STEPS, -1, h_abs
         min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
         h_abs = max(h_abs, min_step) if fixed <= 0.0 else fixed
         rejected = False
         while True:
             if h_abs < min_step:
-                return STEP_TOO_SMALL, -1
+                return STEP_TOO_SMALL, -1, h_abs
             t_new = min(t + h_abs, PIECE_SPAN)
             h = t_new - t
-            _rk_step(x, h, piece, impact, tableau, stages, x_new)
-            rates(x_new, k, live, nlive, indptr, indices, data, gamma0, law, gamma, K[12])
+            rk_step(xc, h, piece, impact, tableau, stages, x_new)
+            evaluate(x_new, piece, impact, stages, K[12])
             istate[EVALUATIONS] += 12
-            _combine(K, E5, 13, comps, nc, e5)
-            _combine(K, E3, 13, comps, nc, e3)
-            err5, err3 = 0.0, 0.0
-            for c in range(nc):
-                i = comps[c]
-                scale = 1.0 + max(abs(x[i]), abs(x_new[i]))
-                err5 += (e5[i] / scale) ** 2
-                err3 += (e3[i] / scale) ** 2
-            unit = 0.0 if err5 == 0.0 and err3 == 0.0 else \
-                h * err5 / np.sqrt((err5 + 0.01 * err3) * n)
+            unit = error_norm(xc, x_new, h, nc, n, tableau, K, e5, e3)
             if fixed > 0.0:
                 break
-            norm = unit / rtol  # scipy's error norm, scale rtol·(1 + |x|)
+            norm = unit / rtol
             if norm < 1.0:
-                factor = max_factor if norm == 0.0 else \
-                    min(max_factor, safety * norm ** exponent)
-                h_abs = h * (min(1.0, factor) if rejected else factor)
+                h_abs = _next_step(h, norm, rejected, k >= 0, h_prev, norm_prev)
+                h_prev, norm_prev = h, norm
                 break
-            h_abs = h * max(min_factor, safety * norm ** exponent)
+            h_abs = h * max(MIN_FACTOR, SAFETY * norm ** EXPONENT)
             rejected = True
         istate[STEPS] += 1
         fstate[ERROR] += unit
+        scatter(x_new, comps, nc, full_new)
+        event_values(events, k, full_new, piece.level, live, nlive, impact, g_new)
         first, first_theta, dense = -1, 2.0, False
         for e in range(ne):  # sign changes over the step, in the event's direction
-            g_new[e] = event_value(kinds[e], contacts[e], k, x_new, level, live, nlive, law,
-                                   indptr, indices, data, gamma0)
             up = g_old[e] <= 0.0 <= g_new[e]
             down = g_old[e] >= 0.0 >= g_new[e]
             if not ((up and directions[e] > 0.0) or (down and directions[e] < 0.0)):
                 continue
-            if not dense:  # the dense output of the step: three more stages
-                for s in range(13, 16):
-                    _stage(K, A, s, x, h, comps, nc, xs)
-                    rates(xs, k, live, nlive, indptr, indices, data, gamma0, law, gamma, K[s])
+            if not dense:
+                dense_output(xc, x_new, h, piece, impact, tableau, stages, F)
                 istate[EVALUATIONS] += 3
-                for r in range(4):
-                    _combine(K, Dd[r], 16, comps, nc, F[3 + r])
-                for c in range(nc):
-                    i = comps[c]
-                    delta = x_new[i] - x[i]
-                    F[0, i] = delta
-                    F[1, i] = h * K[0, i] - delta
-                    F[2, i] = 2.0 * delta - h * (K[12, i] + K[0, i])
-                    for r in range(3, 7):
-                        F[r, i] *= h
                 dense = True
-            theta = _root(kinds[e], contacts[e], g_old[e], g_new[e], F, x, piece, impact, xt)
+            theta = _root(kinds[e], contacts[e], g_old[e], g_new[e], F, xc, piece, impact,
+                          x_try, full_try)
             if theta < first_theta:
                 first, first_theta = e, theta
         if first >= 0:
             if kinds[first] == TURN or kinds[first] == PLASTIC_STOP:
-                _step_to_kink(x, h * first_theta, kinds[first], contacts[first], g_old[first],
-                              piece, impact, tableau, stages, xt, istate)
+                _step_to_kink(xc, h * first_theta, kinds[first], contacts[first], g_old[first],
+                              piece, impact, tableau, stages, x_try, full_try, istate)
             else:
-                _interpolate(F, x, first_theta, comps, nc, xt)
-            for c in range(nc):
-                x[comps[c]] = xt[comps[c]]
-            return DONE, first
+                interpolate(F, xc, first_theta, nc, x_try)
+            scatter(x_try, comps, nc, x)
+            return DONE, first, h_abs
         for c in range(nc):
-            i = comps[c]
-            x[i] = x_new[i]
-            K[0, i] = K[12, i]
+            xc[c] = x_new[c]
+            K[0, c] = K[12, c]
         for e in range(ne):
             g_old[e] = g_new[e]
         t = t_new
         if t >= PIECE_SPAN:
-            return DONE, -1
+            scatter(xc, comps, nc, x)
+            return DONE, -1, h_abs
 
 
-@kernel
+@kernel(refcounted=False)
 def integrate_impact(impact, tableau, rtol, max_steps, max_pieces, y, P, D, left, istate,
-                     fstate, primaries):
+                     fstate, primaries, buffers, work):
     """Integrate one multiple ``impact`` (:class:`~impactqp.kernels.lzb_model.Impact`) with
     DOP853's ``tableau`` (:class:`~impactqp.kernels.lzb_groups.Tableau`) piece by piece
     until every contact is open (docs/theory.md §13): y, P, D and ``left`` (energy still
     stored when a contact opened) updated in place, the primary contact of each piece into
     ``primaries`` (max_pieces + 1 entries), counters into ``istate``/``fstate``
-    (:func:`impactqp.kernels.lzb_model.new_state`). fstate[FIXED_STEP] > 0 takes fixed
+    (:func:`impactqp.kernels.lzb_model.new_state`), ``buffers`` and ``work`` the pieces'
+    scratch (:func:`impactqp.kernels.lzb_groups.piece_buffers`, :func:`piece_work
+    <impactqp.kernels.lzb_groups.piece_work>`). fstate[FIXED_STEP] > 0 takes fixed
     steps of that (dimensionless) length in the primary impulse, the pieces against time
     staying adaptive. Returns DONE, OUT_OF_STEPS (``max_steps`` accepted steps spent),
     OUT_OF_PIECES or STEP_TOO_SMALL."""
     indptr, indices, data, gamma0, law = impact
-    m = gamma0.size
-    n = 3 * m
-    work = (np.zeros((16, n)), np.empty(n), np.empty(n), np.zeros(m), np.empty(3 * m + 3),
-            np.empty(3 * m + 3), np.zeros((7, n)), np.empty(n), np.empty(n, dtype=np.int64),
-            np.empty(n), np.empty(n))
-    frozen = np.zeros(m, dtype=np.bool_)
-    live = np.empty(m, dtype=np.int64)
-    gamma = np.empty(m)
-    kinds = np.empty(3 * m + 3, dtype=np.int64)
-    contacts = np.empty(3 * m + 3, dtype=np.int64)
-    directions = np.empty(3 * m + 3)
-    x = np.empty(n)
+    frozen, live, gamma, kinds, contacts, directions, x = buffers
+    h_next, k_last = 0.0, -1
     while True:
         primary = begin_piece(y, P, D, frozen, gamma, istate, fstate, law, indptr, indices,
                               data, gamma0)
@@ -308,8 +248,11 @@ def integrate_impact(impact, tableau, rtol, max_steps, max_pieces, y, P, D, left
         piece_state(y, P, D, k, law, x)
         before = P[primary]
         fixed = fstate[FIXED_STEP] if k >= 0 else 0.0
-        status, fired = _piece(x, k, live, nlive, PieceEvents(kinds, contacts, directions, ne),
-                               rtol, fixed, max_steps, impact, tableau, istate, fstate, work)
+        start = h_next if k >= 0 and k_last >= 0 else 0.0
+        status, fired, h_next = _piece(x, k, live, nlive,
+                                       PieceEvents(kinds, contacts, directions, ne), rtol, fixed,
+                                       start, max_steps, impact, tableau, istate, fstate, work)
+        k_last = k
         if status != DONE:
             return status
         kind = kinds[fired] if fired >= 0 else -1

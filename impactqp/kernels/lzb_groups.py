@@ -76,21 +76,110 @@ class PieceEvents(NamedTuple):
 
 
 class Stages(NamedTuple):
-    """Scratch of one DOP853 step over 3m components.
+    """Scratch of one DOP853 step of a piece. The step works on the piece's components
+    c < nc (contiguous, ``comps[c]`` their places in x = (z, P, D)); the rates read and
+    write the full 3m entries.
 
     Attributes
     ----------
     K : (16, 3m) float array
-        The stages' rates (K[0] the rates at the step's start).
+        The stages' rates on the components, K[q, c] (K[0] the rates at the step's start).
     xs : (3m,) float array
-        The state of the stage being evaluated.
+        The full state of the stage being evaluated (the frozen components stay x's).
     gamma : (m,) float array
         The contact velocities of the last evaluation.
+    xc : (3m,) float array
+        The components of the stage being evaluated.
+    rate : (3m,) float array
+        The full rates of the last evaluation.
     """
 
     K: np.ndarray
     xs: np.ndarray
     gamma: np.ndarray
+    xc: np.ndarray
+    rate: np.ndarray
+
+
+class PieceWork(NamedTuple):
+    """Scratch of one piece (:func:`impactqp.kernels.lzb.integrate_impact` allocates it once
+    per impact): the step's :class:`Stages`, then, on the piece's components c < nc,
+    the state, the step's end, a trial state and the dense output, and, in full, the states
+    the events read.
+
+    Attributes
+    ----------
+    stages : Stages
+    x, x_new, x_try : (3m,) float arrays
+        The state at the step's start and end, a state inside the step (components).
+    e5, e3 : (3m,) float arrays
+        The step's error estimates (components).
+    F : (7, 3m) float array
+        The step's dense output (components).
+    full_new, full_try : (3m,) float arrays
+        x_new and x_try in full, for the events.
+    g_old, g_new : (3m + 3,) float arrays
+        The events' values at the step's start and end.
+    comps : (3m,) int array
+        The places of the components in x.
+    """
+
+    stages: Stages
+    x: np.ndarray
+    x_new: np.ndarray
+    x_try: np.ndarray
+    e5: np.ndarray
+    e3: np.ndarray
+    F: np.ndarray
+    full_new: np.ndarray
+    full_try: np.ndarray
+    g_old: np.ndarray
+    g_new: np.ndarray
+    comps: np.ndarray
+
+
+def piece_work(m: int) -> PieceWork:
+    """The :class:`PieceWork` of an impact of m contacts."""
+    n = 3 * m
+    stages = Stages(np.zeros((16, n)), np.empty(n), np.zeros(m), np.empty(n), np.zeros(n))
+    return PieceWork(stages, np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
+                     np.zeros((7, n)), np.empty(n), np.empty(n), np.empty(n + 3),
+                     np.empty(n + 3), np.empty(n, dtype=np.int64))
+
+
+class PieceBuffers(NamedTuple):
+    """What the piece-by-piece logic of :func:`impactqp.kernels.lzb.integrate_impact` keeps
+    between pieces (:mod:`impactqp.kernels.lzb_model`).
+
+    Attributes
+    ----------
+    frozen : (m,) bool array
+        The open contacts.
+    live : (m,) int array
+        The others, ``live[:nlive]``.
+    gamma : (m,) float array
+        The contact velocities at the start of the piece.
+    kinds, contacts, directions : (3m + 3,) int, int, float arrays
+        The piece's events (:class:`PieceEvents`).
+    x : (3m,) float array
+        The state x = (z, P, D) of the piece.
+    """
+
+    frozen: np.ndarray
+    live: np.ndarray
+    gamma: np.ndarray
+    kinds: np.ndarray
+    contacts: np.ndarray
+    directions: np.ndarray
+    x: np.ndarray
+
+
+def piece_buffers(m: int) -> PieceBuffers:
+    """The :class:`PieceBuffers` of an impact of m contacts."""
+    return PieceBuffers(np.zeros(m, dtype=np.bool_), np.empty(m, dtype=np.int64), np.empty(m),
+                        np.empty(3 * m + 3, dtype=np.int64),
+                        np.empty(3 * m + 3, dtype=np.int64), np.empty(3 * m + 3),
+                        np.empty(3 * m))
 
 
 def dop853_tableau() -> Tableau:

@@ -29,7 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .jit import inline_kernel, kernel
+from .jit import kernel
 
 TINY = 1e-30
 """Floor of the primary contact's dimensionless force: its energy is zero only at the event
@@ -93,7 +93,7 @@ def new_state() -> tuple[np.ndarray, np.ndarray]:
     return istate, np.zeros(4)
 
 
-@inline_kernel
+@kernel(refcounted=False)
 def _gamma_row(indptr, indices, data, gamma0, P, i):
     """γᵢ = γ⁻ᵢ + (GP)ᵢ."""
     s = gamma0[i]
@@ -102,7 +102,7 @@ def _gamma_row(indptr, indices, data, gamma0, P, i):
     return s
 
 
-@inline_kernel
+@kernel(refcounted=False)
 def _power(y, a):
     """y^a for y ≥ 0, without the general power where a is a Hertz or linear exponent."""
     if a == 1.0:
@@ -118,20 +118,20 @@ def _power(y, a):
     return y ** a
 
 
-@inline_kernel
+@kernel(refcounted=False)
 def _energy(y, eta):
     """E = max(y, 0)^(η+1)."""
     return _power(y, eta + 1.0) if y > 0.0 else 0.0
 
 
-@kernel
+@kernel(refcounted=False)
 def contact_velocities(indptr, indices, data, gamma0, P, out):
     """γ = γ⁻ + GP into ``out``."""
     for i in range(gamma0.size):
         out[i] = _gamma_row(indptr, indices, data, gamma0, P, i)
 
 
-@kernel
+@kernel(refcounted=False)
 def rates(x, k, live, nlive, indptr, indices, data, gamma0, law, gamma, out):
     """dx of the state x = (z, P, D) against time (k < 0) or against the impulse of the
     primary contact k (docs/theory.md §13), for the contacts ``live[:nlive]`` into ``out``
@@ -173,7 +173,7 @@ def rates(x, k, live, nlive, indptr, indices, data, gamma0, law, gamma, out):
             out[2 * m + k] = (law[EXPANSION, k] - 1.0) * g
 
 
-@kernel
+@kernel(refcounted=False)
 def begin_piece(y, P, D, frozen, gamma, istate, fstate, law, indptr, indices, data, gamma0):
     """Start the next piece: empty the plastic contacts past compression (their energy is
     dissipated), mark the open contacts ``frozen``, set the energy level and whether the
@@ -213,7 +213,7 @@ def begin_piece(y, P, D, frozen, gamma, istate, fstate, law, indptr, indices, da
     return k
 
 
-@kernel
+@kernel(refcounted=False)
 def piece_events(k, frozen, gamma, law, indptr, indices, kinds, contacts, directions, live):
     """The events that end a piece with primary k (k < 0: against time), into ``kinds``,
     ``contacts`` and ``directions`` (−1: the value falls through 0, +1: rises), and the
@@ -256,7 +256,7 @@ def piece_events(k, frozen, gamma, law, indptr, indices, kinds, contacts, direct
     return n, nlive
 
 
-@kernel
+@kernel(refcounted=False)
 def event_value(kind, j, k, x, level, live, nlive, law, indptr, indices, data, gamma0):
     """The function whose zero is event ``kind`` of contact j, at state x of a piece with
     primary k (k < 0: against time) and contacts ``live[:nlive]`` (the others store
@@ -287,7 +287,17 @@ def event_value(kind, j, k, x, level, live, nlive, law, indptr, indices, data, g
     return g  # TURN
 
 
-@kernel
+@kernel(refcounted=False)
+def event_values(events, k, x, level, live, nlive, impact, out):
+    """out[e] = :func:`event_value` of each of a piece's ``events``
+    (:class:`~impactqp.kernels.lzb_groups.PieceEvents`) at x."""
+    indptr, indices, data, gamma0, law = impact
+    for e in range(events.n):
+        out[e] = event_value(events.kinds[e], events.contacts[e], k, x, level, live, nlive,
+                             law, indptr, indices, data, gamma0)
+
+
+@kernel(refcounted=False)
 def piece_state(y, P, D, k, law, x):
     """x = (z, P, D) at the start of a piece: z = y, with zₖ = Eₖ against Pₖ (k ≥ 0)."""
     m = y.size
@@ -299,7 +309,7 @@ def piece_state(y, P, D, k, law, x):
         x[k] = _energy(y[k], law[ETA, k])
 
 
-@kernel
+@kernel(refcounted=False)
 def end_piece(kind, j, k, primary, before, x, y, P, D, left, istate, fstate, law):
     """Take the state x at the end of a piece with rates against ``k`` (−1: time) and apply
     the event ``kind`` of contact j that ended it (−1: none): an opened contact keeps the
@@ -336,7 +346,7 @@ def end_piece(kind, j, k, primary, before, x, y, P, D, left, istate, fstate, law
     fstate[IMPULSE_VARIABLE] += P[primary] - before
 
 
-@kernel
+@kernel(refcounted=False)
 def stored_energies(y, law, out):
     """out += Eᵢ = max(yᵢ, 0)^(ηᵢ+1): what the contacts still store at the end."""
     for i in range(y.size):

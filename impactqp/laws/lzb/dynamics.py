@@ -32,6 +32,7 @@ from ...kernels.lzb_model import (
     Impact,
     contact_velocities,
 )
+from ...model.structure import ImpactStructure
 
 
 def log_force_coefficient(stiffness: np.ndarray, exponent: np.ndarray) -> np.ndarray:
@@ -50,6 +51,22 @@ def log_force_coefficient(stiffness: np.ndarray, exponent: np.ndarray) -> np.nda
         log c = η/(η+1) log(η+1) + log(K)/(η+1).
     """
     return (exponent * np.log(exponent + 1.0) + np.log(stiffness)) / (exponent + 1.0)
+
+
+def delassus_rows(structure: ImpactStructure) -> Matrix:
+    """G = WᵀM⁻¹W as the LZB integration takes it (docs/theory.md §1, §5): a chain's is
+    tridiagonal and is formed from its masses in O(N), as a sparse matrix (its diagonal is
+    :attr:`~impactqp.model.structure.ImpactStructure.delassus_diagonal`; neighbouring
+    contacts share the ball between them, −1/m of it); any other structure's is its
+    :attr:`~impactqp.model.structure.ImpactStructure.delassus`. A chain's dense G would be
+    a product of dense matrices, whose BLAS threads then keep the second core busy while
+    the integration runs."""
+    c = structure.chain
+    if c is None:
+        return structure.delassus
+    lo = int(c.left_wall)
+    off = -structure.inverse_masses[1 - lo:1 - lo + structure.m - 1]
+    return sp.diags([off, structure.delassus_diagonal, off], [-1, 0, 1], format="csr")
 
 
 @dataclass(frozen=True)

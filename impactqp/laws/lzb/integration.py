@@ -32,7 +32,7 @@ from scipy.integrate import solve_ivp
 from ...errors import CertificateError, IntegrationBudgetError
 from ...kernels import lzb_model as kl
 from ...kernels.lzb import integrate_impact
-from ...kernels.lzb_groups import dop853_tableau
+from ...kernels.lzb_groups import dop853_tableau, piece_buffers, piece_work
 from .dynamics import LZBDynamics
 
 MAX_PIECES = 20_000
@@ -261,7 +261,8 @@ def integrate(dyn: LZBDynamics, *, rtol: float, step: float | None,
     else:
         buffer = np.empty(MAX_PIECES + 1, dtype=np.int64)
         status = integrate_impact(dyn.structure, dop853_tableau(), rtol, budget, MAX_PIECES,
-                                  y, P, D, left, istate, fstate, buffer)
+                                  y, P, D, left, istate, fstate, buffer, piece_buffers(m),
+                                  piece_work(m))
         primaries = buffer[:min(int(istate[kl.PIECES]), MAX_PIECES)].tolist()
     if status != kl.DONE:
         raise _budget_error(status, budget, dyn, step, rtol)

@@ -22,7 +22,7 @@ from ...model.problem import ImpactProblem
 from ...model.structure import ImpactStructure
 from ..base import ImpactLaw
 from .certificate import LZB_RESIDUALS, integration_tolerance, lzb_certificate, lzb_residuals
-from .dynamics import LZBDynamics
+from .dynamics import LZBDynamics, delassus_rows
 from .integration import LZBRecord, integrate
 
 DEFAULT_RTOL = 1e-12
@@ -252,7 +252,7 @@ class LZB(ImpactLaw):
         if st.m == 0 or not np.any(gamma < 0):
             return LZBAnswer(u.copy(), np.zeros(st.m), None, None)
         K, eta, e = self.contact_laws(st.m)
-        dyn = LZBDynamics(st.delassus, gamma, K, eta, e)
+        dyn = LZBDynamics(delassus_rows(st), gamma, K, eta, e)
         rtol = self.rtol if self.energy_target is None else first_rtol(self.rtol, st.m)
         while True:
             record = integrate(dyn, rtol=rtol, step=self.step, reference=reference)
