@@ -91,7 +91,7 @@ def auto_order(qp: Any, form: str) -> list[str]:
     they apply; NNLS is exact and fastest on dense impulse forms; PIQP is 3–5× faster than
     Clarabel on sparse impacts of 10⁴ contacts and as accurate after polishing; that order
     depends on the program's shape only, so it is kept per owner and tag."""
-    if form == backends.FRICTION:  # the repairs' place depends on the size (§22)
+    if form == backends.FRICTION:  # the repairs' place depends on the size (docs/theory.md §22)
         return friction_order(backends.AUTO_ORDER[form], qp)
     if form not in backends.FORMS:
         return list(backends.AUTO_ORDER[form])

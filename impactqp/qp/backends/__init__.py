@@ -144,8 +144,8 @@ AUTO_ORDER = {
 quadratic programs' order depends on the program, :func:`impactqp.qp.certified.auto_order`).
 Friction: cheapest where each works first — one compiled call for a few contacts, a short
 NSGS on well-conditioned problems, Newton from r = 0 most of the rest, Newton with local
-repairs where it stalls on a few contacts (§22), the SOCP fixed point the badly conditioned
-ones, the damped and least-squares Newton some rank-deficient ones, a long
+repairs where it stalls on a few contacts (docs/theory.md §22), the SOCP fixed point the
+badly conditioned ones, the damped and least-squares Newton some rank-deficient ones, a long
 NSGS last; the SOCP route, the least-squares Newton and the long NSGS start from the best
 answer so far (docs/theory.md §15, §22)."""
 
