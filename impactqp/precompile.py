@@ -181,7 +181,7 @@ def compile_kernels(progress: Callable[[str, int, int], None] | None = None,
         ``jobs`` > 1, with the stages that finished) and once at the end.
     jobs : int
         Processes compiling at once (``impactqp compile`` uses one per core), each writing
-        to the same cache: two run the groups of :data:`PAIRED`, more the stages one by
+        to the same cache: two run two groups of stages (``PAIRED``), more the stages one by
         one, longest first. 1 compiles in this process (a dask worker, which may not start
         processes of its own).
 
