@@ -13,8 +13,11 @@ import numpy as np
 from .friction import natural_map
 from .jit import inline_kernel
 
-SLIP_SAMPLES = 64
-"""Slip angles at which :func:`sliding_3d` looks for a sign change of its function."""
+SLIP_SAMPLES = 16
+"""Slip angles at which :func:`sliding_3d` looks for a sign change of its function (it has at
+most four roots; two closer than 2π/16 are missed, and the sweeps then solve the contact)."""
+SLIP_STEPS = 60
+"""Most steps of the bracketing root search of :func:`sliding_3d`."""
 
 
 @inline_kernel
@@ -31,15 +34,42 @@ def _slip(Wc, base, mu, theta):
 
 
 @inline_kernel
+def _root(Wc, base, mu, a, b, g_a, g_b):
+    """A root of the slip function in [a, b], where it changes sign, by regula falsi with
+    the Illinois rule (the retained end's value halved), to the floats' resolution."""
+    side = 0
+    for _ in range(SLIP_STEPS):
+        mid = (a * g_b - b * g_a) / (g_b - g_a)
+        if not a < mid < b:
+            mid = 0.5 * (a + b)
+            if not a < mid < b:
+                break
+        g_mid, _, _ = _slip(Wc, base, mu, mid)
+        if g_mid == 0.0:
+            return mid
+        if (g_mid < 0.0) == (g_a < 0.0):
+            a, g_a = mid, g_mid
+            if side == -1:
+                g_b *= 0.5
+            side = -1
+        else:
+            b, g_b = mid, g_mid
+            if side == 1:
+                g_a *= 0.5
+            side = 1
+    return a if abs(g_a) < abs(g_b) else b
+
+
+@inline_kernel
 def sliding_3d(Wc, base, mu, out):
     """A 3-D contact's local problem u = W_cc r + b solved sliding, where it slides
     (docs/theory.md §15): r = r_n(1, −μ cos θ, −μ sin θ) with u_n = 0, so
     r_n = −b_n/a(θ), a(θ) = W_nn − μ(W_n1 cos θ + W_n2 sin θ), and u_t parallel to
     e = (cos θ, sin θ) with e·u_t > 0: a root of G(θ) = e × (a·u_t), a trigonometric
-    polynomial of degree 2 (at most four roots), found by a sign change among
-    :data:`SLIP_SAMPLES` angles and bisection to the floats' resolution. The first root with
-    a > 0 and e·u_t > 0 is written into ``out[0:3]``. Returns False (``out`` untouched)
-    where b_n ≥ 0 or no such root is found (a double root, or no sliding solution)."""
+    polynomial of degree 2 (at most four roots), bracketed by a sign change among
+    :data:`SLIP_SAMPLES` angles (:func:`_root`). The first root with a > 0 and e·u_t > 0 is
+    written into ``out[0:3]``. Returns False (``out`` untouched) where b_n ≥ 0 or no such
+    root is found (a double root, or no sliding solution)."""
     if not base[0] < 0.0 or not mu > 0.0:
         return False
     step = 2.0 * math.pi / SLIP_SAMPLES
@@ -49,21 +79,7 @@ def sliding_3d(Wc, base, mu, out):
         hi = k * step
         g_hi, _, _ = _slip(Wc, base, mu, hi)
         if g_lo == 0.0 or (g_lo < 0.0) != (g_hi < 0.0):
-            a, b = lo, hi
-            g_a = g_lo
-            for _ in range(60):
-                mid = 0.5 * (a + b)
-                if not a < mid < b:
-                    break
-                g_mid, _, _ = _slip(Wc, base, mu, mid)
-                if g_mid == 0.0:
-                    a = b = mid
-                    break
-                if (g_mid < 0.0) == (g_a < 0.0):
-                    a, g_a = mid, g_mid
-                else:
-                    b = mid
-            theta = 0.5 * (a + b)
+            theta = lo if g_lo == 0.0 else _root(Wc, base, mu, lo, hi, g_lo, g_hi)
             _, slope, along = _slip(Wc, base, mu, theta)
             if slope > 0.0 and along > 0.0:
                 rn = -base[0] / slope
@@ -100,4 +116,4 @@ def sliding_alone(indptr, indices, data, q, mu, r, err):
     return found
 
 
-__all__ = ["SLIP_SAMPLES", "sliding_3d", "sliding_alone"]
+__all__ = ["SLIP_SAMPLES", "SLIP_STEPS", "sliding_3d", "sliding_alone"]
