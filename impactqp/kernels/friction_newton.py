@@ -288,10 +288,10 @@ at a time, where the rate of the last ones does not promise round-off within
 :data:`FIRST_SWEEPS`: the sweeps of LMGC-00046 (9 contacts) speed up, 2e-1, 1.6e-2, 9e-5,
 2e-12, 7e-15 (a rate of 0.08, then 0.006), those of the problems Newton solves sooner keep
 0.12 (sliding single contacts) to 0.95 of ‖F‖ from the second sweep on."""
-SWEEP_GATE = 1e-7
+SWEEP_GATE = 1e-6
 """‖F‖/‖q‖ within which the first sweep is followed by a second whatever Newton's cost: the
-first sweep ends at 2e-10…2e-7 on the FCLib problems of a few contacts whose sweeps reach
-round-off soon (CubeH8, FC3D-1c, FC3D-Example1, Confeti-ex13-4c, TwoRods1-condensed), at
+first sweep ends at 2e-10…2.1e-7 on the FCLib problems of a few contacts whose sweeps reach
+tol/2 soon (CubeH8, FC3D-1c, FC3D-Example1, Confeti-ex13-4c, TwoRods1-condensed), at
 1e-2…2e-1 on the rest. Beyond it the second is taken only where a dense Newton step costs
 :data:`FIRST_SWEEPS` sweeps or more (:func:`sweep_budget`: LMGC-00046, 9 dense 3-D contacts,
 about 17; the Rover problems of 2–5 contacts, which Newton solves, 2–8)."""
