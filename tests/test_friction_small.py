@@ -185,3 +185,63 @@ def test_the_benchmark_table_judges_each_target() -> None:
     assert "Targets met on 2 of 4 problems." in text
     assert "| a | 1 | 3 | 11.0 µs (1e-16) | 2.0 µs (ok) | +9.0 µs | 5.50 |" in text
     assert "| b | 1 | 3 | 13.0 µs (1e-16) | 2.0 µs (ok) | +11.0 µs | 6.50 | t | no |" in text
+
+
+@pytest.mark.parametrize("name, iterations", [("LMGC-00046", 5), ("TwoRods1-condensed", 3),
+                                              ("Confeti-ex13-4c", 3)])
+def test_fast_sweeps_and_the_newton_polish_agree_with_the_general_route(
+        name: str, iterations: int) -> None:
+    """Sweeps that speed up are taken on (LMGC-00046: five sweeps to round-off, no Newton
+    step), sweeps within tol/2 whose rate is slow end in one Newton step from their answer
+    (TwoRods1-condensed, Confeti-ex13-4c: two sweeps and one step), not in the method whole
+    from r = 0; the answer is the general route's and the ``"kernel"`` method's, to
+    round-off."""
+    problem = friction_data.load(name).problem
+    fast = iq.solve_friction(problem, tol=TOL)
+    assert type(fast) is SmallFrictionResult and fast.iterations == iterations
+    assert fast.error <= 1e-12
+    same_answer(fast, general_route(problem), problem, TOL)
+    same_answer(fast, iq.solve_friction(problem, tol=TOL, backend="kernel"), problem, TOL)
+
+
+@pytest.mark.parametrize("name", ["FC3D-RR-1c", "Rover11035", "Rover11211", "CubeH8",
+                                  "FC3D-1c"])
+def test_one_sliding_contact_is_solved_by_its_slip_angle(name: str) -> None:
+    """A single 3-D contact the first sweep leaves sliding is solved by the root of its
+    slip function, to round-off with no sweep more: the general route's answer, certified
+    independently."""
+    problem = friction_data.load(name).problem
+    fast = iq.solve_friction(problem, tol=TOL)
+    assert type(fast) is SmallFrictionResult and fast.iterations == 1
+    assert fast.error <= 1e-14
+    rn, rt = fast.r[0], np.linalg.norm(fast.r[1:])
+    assert rn > 0.0 and rt == pytest.approx(problem.mu[0] * rn, rel=1e-12)  # on the rim
+    same_answer(fast, general_route(problem), problem, TOL)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_the_slip_angle_root_solves_random_sliding_contacts(seed: int) -> None:
+    """sliding_3d on a contact that neither separates nor sticks (W_cc symmetric positive
+    definite: the local problem has one solution, hence a sliding one): it finds the root,
+    r lies on the cone's rim, u_n = 0, u_t opposes r_t, and the natural map of that answer,
+    computed apart, vanishes to round-off."""
+    from impactqp.kernels.friction import natural_map
+    from impactqp.kernels.friction_blocks import sticking
+    from impactqp.kernels.friction_slip import sliding_3d
+
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((3, 3))
+    Wc = A @ A.T + 0.1 * np.eye(3)
+    base = rng.standard_normal(3)
+    base[0] = -abs(base[0])
+    mu = float(rng.uniform(0.05, 1.5))
+    r = np.empty(3)
+    if sticking(Wc, base, mu, 3, r):
+        return  # the sticking answer, checked by the files above
+    assert sliding_3d(Wc, base, mu, r)
+    u = Wc @ r + base
+    assert r[0] > 0.0 and np.hypot(r[1], r[2]) == pytest.approx(mu * r[0], rel=1e-12)
+    assert abs(u[0]) <= 1e-12 * (np.abs(Wc).max() * r[0] + abs(base[0]))
+    assert u[1] * r[1] + u[2] * r[2] < 0.0
+    F = natural_map(r, u, np.array([mu]), 3)
+    assert np.linalg.norm(F) <= 1e-12 * (np.linalg.norm(base) + np.linalg.norm(r))

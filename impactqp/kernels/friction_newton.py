@@ -177,11 +177,11 @@ def _accept(W, q, mu, d, r, tol):
 
 ROUND_OFF = 1e-14
 """‖F‖/‖q‖ below which the sweeps' answer is kept as it is; above it, Newton takes one step
-from it and keeps it when better (:func:`_to_round_off`)."""
+from it and keeps it when better (:func:`to_round_off`)."""
 
 
 @kernel
-def _to_round_off(W, q, mu, rho, d, r, tol):
+def to_round_off(W, q, mu, rho, d, r, tol):
     """One Newton step from the sweeps' r (within tol/2), kept when it is better, unless r is
     within :data:`ROUND_OFF` already: as :func:`newton_dense` answers, the few contacts of a
     time step are answered to round-off, not just to the tolerance. Returns the steps."""
@@ -249,7 +249,7 @@ def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
     """A local problem of a few contacts (dense W) in one compiled call, into ``r``: the
     projected Gauss–Seidel on W's nonzero entries while its rate says it finishes within
     ``sweeps`` (:func:`sweeps_first`; its answer taken to round-off by
-    :func:`_to_round_off`), else Newton from r = 0, then the sweeps on from where
+    :func:`to_round_off`), else Newton from r = 0, then the sweeps on from where
     they stopped (``sweeps`` in all) followed by Newton, then the damped Newton (shift factor
     10) from r = 0 — the order of ``auto`` without the cone programs (docs/theory.md §15).
     Returns (iterations, whether the projected r left in ``r`` is within tol/2 in ‖F‖/‖q‖);
@@ -257,7 +257,7 @@ def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
     rows = nonzero_rows(W)
     swept_its = sweeps_first(rows, q, mu, d, r, tol, sweeps, local_iters)
     if _accept(W, q, mu, d, r, tol):
-        return swept_its + _to_round_off(W, q, mu, rho, d, r, tol), True
+        return swept_its + to_round_off(W, q, mu, rho, d, r, tol), True
     swept = r.copy()
     r[:] = 0.0
     steps, ok = newton_dense(W, q, mu, rho, d, r, tol, 1.0, newton_steps)
@@ -270,7 +270,7 @@ def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
                             sweeps - swept_its, local_iters)
         its += done
         if _accept(W, q, mu, d, r, tol):
-            return its + _to_round_off(W, q, mu, rho, d, r, tol), True
+            return its + to_round_off(W, q, mu, rho, d, r, tol), True
     more, ok = newton_dense(W, q, mu, rho, d, r, tol, 1.0, newton_steps)
     its += more
     if ok:
@@ -278,3 +278,72 @@ def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
     r[:] = 0.0
     more, ok = newton_dense(W, q, mu, rho, d, r, tol, 10.0, newton_steps)
     return its + more, ok
+
+
+FIRST_SWEEPS = 12
+"""Most sweeps :func:`sweeps_on` tries before the ``"kernel"`` method whole: while their
+rate says they reach :data:`ROUND_OFF` within this many
+(a sweep of a few contacts costs less than a microsecond, the dense Newton steps the method
+takes a few microseconds: CubeH8 and FC3D-1c, one contact, reach round-off in 5–7 sweeps)."""
+FAST_RATE = 0.1
+"""Most ‖F‖ a sweep may keep of the last one's for :func:`sweeps_on` to sweep on, one sweep
+at a time, where the rate of the last ones does not promise round-off within
+:data:`FIRST_SWEEPS`: the sweeps of LMGC-00046 (9 contacts) speed up, 2e-1, 1.6e-2, 9e-5,
+2e-12, 7e-15 (a rate of 0.08, then 0.006), those of the problems Newton solves sooner keep
+0.12 (sliding single contacts) to 0.95 of ‖F‖ from the second sweep on."""
+SWEEP_GATE = 1e-6
+"""‖F‖/‖q‖ within which the first sweep is followed by a second whatever Newton's cost: the
+first sweep ends at 2e-10…2.1e-7 on the FCLib problems of a few contacts whose sweeps reach
+tol/2 soon (CubeH8, FC3D-1c, FC3D-Example1, Confeti-ex13-4c, TwoRods1-condensed), at
+1e-2…2e-1 on the rest. Beyond it the second is taken only where a dense Newton step costs
+:data:`FIRST_SWEEPS` sweeps or more (:func:`sweep_budget`: LMGC-00046, 9 dense 3-D contacts,
+about 17; the Rover problems of 2–5 contacts, which Newton solves, 2–8)."""
+POLISH_SWEEPS = 2
+"""Most sweeps :func:`sweeps_on` predicts to round-off that it takes once within tol/2;
+beyond them it takes one Newton step on the dense W̃ (TwoRods1-condensed, 3 contacts: within
+tol/2 after 2 sweeps, 5e-12 after 4, then 0.65 of ‖F‖ a sweep)."""
+
+
+@kernel(interpretable=True)
+def sweeps_on(rows, q, mu, d, r, tol, local_iters, done, err):
+    """The projected Gauss–Seidel on W's nonzero ``rows`` (indptr, indices, data) from the
+    answer in ``r`` of ``done`` sweeps, at ‖F‖/‖q‖ = ``err`` (docs/theory.md §15): none
+    where ``err`` is beyond :data:`SWEEP_GATE` and Newton costs less than
+    :data:`FIRST_SWEEPS` sweeps; otherwise more while their rate says they reach
+    :data:`ROUND_OFF` within :data:`FIRST_SWEEPS`, or, one at a time, while each keeps at
+    most :data:`FAST_RATE` of the last one's ‖F‖; once within tol/2, only while at most
+    :data:`POLISH_SWEEPS` are left, and then one Newton step on the dense W
+    (:func:`to_round_off`). Returns (sweeps and steps done, ‖F‖/‖q‖ of the sweeps, at most
+    tol/2 where ``r`` is within it)."""
+    indptr, indices, data = rows
+    ask = np.int64(1)  # an int64, not a literal 1: one compiled sweep
+    last, last_done = np.inf, 0
+    if err > SWEEP_GATE and sweep_budget(q.size, mu.size, indices.size, FIRST_SWEEPS,
+                                         local_iters) < FIRST_SWEEPS:
+        return done, err  # a second sweep costs more than the Newton steps it may spare
+    while ROUND_OFF < err < last and done < FIRST_SWEEPS:
+        if last < np.inf:  # the sweeps left to round-off at the rate of the last ones
+            rate = (err / last) ** (1.0 / (done - last_done))  # per sweep
+            left = np.log(ROUND_OFF / err) / np.log(rate)
+            if err <= 0.5 * tol and left > POLISH_SWEEPS:
+                break  # within tol: one Newton step costs less
+            if done + left <= FIRST_SWEEPS:
+                ask = min(int(left) + 1, FIRST_SWEEPS - done)
+            elif rate <= FAST_RATE:
+                ask = 1
+            else:
+                break
+        more, new = nsgs_rows(indptr, indices, data, q, mu, d, r, ROUND_OFF, ask, local_iters)
+        last, last_done, err = err, done, new
+        done += more
+    if ROUND_OFF < err <= 0.5 * tol:  # within tol: one Newton step to round-off
+        size = q.size
+        dense = np.zeros((size, size))
+        for i in range(size):
+            for p in range(indptr[i], indptr[i + 1]):
+                dense[i, indices[p]] += data[p]
+        diagonal = np.empty(size)
+        for i in range(size):
+            diagonal[i] = dense[i, i]
+        done += to_round_off(dense, q, mu, scales(diagonal, d), d, r, tol)
+    return done, err

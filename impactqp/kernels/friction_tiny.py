@@ -20,24 +20,14 @@ import numpy as np
 
 from .coulomb_certificate import FRICTION_FIGURES, friction_figures
 from .friction import natural_map, nsgs_rows
-from .friction_newton import ROUND_OFF, scales, solve_small
+from .friction_newton import ROUND_OFF, scales, solve_small, sweeps_on
+from .friction_slip import sliding_alone
 from .jit import inline_kernel, kernel
 from .units import contact_units
 
 CERTIFIED, NOT_CERTIFIED, NEEDS_SCALING = 0, 1, 2
 """The outcomes of :func:`solve_tiny`."""
 
-FIRST_SWEEPS = 12
-"""Most sweeps :func:`solve_given` tries before the ``"kernel"`` method whole: while their
-rate says they reach :data:`~impactqp.kernels.friction_newton.ROUND_OFF` within this many
-(a sweep of a few contacts costs less than a microsecond, the dense Newton steps the method
-takes a few microseconds: CubeH8 and FC3D-1c, one contact, reach round-off in 5–7 sweeps)."""
-SWEEP_GATE = 1e-7
-"""‖F‖/‖q̂‖ the first sweep must reach for :func:`solve_given` to sweep on. Measured on the
-FCLib problems of a few contacts: the first sweep ends at 2e-10…2e-8 on those whose sweeps
-reach round-off within :data:`FIRST_SWEEPS` (CubeH8, FC3D-1c, FC3D-Example1,
-Confeti-ex13-4c: 4–7 sweeps), at 2e-7 on TwoRods1-condensed (19 sweeps, where sweeping on
-cost 4 µs before the method whole), at 1e-2…2e-1 on the rest (hundreds)."""
 LOG2_RANGE = (-333, 333)
 """The binary exponents (``math.frexp``) of max|q̂ᵢ|, strictly between these two, for which
 q̂ is posed as it is: those of :data:`impactqp.model.friction.QUANTITY_RANGE`, 1e-100…1e100
@@ -247,12 +237,13 @@ def solve_given(W, rows, q, mu, d, limits, out):
     """Solve and certify a problem of a few contacts, W as the problem holds it (dense or
     compressed), in one call (docs/theory.md §15): posed in its contacts' units by its
     nonzero entries (:func:`_posed`), one sweep of the projected Gauss–Seidel from r = 0
-    (:func:`~impactqp.kernels.friction.nsgs_rows`) and, where it ends within
-    :data:`SWEEP_GATE`, more while their rate says they reach
-    :data:`~impactqp.kernels.friction_newton.ROUND_OFF` within :data:`FIRST_SWEEPS`; their
-    answer is kept where it is within round-off (as the ``"kernel"`` method answers, without
-    the dense W̃ or a Newton step); otherwise, with ``whole``, the method whole by
-    :func:`solve_tiny`. The answer is scaled back (r = r̂/s) and certified from r as given
+    (:func:`~impactqp.kernels.friction.nsgs_rows`; a single 3-D contact it left sliding is
+    solved sliding by its slip angle, :func:`~impactqp.kernels.friction_slip.sliding_alone`),
+    more by :func:`~impactqp.kernels.friction_newton.sweeps_on` while their rate is worth it,
+    ended where needed by one Newton step to round-off (as the ``"kernel"`` method answers,
+    without its restart from r = 0). Their answer is kept where it is within tol/2;
+    otherwise, with ``whole``, the method whole by :func:`solve_tiny`. The answer is scaled
+    back (r = r̂/s) and certified from r as given
     (r̂ = s∘r, û = W̃r̂ + q̂ recomputed, the velocity given u = s∘û: W r + q, the product
     the sweeps' own ‖F‖ did not share).
 
@@ -288,17 +279,12 @@ def solve_given(W, rows, q, mu, d, limits, out):
     ru = np.zeros(size)
     ask = np.int64(1)  # an int64, not a literal 1: one compiled sweep
     done, err = nsgs_rows(indptr, indices, data, qu, mu, d, ru, target, ask, local_iters)
-    last, last_done = np.inf, 0
-    while whole and target < err < min(last, SWEEP_GATE) and done < FIRST_SWEEPS:
-        if last < np.inf:  # the sweeps left to round-off at the rate of the last ones
-            left = np.log(target / err) / np.log(err / last) * (done - last_done)
-            if done + left > FIRST_SWEEPS:
-                break
-            ask = min(int(left) + 1, FIRST_SWEEPS - done)
-        more, new = nsgs_rows(indptr, indices, data, qu, mu, d, ru, target, ask, local_iters)
-        last, last_done, err = err, done, new
-        done += more
-    if err <= target:
+    if whole and err > target and size == 3 and d == 3:  # one contact, sliding
+        err = sliding_alone(indptr, indices, data, qu, mu, ru, err)
+    if whole:
+        done, err = sweeps_on((indptr, indices, data), qu, mu, d, ru, tol, local_iters, done,
+                              err)
+    if err <= 0.5 * tol:  # target, or within tol and taken to round-off
         for i in range(size):  # the answer as given, r = r̂/s, and r̂ = s∘r from it
             r[i] = ru[i] / s[i]
             ru[i] = r[i] * s[i]
