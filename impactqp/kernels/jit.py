@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import os
+import shutil
 import sys
 import threading
 from collections.abc import Callable, Iterator
@@ -30,19 +33,61 @@ def cache_dir() -> str:
     return os.path.join(base, "impactqp", "numba")
 
 
+KEPT_SOURCES = 4
+"""Cache folders of earlier kernel sources kept beside the current one (for a few checkouts
+or versions used in turn); older ones are removed when a new one is made."""
+
+
+def sources_stamp() -> str:
+    """A fingerprint of every kernel's source file (name, size, modification time).
+
+    numba drops a kernel's cached machine code when the file that defines it changes, but not
+    when a kernel it calls changes in another file: the caller's cached code still holds the
+    old callee. Machine code is therefore kept in a folder of its own for each state of the
+    kernels' sources (:func:`_cached_in_user_dir`), so an edited or updated checkout never
+    loads code compiled from other sources.
+    """
+    digest = hashlib.blake2b(digest_size=8)
+    for name in sorted(os.listdir(_HERE)):
+        if name.endswith(".py"):
+            stat = os.stat(os.path.join(_HERE, name))
+            digest.update(f"{name}:{stat.st_size}:{stat.st_mtime_ns};".encode())
+    return digest.hexdigest()
+
+
+_HERE = os.path.dirname(os.path.abspath(__file__))
+_STAMP = sources_stamp()
+
+
+@functools.cache
+def _sources_folder(base: str, stamp: str) -> str:
+    """``base``'s folder for the kernel sources of ``stamp``; when it is new, folders of
+    other sources beyond the :data:`KEPT_SOURCES` newest are removed."""
+    folder = os.path.join(base, f"sources-{stamp}")
+    if not os.path.isdir(folder):
+        try:
+            others = sorted((os.path.join(base, name) for name in os.listdir(base)
+                             if name.startswith("sources-")), key=os.path.getmtime)
+        except OSError:  # no cache yet
+            others = []
+        for old in others[:max(len(others) - KEPT_SOURCES, 0)]:
+            shutil.rmtree(old, ignore_errors=True)
+    return folder
+
+
 @contextmanager
 def _cached_in_user_dir() -> Iterator[None]:
-    """numba's cache directory set to :func:`cache_dir` while impactqp decorates a kernel
-    (numba picks the directory when the cache is created, at decoration); a directory the
-    user chose with ``NUMBA_CACHE_DIR`` is kept, and nothing else's caching changes."""
-    if numba.config.CACHE_DIR:
-        yield
-        return
-    numba.config.CACHE_DIR = cache_dir()
+    """numba's cache directory set, while impactqp decorates a kernel (numba picks the
+    directory when the cache is created, at decoration), to the folder of the current kernel
+    sources (:func:`sources_stamp`) in :func:`cache_dir`, or in the directory the user chose
+    with ``NUMBA_CACHE_DIR``; numba's setting is restored afterwards, so nothing else's
+    caching changes."""
+    chosen = numba.config.CACHE_DIR
+    numba.config.CACHE_DIR = _sources_folder(chosen or cache_dir(), _STAMP)
     try:
         yield
     finally:
-        numba.config.CACHE_DIR = ""
+        numba.config.CACHE_DIR = chosen
 
 
 OPTIONS = {"nopython": True, "nogil": True, "error_model": "numpy", "boundscheck": None}
