@@ -116,3 +116,21 @@ def test_a_parallel_compile_starts_every_stage():
     names = sorted(name for name, _ in precompile.STAGES)
     assert sorted(precompile.LONGEST_FIRST) == names
     assert sorted(name for group in precompile.PAIRED for name in group) == names
+
+
+def test_an_internal_kernel_runs_inside_its_callers_and_refuses_a_call_from_python():
+    """A kernel compiled without the wrapper for calls from Python (kernel(internal=True))
+    gives its callers the same answer as its Python text, and a direct call raises instead
+    of jumping into code that was never built."""
+    import numba
+    import numpy as np
+
+    from impactqp.kernels import jit, residuals
+
+    um, up, lam = np.array([0.0, 0.0]), np.array([3e61, -1.0]), np.array([-4e61])
+    assert residuals.unit_of(um, up, lam) == 4e61  # _largest of u⁺ and Λ, compiled inside
+    if not numba.config.DISABLE_JIT:
+        with pytest.raises(TypeError, match="called only by other kernels"):
+            residuals._largest(up)
+    with pytest.raises(TypeError, match="exclude each other"):
+        jit.kernel(lambda x: x, interpretable=True, internal=True)

@@ -465,3 +465,15 @@ def test_bad_solver_arguments_are_named_errors() -> None:
         iq.solve_friction((np.eye(3), np.zeros(3), 0.5))
     with pytest.raises(iq.errors.ShapeError):
         certify_friction(problem, np.zeros(2))
+
+
+def test_the_kernels_take_a_writable_copy_of_the_problems_mu() -> None:
+    """The solvers hand the kernels μ as the time-step kernels do (a writable array: one
+    compiled version of each kernel on μ serves both), while the problem's μ stays read-only
+    and unchanged."""
+    problem = iq.FrictionContactProblem(np.eye(6), -np.ones(6), [0.3, 0.5])
+    data = friction_newton.FrictionData(problem)
+    assert data.mu.flags.writeable and not problem.mu.flags.writeable
+    assert data.mu is not problem.mu and np.array_equal(data.mu, problem.mu)
+    data.mu[0] = 9.0
+    assert problem.mu[0] == 0.3

@@ -38,7 +38,7 @@ DESCENT_TOL = 1e-13
 """A variable joins only when −(Gx + q)ⱼ exceeds DESCENT_TOL·(max|q| + max|G|·max|x|)."""
 
 
-@kernel
+@kernel(internal=True)
 def _append(L, idx, k, G, j):
     """Append variable j to the factor of G_PP (P = idx[:k]); False if its column is dependent.
     The new row is formed in row k of L, which is not part of the factor until it succeeds."""
@@ -57,7 +57,7 @@ def _append(L, idx, k, G, j):
     return True
 
 
-@kernel
+@kernel(internal=True)
 def _refactor(L, idx, k, G, x):
     """Factor G_PP anew for P = idx[:k]; variables whose columns turn out dependent leave P
     (with x = 0). Returns the new size of P."""
@@ -71,13 +71,13 @@ def _refactor(L, idx, k, G, x):
     return kept
 
 
-@kernel
+@kernel(internal=True)
 def _solve_factored(L, idx, k, rhs, out):
     """out[idx[:k]] = G_PP⁻¹ rhs[idx[:k]] with G_PP = LLᵀ."""
     solve_factored_into(L, idx, k, rhs, out, np.empty(k))
 
 
-@kernel
+@kernel(internal=True)
 def solve_factored_into(L, idx, k, rhs, out, y):
     """:func:`_solve_factored` in the scratch y of at least k floats (no allocation: the
     derivative kernels call it several times per row)."""
@@ -104,7 +104,7 @@ def cholesky_solve(L, k, y):
         y[a] = s / L[a, a]
 
 
-@kernel
+@kernel(internal=True)
 def _gradient(G, q, x, w):
     """w = Gx + q."""
     m = q.size
@@ -116,7 +116,7 @@ def _gradient(G, q, x, w):
         w[i] = s
 
 
-@kernel
+@kernel(internal=True)
 def _member(idx, k, i):
     """Whether variable i is in P = idx[:k]."""
     for a in range(k):
@@ -125,7 +125,7 @@ def _member(idx, k, i):
     return False
 
 
-@kernel
+@kernel(internal=True)
 def _to_minimizer(L, idx, k, G, q, x, s, joined):
     """Move x towards the minimizer of the quadratic on P = idx[:k] until it is reached with
     x_P > 0, dropping the variables that reach zero on the way (Lawson–Hanson's inner loop).
@@ -171,7 +171,7 @@ def _to_minimizer(L, idx, k, G, q, x, s, joined):
     return k, True
 
 
-@kernel
+@kernel(internal=True)
 def _final_solve(L, idx, k, G, q, x, w, s):
     """The solution on the final support as a function of the support alone (indices in
     order, a fresh factor, one step of iterative refinement), so that the path that found it
@@ -234,7 +234,7 @@ def lcp_psd(G, q, passive, x, w, max_iter):
                         np.empty(m, dtype=np.int64), np.empty(m), np.empty(m, dtype=np.bool_))
 
 
-@kernel
+@kernel(internal=True)
 def lcp_psd_work(G, q, passive, x, w, max_iter, L, idx, s, blocked):
     """:func:`lcp_psd` with its workspace given: L (m × m), idx (m integers), s (m floats)
     and blocked (m booleans), so that a loop over many LCPs allocates nothing."""

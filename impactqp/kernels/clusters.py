@@ -10,7 +10,7 @@ import numpy as np
 from .jit import kernel
 
 
-@kernel
+@kernel(internal=True)
 def _root(parent, i):
     """The root of i in the union–find forest, halving the path on the way."""
     while parent[i] != i:
@@ -19,7 +19,7 @@ def _root(parent, i):
     return i
 
 
-@kernel
+@kernel(internal=True)
 def _join(parent, a, b):
     """Merge the sets of a and b; the smaller index becomes the root, so every root is the
     first degree of freedom of its set."""
@@ -31,7 +31,7 @@ def _join(parent, a, b):
         parent[ra] = rb
 
 
-@kernel
+@kernel(internal=True)
 def group_work(n):
     """Scratch of :func:`group` for n degrees of freedom: (parent, cluster of each root,
     fill pointers of dofs and of contacts)."""

@@ -125,7 +125,7 @@ def new_cells(m, cached):
                  np.empty((m, m)), np.empty(2 * m))
 
 
-@kernel
+@kernel(internal=True)
 def classify_rows(G, s, R, M, Um, Lam, kink_tol, classes, codes):
     """For every row (u⁻, Λ): w = GΛ + Ru⁻ (= GΛ + q) and the classification
     (docs/theory.md §19): a contact is degenerate when its scaled Λᵢsᵢ and wᵢ/sᵢ
@@ -213,7 +213,7 @@ def measure_cell(G, R, active, cells, e):
     cells.residual[e] = np.sqrt(res) / (np.sqrt(scale) if scale > 0.0 else 1.0)
 
 
-@kernel
+@kernel(internal=True)
 def margin_rows(Um, Lam, classes, codes, grad, margin, start, stop):
     """For the rows start..stop with a cell: the cell's radius relative to ‖u⁻‖
     (docs/theory.md §20), min over contacts of the value (Λᵢ active, wᵢ inactive) times
@@ -233,7 +233,7 @@ def margin_rows(Um, Lam, classes, codes, grad, margin, start, stop):
         margin[r] = 0.0 if codes[r] == KINK or not unorm > 0.0 else best / np.sqrt(unorm)
 
 
-@kernel
+@kernel(internal=True)
 def apply_rows(P, Q, cells, cell, transpose, X, out, start, stop):
     """For the rows start..stop with a cell: out = x − Q_Aᵀ K_AA P_A x (K_AAᵀ with
     ``transpose``) on the row's cell; with P = R, Q = Yᵀ the JVP of u⁻, with P = Yᵀ,

@@ -78,6 +78,14 @@ def modified_velocity(u, mu, d):
     return ut
 
 
+def kernel_mu(mu: np.ndarray) -> np.ndarray:
+    """A writable copy of the (read-only) μ of a problem or law, for the kernels: they take μ
+    as the kernels of a time step index it (``friction.mu[cons]``, a writable array), so one
+    compiled version of each serves both (a read-only array is another argument type to
+    numba, which would compile every kernel on μ twice). Taken once per solve."""
+    return np.array(mu, dtype=float)
+
+
 @kernel(interpretable=True)
 def natural_map(r, u, mu, d):
     """F = r − P_{K_μ}(r − ũ) contact by contact, ũ = u + μ‖u_T‖e_n."""

@@ -72,7 +72,7 @@ def worst_step(n: int, m: int, d: int) -> np.ndarray:
     return np.array([1, m, 2 * m * d + 2 * n], dtype=np.int64)
 
 
-@kernel
+@kernel(internal=True)
 def _certified(W, q, r, mu, d, tol):
     """The figures of :func:`impactqp.model.friction.certify_friction` of (W, q, μ, r)
     within ``tol``: ‖F‖ ≤ tol·‖q‖ and the cone gap ≤ tol·‖r‖."""

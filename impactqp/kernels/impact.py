@@ -92,7 +92,7 @@ def _unpack(packed, n, m):
                      packed[e:e + n * m].reshape((n, m)))
 
 
-@kernel
+@kernel(internal=True)
 def workspace(n, m):
     """Scratch for :func:`_solve_into` (floats, the factor L, indices, flags): allocated once
     per call of the kernels below, however many impacts they solve."""
@@ -100,7 +100,7 @@ def workspace(n, m):
             np.empty(m, dtype=np.bool_))
 
 
-@kernel
+@kernel(internal=True)
 def _solve_into(ops, um, E, eps, moreau, tol, passive, up, lam, res, work):
     """Solve and certify one impact of the structure ``ops`` (:class:`Operators`) into
     (u⁺, Λ, residuals); True when certified."""

@@ -95,8 +95,19 @@ OPTIONS = {"nopython": True, "nogil": True, "error_model": "numpy", "boundscheck
 inf/NaN (which every certificate then rejects) instead of raising."""
 
 
+class InternalDispatcher(CPUDispatcher):
+    """numba's CPU dispatcher for a kernel compiled without a wrapper for calls from Python:
+    such a call would jump into missing code, so it raises instead. Kernels calling it are
+    compiled by numba from its Python function, without this method."""
+
+    def __call__(self, *args: Any, **kws: Any) -> Any:
+        raise TypeError(f"{self.py_func.__module__}.{self.py_func.__name__} is a kernel "
+                        "called only by other kernels (kernel(internal=True)); call the "
+                        "kernel that uses it")
+
+
 def kernel(function: F | None = None, *, interpretable: bool = False,
-           inline: bool = False, refcounted: bool = True) -> Any:
+           inline: bool = False, refcounted: bool = True, internal: bool = False) -> Any:
     """Compile ``function`` with numba on its first call, caching the machine code on disk
     (in :func:`cache_dir`).
 
@@ -108,19 +119,33 @@ def kernel(function: F | None = None, *, interpretable: bool = False,
     kernel called in an inner loop that allocates no array and returns none, whose every
     call would otherwise pay two atomic counts per array argument. Used bare (``@kernel``)
     or with arguments.
+
+    ``internal=True`` declares a kernel called only by other kernels, never from Python:
+    numba then builds neither of the wrappers a call from Python (or through a C function
+    pointer) needs (measured: the LZB stage, whose step, stages, roots and events are such
+    helpers, compiles in 12.7 s of CPU instead of 13.1–14.0 s). Its machine code is compiled
+    into the kernels calling it (and cached with them); a call from Python raises
+    :class:`TypeError` (:class:`InternalDispatcher`).
     """
     if function is None:
         return lambda f: kernel(f, interpretable=interpretable, inline=inline,
-                                refcounted=refcounted)
+                                refcounted=refcounted, internal=internal)
+    if interpretable and internal:
+        raise TypeError("a kernel called only by kernels has no first calls from Python to "
+                        "interpret: interpretable and internal exclude each other")
     if numba.config.DISABLE_JIT:
         return function
     options = {**OPTIONS, "inline": "always"} if inline else dict(OPTIONS)
     if not refcounted:
         options["_nrt"] = False
+    if internal:
+        options.update(no_cpython_wrapper=True, no_cfunc_wrapper=True)
     with _cached_in_user_dir():
         if interpretable:
             dispatcher = InterpretableDispatcher(py_func=function, locals={},
                                                  targetoptions=options)
+        elif internal:
+            dispatcher = InternalDispatcher(py_func=function, locals={}, targetoptions=options)
         else:
             dispatcher = CPUDispatcher(py_func=function, locals={}, targetoptions=options)
         dispatcher.enable_caching()

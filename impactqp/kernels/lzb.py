@@ -51,7 +51,7 @@ SAFETY, MIN_FACTOR, MAX_FACTOR, EXPONENT = 0.9, 0.2, 10.0, -1.0 / 8.0
 """scipy's step-size control for DOP853 (error estimator of order 7)."""
 
 
-@kernel(refcounted=False)
+@kernel(refcounted=False, internal=True)
 def _root(kind, j, ga, gb, F, x_old, piece, impact, xt, full):
     """θ ∈ [0, 1] where the event's value on the dense output crosses zero (Illinois' regula
     falsi until the bracket is 4 ulp wide), on the far side of the crossing; ``xt`` and
@@ -89,7 +89,7 @@ def _root(kind, j, ga, gb, F, x_old, piece, impact, xt, full):
     return b
 
 
-@kernel(refcounted=False)
+@kernel(refcounted=False, internal=True)
 def _step_to_kink(x, tau, kind, j, g0, piece, impact, tableau, stages, out, full, istate):
     """The state where a kink of the rates (a turn, a plastic stop) lies, into ``out``
     (components; ``full`` the full state): the dense output of the step that crossed it is

@@ -44,7 +44,7 @@ def evaluate(xc, piece, impact, stages, row):
         row[c] = rate[comps[c]]
 
 
-@kernel(refcounted=False)
+@kernel(refcounted=False, internal=True)
 def stage(s, x, h, piece, impact, A, stages):
     """Stage s of a step of length h from x: xc = x + h Σ_{q<s} A[s, q] K[q], then K[s]
     there (one compiled stage serves the step and its dense output)."""
@@ -55,7 +55,7 @@ def stage(s, x, h, piece, impact, A, stages):
     evaluate(xc, piece, impact, stages, K[s])
 
 
-@kernel(refcounted=False)
+@kernel(refcounted=False, internal=True)
 def rk_step(x, h, piece, impact, tableau, stages, out):
     """One DOP853 step of length h from x (K[0] = its rates) into ``out``, stages into K."""
     for s in range(1, tableau.B.size):
@@ -66,7 +66,7 @@ def rk_step(x, h, piece, impact, tableau, stages, out):
         out[c] = x[c] + h * out[c]
 
 
-@kernel(refcounted=False)
+@kernel(refcounted=False, internal=True)
 def error_norm(x, x_new, h, nc, n, tableau, K, e5, e3):
     """h‖err‖ of the step from x to x_new: scipy's RMS over all n components of the 5th-order
     estimate, corrected by the 3rd-order one, relative to 1 + |x| (the frozen components
@@ -83,7 +83,7 @@ def error_norm(x, x_new, h, nc, n, tableau, K, e5, e3):
     return h * err5 / np.sqrt((err5 + 0.01 * err3) * n)
 
 
-@kernel(refcounted=False)
+@kernel(refcounted=False, internal=True)
 def dense_output(x, x_new, h, piece, impact, tableau, stages, F):
     """F = the coefficients of the step's 7th-order dense output (three more stages)."""
     K, nc = stages.K, piece.nc

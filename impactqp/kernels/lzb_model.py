@@ -93,7 +93,7 @@ def new_state() -> tuple[np.ndarray, np.ndarray]:
     return istate, np.zeros(4)
 
 
-@kernel(refcounted=False)
+@kernel(refcounted=False, internal=True)
 def _gamma_row(indptr, indices, data, gamma0, P, i):
     """γᵢ = γ⁻ᵢ + (GP)ᵢ."""
     s = gamma0[i]
@@ -102,7 +102,7 @@ def _gamma_row(indptr, indices, data, gamma0, P, i):
     return s
 
 
-@kernel(refcounted=False)
+@kernel(refcounted=False, internal=True)
 def _power(y, a):
     """y^a for y ≥ 0, without the general power where a is a Hertz or linear exponent."""
     if a == 1.0:
@@ -118,7 +118,7 @@ def _power(y, a):
     return y ** a
 
 
-@kernel(refcounted=False)
+@kernel(refcounted=False, internal=True)
 def _energy(y, eta):
     """E = max(y, 0)^(η+1)."""
     return _power(y, eta + 1.0) if y > 0.0 else 0.0
@@ -287,7 +287,7 @@ def event_value(kind, j, k, x, level, live, nlive, law, indptr, indices, data, g
     return g  # TURN
 
 
-@kernel(refcounted=False)
+@kernel(refcounted=False, internal=True)
 def event_values(events, k, x, level, live, nlive, impact, out):
     """out[e] = :func:`event_value` of each of a piece's ``events``
     (:class:`~impactqp.kernels.lzb_groups.PieceEvents`) at x."""

@@ -115,7 +115,7 @@ def _work(n, m, chain):
             np.empty(6), np.empty(2 * n + 2 * m))
 
 
-@kernel
+@kernel(internal=True)
 def _solve_dense(cl, contacts, law, tol, dense_work, res, work):
     """One cluster ``cl`` = (dofs D, contacts C, u⁻, v_k, u⁺, Λ, q) by the active-set search
     on G_CC, u⁺ = u⁻ + (Ŵ⁻¹H)_DC Λ and the dense certificate; True when certified (then

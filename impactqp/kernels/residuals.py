@@ -84,7 +84,7 @@ def finish(V, momentum_norm, acc, eps, moreau, cross, out):
         out[5] = np.nan
 
 
-@kernel
+@kernel(internal=True)
 def _largest(x):
     """max |xᵢ| (NaN kept), 0 for no entries."""
     c = 0.0

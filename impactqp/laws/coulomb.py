@@ -27,6 +27,7 @@ from ..kernels.coulomb_certificate import (
     LocalFreeVelocity,
     coulomb_residuals,
 )
+from ..kernels.friction import kernel_mu
 from ..model.admissible import AdmissibleSet
 from ..model.friction import FrictionContactProblem, certify_friction, friction_coefficients
 from ..model.problem import ImpactProblem
@@ -327,8 +328,7 @@ class Coulomb(ImpactLaw):
             system = FrictionalSystem(structure.dense_mass, structure.dense_Wt,
                                       certificate_operand(structure),
                                       np.ascontiguousarray(G, dtype=float), s,
-                                      np.ascontiguousarray(mu, dtype=float),
-                                      np.ascontiguousarray(e, dtype=float),
+                                      kernel_mu(mu), np.ascontiguousarray(e, dtype=float),
                                       structure.contact_dim)
         self._operands = structure, system
         return system

@@ -18,6 +18,7 @@ from functools import cached_property
 
 import numpy as np
 
+from ..kernels.friction import kernel_mu
 from ..kernels.friction_tiny import CERTIFIED, FRICTION_FIGURES, solve_given
 from ..model.friction import FrictionCertificate, FrictionContactProblem, friction_certificate
 from ..qp.friction import methods
@@ -121,8 +122,8 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
             tol, NEWTON_STEPS, methods.NSGS_SHORT,
             methods.SMALL_LOCAL if small else methods.NSGS_LOCAL, small))
     out = np.empty(2 * size + _FIGURES)
-    its, outcome, scaled = solve_given(W, rows, q, problem.mu, problem.contact_dim, limits,
-                                       out)
+    its, outcome, scaled = solve_given(W, rows, q, kernel_mu(problem.mu), problem.contact_dim,
+                                       limits, out)
     if outcome != CERTIFIED:
         return None
     return SmallFrictionResult.of_call(out, size, tol, its, time.perf_counter() - start,

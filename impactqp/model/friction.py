@@ -21,7 +21,7 @@ from ..base.arrays import as_array, as_count, as_matrix, check_tol
 from ..base.checks import Certificate
 from ..errors import InputError, OutOfRangeError, ShapeError
 from ..kernels.coulomb_certificate import FRICTION_FIGURES, friction_figures
-from ..kernels.friction import natural_map
+from ..kernels.friction import kernel_mu, natural_map
 from ..kernels.friction_tiny import LOG2_RANGE
 from ..kernels.units import contact_units
 
@@ -320,9 +320,10 @@ def certify_friction(problem: FrictionContactProblem, r, u=None, *,
     with np.errstate(over="ignore", invalid="ignore"):
         u_w = np.asarray(unit.W @ r).ravel() + unit.q
         mismatch = 0.0 if u is None else _norm(units.unit_velocity(u) - u_w)
-        f_norm = _norm(natural_map(r, u_w, unit.mu, unit.contact_dim))
+        mu = kernel_mu(unit.mu)
+        f_norm = _norm(natural_map(r, u_w, mu, unit.contact_dim))
     figures = np.empty(len(FRICTION_FIGURES))
-    friction_figures(r, u_w, unit.q, unit.mu, unit.contact_dim, (f_norm, mismatch), figures)
+    friction_figures(r, u_w, unit.q, mu, unit.contact_dim, (f_norm, mismatch), figures)
     return friction_certificate(figures, tol)
 
 

@@ -16,6 +16,7 @@ import scipy.sparse.linalg as spla
 
 from ...kernels.friction import (
     alart_curnier,
+    kernel_mu,
     modified_velocity,
     modified_velocity_jacobian,
     natural_map,
@@ -98,7 +99,7 @@ class FrictionData:
     def __init__(self, program: FrictionProgram) -> None:
         self.program = program
         self.q = program.q
-        self.mu = program.mu
+        self.mu = kernel_mu(program.mu)
         self.d = program.contact_dim
         self.n = self.q.size
         self._rows: sp.csr_matrix | None = None
