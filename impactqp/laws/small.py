@@ -29,7 +29,7 @@ from ..kernels.impact import solve_impact
 from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
 from ..model.residuals import restitution_matrix
-from ..qp.isotonic import _scratch
+from ..qp.isotonic import scratch
 from .base import FAMILIES, MOREAU_FAMILY, ImpactLaw
 from .result import CompiledImpactResult, ImpactResult
 
@@ -155,7 +155,7 @@ def _solve_chain(problem: ImpactProblem, law: ImpactLaw, tol: float,
                                  law.eps, tol, out)
     else:
         done = solve_chain(packed, problem.u_minus, chain.left_wall, chain.right_wall,
-                           law.eps, tol, out, *_scratch(n))
+                           law.eps, tol, out, *scratch(n))
     if not done:
         return None
     first = n if chain.left_wall else n + 1  # Λ: L from the left wall's (or the first gap's)

@@ -82,7 +82,7 @@ def chain_projection(m: np.ndarray, u: np.ndarray, left: bool,
     With both walls z = 0 and Λ_z is the least of its half-line (see :func:`chain_moreau`).
     """
     z, L = np.empty(u.size), np.empty(u.size + 1)
-    starts, weight = _scratch(u.size)
+    starts, weight = scratch(u.size)
     project(np.ascontiguousarray(m, dtype=float), np.ascontiguousarray(u, dtype=float),
             bool(left), bool(right), z, L, starts, weight)
     return z, _contacts(L, left, right)
@@ -93,7 +93,7 @@ _SCRATCH = threading.local()
 long chain cost more than the regression (its contents never leave the kernel)."""
 
 
-def _scratch(n: int) -> tuple[np.ndarray, np.ndarray]:
+def scratch(n: int) -> tuple[np.ndarray, np.ndarray]:
     """(starts, weight) of at least n + 1 and n entries, the calling thread's when they fit
     (and are not more than twice too long)."""
     kept = getattr(_SCRATCH, "arrays", None)
