@@ -195,3 +195,70 @@ def test_batches_of_chains_keep_their_paths(n, monkeypatch) -> None:
     assert b.ok.all() and b.resolved == 0
     single = np.array([iq.moreau(p.with_u_minus(u), 0.3).u_plus for u in U])
     np.testing.assert_allclose(b.u_plus, single, rtol=1e-12, atol=1e-12)
+
+
+def decision_cases():
+    """Impacts on both sides of each of the planner's decisions that the short route restates:
+    the law's family, the velocity's scale, contacts beyond the degrees of freedom, chains and
+    dense structures, the tolerance, frictional contacts."""
+    rng = np.random.default_rng(29)
+    chain = iq.chain([1.0, 2.0, 0.5], [1.0, 0.0, -2.0], left_wall=True)
+    dense = iq.random_impact(5, 3, seed=4)
+    redundant = iq.random_impact(3, 3, seed=6, redundant=2)
+    pinned = iq.chain([2.0], [1.0], left_wall=True, right_wall=True)  # 2 contacts, 1 dof
+    crowded = iq.ImpactProblem(np.eye(2), [[1.0, 0.0, 1.0], [0.0, 1.0, 1.0]], [-1.0, -2.0])
+    doubled = iq.ImpactProblem(2.0 * np.eye(1), [[1.0, 2.0]], [-1.0])  # parallel contacts
+    for p in (chain, dense, redundant, pinned, crowded, doubled, iq.newtons_cradle(3),
+              iq.newtons_cradle(12)):
+        k = p.n_contacts
+        for law in (iq.Moreau(0.5), iq.Newton(rng.random(k)), iq.Fremond(0.2 * np.eye(k))):
+            for scale in (1.0, 1e-150, 1e150):
+                for tol in (1e-9, 1e-13):
+                    yield p.with_u_minus(scale * p.u_minus), law, tol
+    cradle = iq.newtons_cradle(3)
+    yield cradle, iq.SectorLaw(), 1e-9
+    yield cradle, iq.Moreau(1.0), 1  # an int tolerance: the full route says what to fix
+    yield iq.friction.point_on_plane(1.0, [1.0, 2.0]), iq.Coulomb(0.5, 0.5), 1e-9
+    yield iq.friction.point_on_plane(1.0, [1.0, 2.0]), iq.Moreau(0.5), 1e-9
+
+
+@pytest.mark.parametrize("case", list(decision_cases()),
+                         ids=lambda c: f"{c[0].n_dof}-{c[0].n_contacts}-{c[1]!r}-{c[2]}"[:60])
+def test_the_short_route_decides_as_the_planner(case, monkeypatch) -> None:
+    """``small.first_try`` restates :func:`validate` and :func:`plan` for the case where they
+    all pass: one by one, it answers only when the full route (with it removed) plans the
+    compiled call for the problem as given (no rescaling, no collapsed contacts) and that
+    call certifies, always then with no more contacts than degrees of freedom (more are left
+    to the full route, which collapses parallel ones), and its answer is the full route's
+    digit for digit."""
+    from impactqp.laws import pipeline
+
+    p, law, tol = case
+    planned = []
+    real_plan = pipeline.plan
+
+    def recording_plan(*args, **kwargs):
+        route = real_plan(*args, **kwargs)
+        planned.append(route)
+        return route
+
+    fast = small.first_try(p, law, tol)
+    monkeypatch.setattr(small, "first_try", lambda *args: None)
+    monkeypatch.setattr(pipeline, "plan", recording_plan)
+    try:
+        full = iq.solve(p, law, tol=tol)
+    except (iq.errors.ImpactError, ValueError, TypeError):
+        assert fast is None  # what the full route refuses, the short one never answers
+        return
+    direct = (len(planned) == 1 and planned[0].scale == 1.0 and planned[0].groups is None
+              and planned[0].path == "compiled"
+              and full.attempts in ([COMPILED], [CHAIN]))
+    if fast is not None:
+        assert direct
+    elif p.n_contacts <= p.n_dof:
+        assert not direct
+    if fast is not None:
+        assert fast.backend == full.backend and fast.attempts == full.attempts
+        np.testing.assert_array_equal(fast.u_plus, full.u_plus)
+        np.testing.assert_array_equal(fast.impulses, full.impulses)
+        assert fast.certificate.residuals == full.certificate.residuals
