@@ -197,9 +197,36 @@ def _run_local(tasks: list[Task], limit: float | None, n_jobs: int,
             proc.close()
 
 
+GROUP = 4
+"""Problems per Dask task at most. Each task costs milliseconds of the client's, the
+scheduler's and its worker's processors and a hand-over between them (measured: ~2.5 ms of
+the scheduler's, ~2 ms of the worker's, a 7–11 ms gap between a worker's tasks on a busy
+machine); a few problems per task share them, while every worker still gets many tasks.
+Groups of 4 cut the scheduler's processor time by 25–30 % on a 100-problem collection."""
+
+
+def _groups(tasks: list[Task], workers: int) -> list[list[Task]]:
+    """``tasks`` in groups of up to :data:`GROUP` (at least 8 groups per worker), the largest
+    files first: as far as a file's size tells its solve's length, the long solves start
+    early and the workers end together."""
+    size = max(1, min(GROUP, len(tasks) // (8 * max(workers, 1))))
+    ordered = sorted(tasks, key=lambda t: -_size(t))  # stable: ties keep their order
+    return [ordered[i:i + size] for i in range(0, len(ordered), size)]
+
+
+def _size(task: Task) -> int:
+    """Bytes of ``task``'s file (0 when it cannot be read: its solve records why)."""
+    try:
+        return (Path(task.folder) / task.file).stat().st_size
+    except OSError:
+        return 0
+
+
 def _run_dask(tasks: list[Task], limit: float | None, emit: Callable[[Record], None],
               scheduler: str | None, client: Any) -> None:
-    """One Dask task per problem; records written in the order they end."""
+    """One Dask task per group of problems (:func:`_groups`); records written as the groups
+    end. A group whose worker died is run again one problem per task, so that a problem
+    that kills its worker fails alone."""
     try:
         import distributed
     except ImportError as exc:
@@ -211,15 +238,25 @@ def _run_dask(tasks: list[Task], limit: float | None, emit: Callable[[Record], N
     client = client or own
     try:
         client.run(_prepare_once)  # the workers there now; later ones prepare on first task
-        futures = {client.submit(_solve_on_worker, task, limit, pure=False): task
-                   for task in tasks}
+        workers = len(client.scheduler_info().get("workers", {}))
+        futures = {client.submit(_solve_group, group, limit, pure=False): group
+                   for group in _groups(tasks, workers)}
+        arrived = distributed.as_completed(futures)
         try:
-            for future in distributed.as_completed(futures):
+            for future in arrived:
+                group = futures[future]
                 try:
-                    record = future.result()
+                    records = future.result()
                 except Exception as exc:  # the worker died with it (Dask gave up retrying)
-                    record = failed_record(blank_record(futures[future]), exc)
-                emit(record)
+                    if len(group) > 1:
+                        for task in group:
+                            alone = client.submit(_solve_group, [task], limit, pure=False)
+                            futures[alone] = [task]
+                            arrived.add(alone)
+                        continue
+                    records = [failed_record(blank_record(group[0]), exc)]
+                for record in records:
+                    emit(record)
         finally:
             client.cancel(list(futures))
             client.run(_close_solvers)
@@ -240,15 +277,15 @@ def _prepare_once() -> None:
             _PREPARED.set()
 
 
-def _solve_on_worker(task: Task, limit: float | None) -> Record:
-    """A Dask worker's solve: in its own process, or in a child process per worker thread
-    under a time limit."""
+def _solve_group(tasks: list[Task], limit: float | None) -> list[Record]:
+    """A Dask worker's solves, one after the other: in its own process, or in a child process
+    per worker thread under a time limit."""
     _prepare_once()
     if limit is None:
-        return solve_task(task)
+        return [solve_task(task) for task in tasks]
     with _LOCK:
         proc = _SOLVERS.setdefault(threading.get_ident(), SolverProcess(prepare_worker))
-    return proc.run(task, limit)
+    return [proc.run(task, limit) for task in tasks]
 
 
 def _close_solvers() -> None:

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import impactqp as iq
+import impactqp.collection as collection
 import impactqp.io.collection as collection_io
 from impactqp.collection import run_collection
 from impactqp.io.collection import Task, collection_files
@@ -112,6 +113,52 @@ def test_dask_local_cluster_gives_the_same_records(folder: Path, tmp_path: Path,
                              client=client, time_limit=limit)
         assert set(client.run(lambda: 1)) == set(client.scheduler_info()["workers"])
     same(local, run.records)
+
+
+def test_groups_hold_every_task_once_largest_files_first(folder: Path) -> None:
+    tasks = [Task(str(folder), f, m, 1e-8) for f in collection_files(folder)
+             for m in ("auto", "nsgs")]
+    size = {f: (folder / f).stat().st_size for f in collection_files(folder)}
+    for workers, expected in ((1, 2), (2, 1), (8, 1)):  # 18 tasks: >= 8 groups per worker
+        groups = collection._groups(tasks, workers)
+        assert {len(g) for g in groups[:-1]} == {expected} and 1 <= len(groups[-1]) <= expected
+        flat = [t for g in groups for t in g]
+        assert sorted(flat) == sorted(tasks)
+        assert [size[t.file] for t in flat] == sorted((size[t.file] for t in tasks),
+                                                      reverse=True)
+    many = tasks * 40  # 720 tasks: groups of at most GROUP
+    assert max(len(g) for g in collection._groups(many, 2)) == collection.GROUP
+
+
+def test_dask_groups_give_the_same_records_and_a_failing_one_is_split(
+        folder: Path, tmp_path: Path, local: list[dict],
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """One worker: groups of two problems. A group whose task fails (as when its worker dies)
+    is run again one problem per task: only the problem that fails is an error record."""
+    distributed = pytest.importorskip("distributed", reason="the optional dask extra")
+    bad = "global/LMGC_GlobalFrictionContactProblem00046.hdf5"
+    solve = collection.solve_task
+
+    def fragile(task: Task) -> dict:
+        if task.file == bad and task.method == "nsgs":
+            raise MemoryError("a problem that takes its worker down")
+        return solve(task)
+
+    monkeypatch.setattr(collection, "solve_task", fragile)
+    sizes: list[int] = []
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=":0") as cluster, \
+            distributed.Client(cluster) as client:
+        submit = client.submit
+        client.submit = lambda f, tasks, *a, **k: sizes.append(len(tasks)) or submit(
+            f, tasks, *a, **k)
+        run = run_collection(folder, tmp_path / "dask.jsonl", methods=("auto", "nsgs"),
+                             client=client)
+    assert sizes == [2] * 9 + [1, 1]  # the failed pair again, one problem per task
+    failed = [r for r in run.records if r["file"] == bad and r["method"] == "nsgs"]
+    assert [(r["status"], r["error_name"]) for r in failed] == [("error", "MemoryError")]
+    rest = [r for r in run.records if r not in failed]
+    same([r for r in local if (r["file"], r["method"]) != (bad, "nsgs")], rest)
 
 
 def test_a_solver_that_kills_its_process_is_an_error_record(
@@ -231,3 +278,19 @@ def test_summary_by_hand(tmp_path: Path) -> None:
     assert "over the 2 problems both certify: 0.50×" in text
     assert "| auto | 3 | 0 | 0 | 0 |" in text and "| siconos:NSGS | 2 | 1 | 0 | 0 |" in text
     assert (tmp_path / "profile.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_scaling_estimate_on_idle_cores_by_hand() -> None:
+    from benchmarks.collection_scaling import ClusterRun
+
+    def run(seconds: float, cpu: list[float], client: float, rates: list[float],
+            cores: int = 2) -> float:
+        return ClusterRun([], seconds, 0.0, cpu, client, rates, [], []).idle_cores(cores)
+
+    # one worker, 40 s of which 0.05/s idle: 20 - 2 = 18 s of work, on 0.95 of a core
+    assert run(40.0, [20.0], 2.0, [0.05, 0.05]) == pytest.approx(18.0 / 0.95)
+    # two workers on 2 cores: all the processes' work, 11 - 1 + 13 - 1 + 3 - 1, on the
+    # 2 - 0.15 cores their idle rates leave
+    assert run(20.0, [11.0, 13.0], 3.0, [0.05, 0.05, 0.05]) == pytest.approx(24.0 / 1.85)
+    # on 4 cores: the workers' 22 s shared evenly, each on 0.95 of a core
+    assert run(20.0, [11.0, 13.0], 3.0, [0.05, 0.05, 0.05], 4) == pytest.approx(22.0 / 1.9)
