@@ -99,3 +99,13 @@ def test_newton_certifies_file_problems_with_these_steps(name: str) -> None:
     assert ok and 0 < steps < 50
     result = iq.solve_friction(problem, backend="newton", tol=1e-8)
     assert result.certificate.ok and result.error <= 1e-8
+
+
+def test_norm_is_the_euclidean_norm_of_long_vectors() -> None:
+    """The friction methods' norm (summed without BLAS) agrees with numpy's, on vectors
+    longer than OpenBLAS's threading threshold and on a zero vector."""
+    rng = np.random.default_rng(3)
+    for x in (rng.standard_normal(14004) * 1e-150, rng.standard_normal(7) * 1e150,
+              np.zeros(20001), rng.standard_normal(20001)):
+        assert newton_module.norm(x) == pytest.approx(float(np.linalg.norm(x)), rel=1e-13,
+                                                      abs=0.0)

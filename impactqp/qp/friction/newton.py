@@ -6,6 +6,7 @@ with :class:`FrictionData`, the problem's arrays as every friction method uses t
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import NamedTuple
 
@@ -153,7 +154,7 @@ class FrictionData:
     def qn(self) -> float:
         """‖q‖ (1 for q = 0)."""
         if self._qn is None:
-            self._qn = float(np.linalg.norm(self.q)) or 1.0
+            self._qn = norm(self.q) or 1.0
         return self._qn
 
     @property
@@ -175,7 +176,7 @@ class FrictionData:
 
     def error(self, r: np.ndarray) -> float:
         """‖F(r)‖/‖q‖."""
-        return float(np.linalg.norm(natural_map(r, self.velocity(r), self.mu, self.d))) / self.qn
+        return norm(natural_map(r, self.velocity(r), self.mu, self.d)) / self.qn
 
     def finished(self, r: np.ndarray, f: float, tol: float) -> np.ndarray | None:
         """r projected onto the cones when ‖F(r)‖ = ``f`` is within tol/2·‖q‖ and the
@@ -185,6 +186,15 @@ class FrictionData:
             return None
         rp = project_cones(r, self.mu, self.d)
         return rp if self.error(rp) <= 0.5 * tol else None
+
+
+def norm(x: np.ndarray) -> float:
+    """‖x‖₂ of a vector, summed by numpy's own loop rather than BLAS: OpenBLAS splits a dot
+    product of more than 10⁴ entries over its threads, which then spin on every core
+    between calls; on a loaded machine that made each norm of Newton on the 7,002-contact
+    granular flow cost ~8 ms and slowed the LU beside it two-fold (docs/theory.md §23)."""
+    x = np.ravel(x)
+    return math.sqrt(np.einsum("i,i->", x, x))
 
 
 def backtrack(r: np.ndarray, step: np.ndarray, f: float,
@@ -197,7 +207,7 @@ def backtrack(r: np.ndarray, step: np.ndarray, f: float,
     while t > 1e-8:
         r_try = r + t * step
         res = residual(r_try)
-        f_try = float(np.linalg.norm(res))
+        f_try = norm(res)
         if f_try <= (1.0 - 1e-4 * t) * f:
             return r_try, res, f_try
         t *= 0.5
@@ -220,7 +230,7 @@ def newton_step(J: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
     try:
         step = spla.splu(J, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                          options={"SymmetricMode": True}).solve(rhs)
-        if np.linalg.norm(J @ step - rhs) <= STEP_RESIDUAL * np.linalg.norm(rhs):
+        if norm(J @ step - rhs) <= STEP_RESIDUAL * norm(rhs):
             return step
     except RuntimeError:  # a zero pivot on the diagonal
         pass
@@ -248,15 +258,15 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
     n, m = data.n, mu.size
     A = np.empty((m, d, d))
     B = np.empty((m, d, d))
-    scale = float(np.linalg.norm(alart_curnier(np.zeros(n), q, mu, rho, d, False, A, B)))
+    scale = norm(alart_curnier(np.zeros(n), q, mu, rho, d, False, A, B))
     u = data.velocity(r)
     phi = alart_curnier(r, u, mu, rho, d, True, A, B)
-    f = float(np.linalg.norm(phi))
+    f = norm(phi)
     steps = 0
     boost = 1.0
     first = -1.0
     while True:
-        f_nat = float(np.linalg.norm(natural_map(r, u, mu, d)))
+        f_nat = norm(natural_map(r, u, mu, d))
         rp = data.finished(r, f_nat, tol)
         if rp is not None:
             return rp, steps, True
@@ -282,7 +292,7 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
         r = found[0]
         u = data.velocity(r)
         phi = alart_curnier(r, u, mu, rho, d, True, A, B)
-        f = float(np.linalg.norm(phi))
+        f = norm(phi)
     return project_cones(r, mu, d), steps, False
 
 
@@ -295,7 +305,7 @@ def lstsq_newton(data: FrictionData, r: np.ndarray, tol: float) -> tuple[np.ndar
     n, m = data.n, mu.size
     u = W @ r + q
     F = natural_map(r, u, mu, d)
-    f = float(np.linalg.norm(F))
+    f = norm(F)
     steps = 0
     while True:
         rp = data.finished(r, f, tol)
