@@ -19,7 +19,7 @@ from functools import reduce
 
 import numpy as np
 
-from ..kernels.residuals import chain_residual_columns
+from ..kernels.chain_batch import chain_residual_columns
 from ..model.problem import ImpactProblem
 from ..model.structure import ImpactStructure
 from .base import MOREAU_FAMILY, ImpactLaw
