@@ -21,10 +21,10 @@ from impactqp.kernels.active_set import (
     lcp_psd_rows,
     solve_lcp_psd,
 )
+from impactqp.kernels.chain_batch import chain_residual_rows
 from impactqp.kernels.impact import _unpack, pack, solve_impact, solve_impact_rows
 from impactqp.kernels.residuals import (
     SCALE_RANGE,
-    chain_residual_rows,
     chain_residuals,
     chain_step_residuals,
     dense_residual_rows,

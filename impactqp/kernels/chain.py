@@ -38,19 +38,53 @@ def _add(total, compensation, x):
 @inline_kernel
 def _pava(m, u, starts, weight, total):
     """Blocks of the weighted isotonic regression of u: returns their count nb, with
-    ``starts[:nb + 1]`` (a last entry N), block weights and weighted sums."""
-    nb = 0
-    for j in range(u.size):
-        starts[nb] = j
-        weight[nb] = m[j]
-        total[nb] = m[j] * u[j]
-        nb += 1
-        while nb > 1 and total[nb - 2] * weight[nb - 1] > total[nb - 1] * weight[nb - 2]:
-            weight[nb - 2] += weight[nb - 1]
-            total[nb - 2] += total[nb - 1]
+    ``starts[:nb + 1]`` (a last entry N), block weights and weighted sums.
+
+    The top block of the stack and the one being pushed live in registers, the blocks
+    below in the arrays: a long run of pooling (one block growing ball by ball) then costs
+    a comparison and two additions per ball, without a store and a reload of the top."""
+    n = u.size
+    if n == 0:
+        starts[0] = 0
+        return 0
+    nb = 0  # blocks below the top one
+    ts, tw, tt = 0, m[0], m[0] * u[0]
+    for j in range(1, n):
+        cs, cw, ct = j, m[j], m[j] * u[j]
+        while True:
+            if not tt * cw > ct * tw:  # the top's mean is at most the new block's: push
+                starts[nb] = ts
+                weight[nb] = tw
+                total[nb] = tt
+                nb += 1
+                break
+            cs, cw, ct = ts, tw + cw, tt + ct  # pool the new block into the top
+            if nb == 0:
+                break
             nb -= 1
-    starts[nb] = u.size
-    return nb
+            ts, tw, tt = starts[nb], weight[nb], total[nb]
+        ts, tw, tt = cs, cw, ct
+    starts[nb] = ts
+    weight[nb] = tw
+    total[nb] = tt
+    starts[nb + 1] = n
+    return nb + 1
+
+
+@inline_kernel
+def _fill(m, u, z, L, a, b, mean, anchored):
+    """z = mean on balls a … b − 1 and, when ``anchored``, L_{j+1} = L_j − dⱼ from L_a = 0
+    (dⱼ = mⱼ(zⱼ − u⁻ⱼ), one pass over the block's balls)."""
+    if not anchored:
+        for j in range(a, b):
+            z[j] = mean
+        return
+    s, c = 0.0, 0.0
+    L[a] = 0.0
+    for j in range(a, b):
+        z[j] = mean
+        s, c = _add(s, c, -m[j] * (mean - u[j]))
+        L[j + 1] = s + c
 
 
 @inline_kernel
@@ -70,23 +104,28 @@ def project(m, u, left, right, z, L, starts, weight):
 
     ``starts`` (N + 1 integers) and ``weight`` (N floats) are scratch for the blocks (a long
     chain's caller keeps them between solves: fresh pages cost more than the regression);
-    the blocks' weighted sums live in ``L`` until the impulses are written."""
+    the blocks' weighted sums live in ``L`` until the impulses are written. Each free block
+    is filled and given its impulses in one pass."""
     n = u.size
     total = L[:n]
     nb = _pava(m, u, starts, weight, total)
     free = 0  # blocks whose mean is at most 0 (a wall clips them or the others)
-    for b in range(nb):
-        mean = total[b] / weight[b]
-        if mean <= 0.0:
+    for b in range(nb):  # the means replace the weights: the impulses overwrite the sums
+        weight[b] = total[b] / weight[b]
+        if weight[b] <= 0.0:
             free = b + 1
+    first = free if left else 0
+    last = free if right else nb
+    for b in range(nb):  # each block filled, the free ones anchored at their own start
+        mean = weight[b]
         if left and right:
             mean = 0.0
         elif left:
             mean = max(mean, 0.0)
         elif right:
             mean = min(mean, 0.0)
-        for j in range(starts[b], starts[b + 1]):
-            z[j] = mean
+        _fill(m, u, z, L, starts[b], starts[b + 1], mean,
+              first <= b < last and not (left and right))
     if left and right:  # z = 0: the least impulses, L = max_j E_j − E_j with E_0 = 0
         s, c, top = 0.0, 0.0, 0.0
         L[0] = 0.0
@@ -98,10 +137,6 @@ def project(m, u, left, right, z, L, starts, weight):
             L[j] = top - L[j]
         return
     L[0] = 0.0
-    first = free if left else 0
-    last = free if right else nb
-    for b in range(first, last):  # each free block from its own start
-        _forward(m, u, z, L, starts[b], starts[b + 1])
     if left:  # the wall and the clipped blocks hang from the first free block start k
         k = starts[free]
         s, c = 0.0, 0.0

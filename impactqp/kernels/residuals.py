@@ -68,20 +68,29 @@ def fold_contacts(lam, w, s):
 
 
 @inline_kernel
-def finish(V, momentum_norm, acc, eps, moreau, cross, out):
+def residual_values(V, momentum_norm, acc, eps, moreau, cross):
     """The six residuals (order :data:`RESIDUALS`) from V, ‖u⁺ − u⁻ − M⁻¹WΛ‖, the fold of the
-    contacts and, for Moreau's law (``moreau``), ε and cross = ⟨z, u⁻ − z⟩."""
-    V2 = V * V
-    out[0] = momentum_norm / V
-    out[1] = _high(0.0, -acc[0] / V)
-    out[2] = _high(0.0, -acc[1] / V)
-    out[3] = acc[2] / V2
+    contacts and, for Moreau's law (``moreau``), ε and cross = ⟨z, u⁻ − z⟩; the last two
+    are NaN for other laws. One division (1/V): the others are products, which a loop over
+    many impacts runs in SIMD at a fraction of a division's cost."""
+    unit = 1.0 / V
+    unit2 = unit * unit
+    momentum = momentum_norm * unit
+    sign = _high(0.0, -acc[0] * unit)
+    law = _high(0.0, -acc[1] * unit)
+    complementarity = acc[2] * unit2
     if moreau:
-        out[4] = 2.0 * eps * abs(cross) / V2
-        out[5] = acc[3] / V2 + out[0] * out[0]
-    else:
-        out[4] = np.nan
-        out[5] = np.nan
+        return (momentum, sign, law, complementarity, 2.0 * eps * abs(cross) * unit2,
+                acc[3] * unit2 + momentum * momentum)
+    return (momentum, sign, law, complementarity, np.nan, np.nan)
+
+
+@inline_kernel
+def finish(V, momentum_norm, acc, eps, moreau, cross, out):
+    """:func:`residual_values` written into ``out``."""
+    values = residual_values(V, momentum_norm, acc, eps, moreau, cross)
+    for i in range(6):
+        out[i] = values[i]
 
 
 @kernel(internal=True)
@@ -107,10 +116,10 @@ def unit_of(um, up, lam):
 
 @inline_kernel
 def velocity_unit(V2_minus, V2_plus):
-    """V = ‖u⁻‖, or for u⁻ = 0 the answer's own size, at least 1 (docs/theory.md §8)."""
-    if V2_minus > 0.0:
-        return np.sqrt(V2_minus)
-    return _high(np.sqrt(_high(V2_plus, 0.0)), 1.0)
+    """V = ‖u⁻‖, or for u⁻ = 0 the answer's own size, at least 1 (docs/theory.md §8); one
+    square root, of the one square it returns."""
+    V = np.sqrt(V2_minus if V2_minus > 0.0 else _high(V2_plus, 0.0))
+    return V if V2_minus > 0.0 else _high(V, 1.0)
 
 
 @inline_kernel
@@ -196,49 +205,84 @@ def dense_residual_rows(M, Wt, MinvW, s, Um, Up, Lam, E, eps, moreau):
     return out
 
 
+NEW_SUMS = (0.0, 0.0, 0.0, 0.0, 0.0)
+"""The neutral sums of a chain's balls (see :func:`ball_terms`)."""
+
+
+@inline_kernel
+def ball_terms(sums, a, b, mass, inverse, lam_in, lam_out):
+    """``sums`` = (‖u⁻‖²_M, ‖u⁺‖²_M, Σ rⱼ²/mⱼ, ⟨t, u⁻⟩_M, ‖t‖²_M) of a chain with one more
+    ball: u⁻ⱼ = a, u⁺ⱼ = b, its mass and 1/mass, the impulses left (L_j) and right
+    (L_{j+1}) of it, 0 at a free end; t = b − a, rⱼ = mⱼtⱼ − (L_j − L_{j+1})."""
+    V2m, V2p, q, mt_u, mt_t = sums
+    t = b - a
+    r = mass * t
+    V2m += mass * a * a
+    V2p += mass * b * b
+    mt_u += r * a
+    mt_t += r * t
+    r = r - lam_in + lam_out
+    q += r * r * inverse
+    return (V2m, V2p, q, mt_u, mt_t)
+
+
+@inline_kernel
+def gap_velocity(b_left, g_left, b, g, E):
+    """w = γ⁺ + Eγ⁻ of the contact between a ball with (u⁺, restituted velocity) =
+    (b_left, g_left) and the next one's (b, g); a wall is a ball at rest (0, 0)."""
+    return b - b_left + E * (g - g_left)
+
+
+@inline_kernel
+def chain_values(sums, acc, eps, moreau):
+    """The six residuals of a chain from its :func:`ball_terms` sums and contact fold, with
+    ⟨z, u⁻ − z⟩ = −(⟨t, u⁻⟩ + ‖t‖²/(1+ε))/(1+ε) in the kinetic metric."""
+    V2m, V2p, q, mt_u, mt_t = sums
+    h = 1.0 / (1.0 + eps)  # the same for every row of a batch: computed once
+    cross = -(mt_u + mt_t * h) * h if moreau else 0.0
+    return residual_values(velocity_unit(V2m, V2p), np.sqrt(q), acc, eps, moreau, cross)
+
+
+@inline_kernel
+def in_range(top):
+    """Whether a largest entry |u⁻ⱼ| lies within :data:`SCALE_RANGE` (the residuals are then
+    computed on the inputs as they are: :func:`unit_of` is 1)."""
+    return SCALE_RANGE[0] < top < SCALE_RANGE[1]
+
+
 @inline_kernel
 def _chain_pass(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, eps, moreau,
                 f, out):
-    """:func:`chain_step_residuals` with the inputs multiplied by f."""
+    """:func:`chain_step_residuals` with the inputs multiplied by f; returns whether
+    max|u⁻ⱼ| (of the inputs as given) is within :data:`SCALE_RANGE`."""
     n = um.size
     lo = 0 if left_wall else 1  # Λ = (L_lo, L_lo+1, …)
-    V2m = 0.0
-    V2p = 0.0
-    q = 0.0
-    mt_u = 0.0
-    mt_t = 0.0
+    sums = NEW_SUMS
     acc = NEW_FOLD
     b_left = 0.0
     g_left = 0.0
+    top = 0.0
     for j in range(n):
+        top = max(top, abs(um[j]))
         a = um[j] * f
         b = up[j] * f
         g = ur[j] * f  # the velocity the restitution acts on
-        t = b - a
-        mj = masses[j]
-        V2m += mj * a * a
-        V2p += mj * b * b
-        r = mj * t
-        mt_u += r * a
-        mt_t += r * t
         k = j - lo  # the impulse left of ball j
-        if 0 <= k < lam.size:
-            r -= lam[k] * f
-        if 0 <= k + 1 < lam.size:
-            r += lam[k + 1] * f
-        q += r * r * inverse[j]
-        if j > 0:  # the gap left of ball j
-            acc = fold_contact(acc, lam[k] * f, b - b_left + E * (g - g_left), s[k])
-        elif left_wall:
-            acc = fold_contact(acc, lam[0] * f, b + E * g, s[0])
+        lam_in = lam[k] * f if k >= 0 else 0.0
+        lam_out = lam[k + 1] * f if k + 1 < lam.size else 0.0
+        sums = ball_terms(sums, a, b, masses[j], inverse[j], lam_in, lam_out)
+        if k >= 0:  # the gap (or the left wall) left of ball j
+            acc = fold_contact(acc, lam_in, gap_velocity(b_left, g_left, b, g, E), s[k])
         b_left = b
         g_left = g
     if right_wall:
         last = lam.size - 1
-        acc = fold_contact(acc, lam[last] * f, -(b_left + E * g_left), s[last])
-    V = velocity_unit(V2m, V2p)
-    cross = -(mt_u + mt_t / (1.0 + eps)) / (1.0 + eps) if moreau else 0.0
-    finish(V, np.sqrt(q), acc, eps, moreau, cross, out)
+        acc = fold_contact(acc, lam[last] * f, gap_velocity(b_left, g_left, 0.0, 0.0, E),
+                           s[last])
+    values = chain_values(sums, acc, eps, moreau)
+    for i in range(6):
+        out[i] = values[i]
+    return in_range(top)
 
 
 @inline_kernel(interpretable=True)
@@ -248,23 +292,13 @@ def chain_residuals(um, up, lam, masses, inverse, s, left_wall, right_wall, E, e
 
     ``inverse`` holds 1/mⱼ (a product is cheaper than a division in the loop). Contacts are
     the gaps between neighbours, with a wall contact first (γ = u₁) and last
-    (γ = −u_N) where there are walls; E is the scalar restitution. With t = u⁺ − u⁻ and L_j
-    the impulse left of ball j, the momentum is Σⱼ rⱼ²/mⱼ with rⱼ = mⱼtⱼ − (L_j − L_{j+1}),
-    and ⟨z, u⁻ − z⟩ = −(⟨t, u⁻⟩ + ‖t‖²/(1+ε))/(1+ε) in the kinetic metric. Inputs are
-    divided by :func:`unit_of` only when max|u⁻ⱼ| is outside :data:`SCALE_RANGE`.
+    (γ = −u_N) where there are walls; E is the scalar restitution. Each ball adds its
+    :func:`ball_terms`, each contact its :func:`fold_contact`, and :func:`chain_values`
+    makes the residuals. Inputs are divided by :func:`unit_of` only when max|u⁻ⱼ| is
+    outside :data:`SCALE_RANGE` (the pass is then made again).
     """
     chain_step_residuals(um, up, lam, um, masses, inverse, s, left_wall, right_wall, E, eps,
                          moreau, out)
-
-
-@inline_kernel
-def in_unit_range(um):
-    """Whether the largest entry of u⁻ lies within :data:`SCALE_RANGE` (then the residuals
-    are computed on the inputs as they are: :func:`unit_of` is 1)."""
-    top = 0.0
-    for j in range(um.size):
-        top = max(top, abs(um[j]))
-    return SCALE_RANGE[0] < top < SCALE_RANGE[1]
 
 
 @inline_kernel
@@ -272,48 +306,10 @@ def chain_step_residuals(um, up, lam, ur, masses, inverse, s, left_wall, right_w
                          moreau, out):
     """:func:`chain_residuals` with the restitution acting on the contact velocities of
     ``ur`` instead of u⁻ (a Moreau–Jean step: ur = v_k, docs/theory.md §14)."""
-    f = 1.0 if in_unit_range(um) else 1.0 / unit_of(um, up, lam)
-    _chain_pass(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, eps, moreau,
-                f, out)
-
-
-@kernel
-def chain_residual_rows(Um, Up, Lam, masses, inverse, s, left_wall, right_wall, E, eps,
-                        moreau):
-    """:func:`chain_residuals` for every row of (U⁻, U⁺, Λ): a (k, 6) array (a view of the
-    residual columns of :func:`chain_residual_columns`)."""
-    out = np.empty((6, Um.shape[0]))
-    chain_residual_columns(Um, Up, Lam, masses, inverse, s, left_wall, right_wall, E, eps,
-                           moreau, out)
-    return out.T
-
-
-@kernel
-def chain_residual_columns(Um, Up, Lam, masses, inverse, s, left_wall, right_wall, E, eps,
-                           moreau, out):
-    """:func:`chain_residuals` for every row of (U⁻, U⁺, Λ), residual i of row r into
-    ``out[i, r]`` (one contiguous column per residual: a batch keeps them as they are).
-
-    The rows within :data:`SCALE_RANGE` are passed first with the unit 1, the others after
-    them with their :func:`unit_of`: a loop that may call the rescaling at every row costs
-    twice as much per row on short chains (measured on 3 balls: ~120 → ~55 ns)."""
-    k = Um.shape[0]
-    row = np.empty(6)
-    plain = np.empty(k, dtype=np.bool_)
-    for r in range(k):
-        plain[r] = in_unit_range(Um[r])
-    for r in range(k):
-        if plain[r]:
-            _chain_pass(Um[r], Up[r], Lam[r], Um[r], masses, inverse, s, left_wall,
-                        right_wall, E, eps, moreau, 1.0, row)
-            for i in range(6):
-                out[i, r] = row[i]
-    for r in range(k):
-        if not plain[r]:
-            chain_residuals(Um[r], Up[r], Lam[r], masses, inverse, s, left_wall, right_wall,
-                            E, eps, moreau, row)
-            for i in range(6):
-                out[i, r] = row[i]
+    if not _chain_pass(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, eps,
+                       moreau, 1.0, out):
+        _chain_pass(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, eps,
+                    moreau, 1.0 / unit_of(um, up, lam), out)
 
 
 @kernel

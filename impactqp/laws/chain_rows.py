@@ -8,9 +8,10 @@ certificate recomputed from the returned u⁺ and Λ (docs/theory.md §8). There
 Python work and no data-dependent loop, so a chunk costs a few dozen array operations
 whatever its content.
 
-The residuals are those of every chain certificate, computed row by row in compiled code
-(:func:`impactqp.kernels.residuals.chain_residuals`, which rescales rows at extreme
-velocities itself).
+The residuals are those of every chain certificate, computed in compiled code for blocks of
+rows side by side by the steps of :func:`impactqp.kernels.residuals.chain_residuals`
+(:func:`impactqp.kernels.chain_batch.chain_residual_columns`, which passes the rows at
+extreme velocities again one by one, rescaled).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from functools import reduce
 
 import numpy as np
 
-from ..kernels.residuals import chain_residual_columns
+from ..kernels.chain_batch import chain_residual_columns
 from ..model.problem import ImpactProblem
 from ..model.structure import ImpactStructure
 from .base import MOREAU_FAMILY, ImpactLaw
@@ -123,7 +124,7 @@ class ChainRows:
         """Moreau's residuals (docs/theory.md §8) of the rows, a (6, k) array, one column per
         residual in the order of :data:`impactqp.kernels.residuals.RESIDUALS` (written into
         ``out`` when given), by the one definition of the chain certificate
-        (:func:`impactqp.kernels.residuals.chain_residuals`)."""
+        (the steps of :func:`impactqp.kernels.residuals.chain_residuals`, rows side by side)."""
         if out is None:
             out = np.empty((6, U.shape[0]))
         chain_residual_columns(U, Up, Lam, self.masses, self.inverse, self.scale, self.left,

@@ -1,0 +1,192 @@
+"""The chain certificate (docs/theory.md §5, §8) of many impacts of one chain, rows side by
+side: the batch kernels.
+
+:func:`impactqp.kernels.residuals.chain_residuals` passes over one chain's balls. Here a block
+of rows is passed ball by ball, each step over all the block's rows at once (struct of
+arrays: one row of ``state`` per running sum, one entry per row of the batch), so the loop
+over the rows has no branch and no loop-carried dependency and LLVM turns it into SIMD code.
+Each step calls the one definition of the formulas (:func:`~impactqp.kernels.residuals.ball_terms`,
+:func:`~impactqp.kernels.residuals.gap_velocity`,
+:func:`~impactqp.kernels.residuals.fold_contact`,
+:func:`~impactqp.kernels.residuals.chain_values`), in the order the single pass calls them,
+so a row's residuals are those of ``chain_residuals`` bit for bit. The certificate reads u⁻,
+u⁺ and Λ as the batch holds them, nothing of the solve.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import inline_kernel, kernel
+from .residuals import (
+    NEW_FOLD,
+    NEW_SUMS,
+    ball_terms,
+    chain_residuals,
+    chain_values,
+    fold_contact,
+    gap_velocity,
+    in_range,
+)
+
+BLOCK = 256
+"""Rows passed together: their running sums (:data:`STATE` rows of ``BLOCK`` floats, 32 kB)
+stay in the L1 cache while the block's balls are passed."""
+
+STATE = 16
+"""Rows of the block's state: the five sums of :func:`~impactqp.kernels.residuals.ball_terms`
+(0–4), the four of the contact fold (5–8), u⁺ and u⁻ of the previous ball (9, 10), the
+largest |u⁻ⱼ| (11), u⁻ⱼ, u⁺ⱼ and the impulse right of ball j gathered from the rows (12–14),
+the impulse left of ball j (15)."""
+
+
+@kernel
+def chain_residual_rows(Um, Up, Lam, masses, inverse, s, left_wall, right_wall, E, eps,
+                        moreau):
+    """:func:`~impactqp.kernels.residuals.chain_residuals` for every row of (U⁻, U⁺, Λ): a
+    (k, 6) array (a view of the residual columns of :func:`chain_residual_columns`)."""
+    out = np.empty((6, Um.shape[0]))
+    chain_residual_columns(Um, Up, Lam, masses, inverse, s, left_wall, right_wall, E, eps,
+                           moreau, out)
+    return out.T
+
+
+@kernel
+def chain_residual_columns(Um, Up, Lam, masses, inverse, s, left_wall, right_wall, E, eps,
+                           moreau, out):
+    """:func:`~impactqp.kernels.residuals.chain_residuals` for every row of (U⁻, U⁺, Λ),
+    residual i of row r into ``out[i, r]`` (one contiguous column per residual: a batch
+    keeps them as they are).
+
+    Blocks of :data:`BLOCK` rows are passed with the unit 1; the rows whose largest |u⁻ⱼ|
+    is outside the unit range are then passed again one by one by ``chain_residuals``, which
+    rescales them."""
+    k = Um.shape[0]
+    state = np.empty(STATE * BLOCK)
+    row = np.empty(6)
+    walls = (left_wall, right_wall)
+    law = (E, eps, moreau)
+    for start in range(0, k, BLOCK):
+        stop = min(start + BLOCK, k)
+        _block(Um[start:stop], Up[start:stop], Lam[start:stop], masses, inverse, s, walls,
+               law, state, out[:, start:stop])
+        for i in range(stop - start):
+            if not in_range(state[11 * BLOCK + i]):
+                r = start + i
+                chain_residuals(Um[r], Up[r], Lam[r], masses, inverse, s, left_wall,
+                                right_wall, E, eps, moreau, row)
+                for c in range(6):
+                    out[c, r] = row[c]
+
+
+@inline_kernel
+def _sums(state, i):
+    """Row i's sums of :func:`~impactqp.kernels.residuals.ball_terms` (state rows 0–4)."""
+    return (state[i], state[BLOCK + i], state[2 * BLOCK + i], state[3 * BLOCK + i],
+            state[4 * BLOCK + i])
+
+
+@inline_kernel
+def _fold(state, i):
+    """Row i's contact fold (state rows 5–8)."""
+    return (state[5 * BLOCK + i], state[6 * BLOCK + i], state[7 * BLOCK + i],
+            state[8 * BLOCK + i])
+
+
+@inline_kernel
+def _put(state, first, values, i):
+    """Write the 4- or 5-tuple ``values`` into state rows first, first + 1, … at row i
+    (element by element: a tuple indexed in a loop keeps LLVM from vectorizing)."""
+    state[first * BLOCK + i] = values[0]
+    state[(first + 1) * BLOCK + i] = values[1]
+    state[(first + 2) * BLOCK + i] = values[2]
+    state[(first + 3) * BLOCK + i] = values[3]
+    if len(values) == 5:
+        state[(first + 4) * BLOCK + i] = values[-1]
+
+
+@inline_kernel
+def _block(Um, Up, Lam, masses, inverse, s, walls, law, state, out):
+    """The residuals of the rows of one block, unit 1, into ``out`` (6 × rows)."""
+    rows, n = Um.shape
+    m = Lam.shape[1]
+    left_wall, right_wall = walls
+    E, eps, moreau = law
+    lo = 0 if left_wall else 1
+    _start(state, Lam, left_wall, rows)
+    for j in range(n):
+        k = j - lo  # the impulse left of ball j
+        _gather(state, Um, Up, Lam, j, k + 1, rows)
+        _balls(state, masses[j], inverse[j], rows)
+        if k >= 0:  # the gap (or the left wall) left of ball j
+            _contacts(state, s[k], E, rows)
+        _shift(state, rows)
+    if right_wall:  # the wall is a ball at rest; L_N is the last impulse
+        _gather(state, Um, Up, Lam, -1, m, rows)
+        _contacts(state, s[m - 1], E, rows)
+    _values(state, eps, moreau, out, rows)
+
+
+@kernel(internal=True)
+def _start(state, Lam, left_wall, rows):
+    """The neutral sums and fold, a previous ball at rest, L_0 (0 left of a free ball)."""
+    for i in range(rows):
+        _put(state, 0, NEW_SUMS, i)
+        _put(state, 5, NEW_FOLD, i)
+        state[9 * BLOCK + i] = 0.0
+        state[10 * BLOCK + i] = 0.0
+        state[11 * BLOCK + i] = 0.0
+        state[15 * BLOCK + i] = Lam[i, 0] if left_wall else 0.0
+
+
+@kernel(internal=True)
+def _gather(state, Um, Up, Lam, j, k, rows):
+    """u⁻ⱼ, u⁺ⱼ (0 for j = −1, a wall at rest) and the impulse Λ_k (0 for k past the end)
+    of each row into state rows 12–14: the loops after it read columns."""
+    m = Lam.shape[1]
+    for i in range(rows):
+        state[12 * BLOCK + i] = Um[i, j] if j >= 0 else 0.0
+        state[13 * BLOCK + i] = Up[i, j] if j >= 0 else 0.0
+        state[14 * BLOCK + i] = Lam[i, k] if k < m else 0.0
+
+
+@kernel(internal=True)
+def _balls(state, mass, inverse, rows):
+    """Each row's sums with its ball j, and its largest |u⁻ⱼ| so far."""
+    for i in range(rows):
+        a = state[12 * BLOCK + i]
+        _put(state, 0, ball_terms(_sums(state, i), a, state[13 * BLOCK + i], mass, inverse,
+                                  state[15 * BLOCK + i], state[14 * BLOCK + i]), i)
+        state[11 * BLOCK + i] = max(state[11 * BLOCK + i], abs(a))
+
+
+@kernel(internal=True)
+def _contacts(state, scale, E, rows):
+    """Each row's contact fold with the contact between its previous ball (state rows 9,
+    10) and its current one (12, 13) of impulse L_j (row 15): the restitution acts on u⁻."""
+    for i in range(rows):
+        w = gap_velocity(state[9 * BLOCK + i], state[10 * BLOCK + i], state[13 * BLOCK + i],
+                         state[12 * BLOCK + i], E)
+        _put(state, 5, fold_contact(_fold(state, i), state[15 * BLOCK + i], w, scale), i)
+
+
+@kernel(internal=True)
+def _shift(state, rows):
+    """Ball j becomes the previous one, L_{j+1} its left impulse."""
+    for i in range(rows):
+        state[9 * BLOCK + i] = state[13 * BLOCK + i]
+        state[10 * BLOCK + i] = state[12 * BLOCK + i]
+        state[15 * BLOCK + i] = state[14 * BLOCK + i]
+
+
+@kernel(internal=True)
+def _values(state, eps, moreau, out, rows):
+    """Each row's six residuals from its sums and fold, into the columns of ``out``."""
+    for i in range(rows):
+        values = chain_values(_sums(state, i), _fold(state, i), eps, moreau)
+        out[0, i] = values[0]
+        out[1, i] = values[1]
+        out[2, i] = values[2]
+        out[3, i] = values[3]
+        out[4, i] = values[4]
+        out[5, i] = values[5]
