@@ -19,7 +19,13 @@ from functools import cached_property
 import numpy as np
 
 from ..kernels.friction import kernel_mu
-from ..kernels.friction_tiny import CERTIFIED, FRICTION_FIGURES, solve_given
+from ..kernels.friction_tiny import (
+    CERTIFIED,
+    FRICTION_FIGURES,
+    pack,
+    solve_given,
+    solve_packed,
+)
 from ..model.friction import FrictionCertificate, FrictionContactProblem, friction_certificate
 from ..qp.friction import methods
 from ..qp.friction.newton import NEWTON_STEPS
@@ -32,8 +38,15 @@ _DENSE = (np.empty(0, dtype=np.int32), np.empty(0, dtype=np.int32), np.empty(0),
 _NO_W = np.empty((0, 0))
 """The ``W`` of :func:`~impactqp.kernels.friction_tiny.solve_given` for a compressed W."""
 _FIGURES = len(FRICTION_FIGURES)
-_limits: dict[tuple[float, bool], tuple[float, int, int, int, bool]] = {}
-"""The ``limits`` of each tolerance and route met so far (a plain tuple, built once)."""
+_KEPT = "_packed_few"
+"""The attribute of a problem :func:`solve_few` has solved: (W, q, (floats, ints, scaled)),
+the problem as :func:`~impactqp.kernels.friction_tiny.pack` packs it and whether its units
+are not all 1, or :data:`_UNPACKED` before its second solve."""
+_UNPACKED = (None, None, False)
+"""The kept arrays of a problem solved once: none yet."""
+_SCALED = 4
+"""The entry of a packed problem's integer array that says whether its units are not all 1
+(:data:`~impactqp.kernels.friction_tiny.PACKED_HEADER`)."""
 SWEPT_CONTACTS = 64
 """Most contacts of a problem beyond :data:`~impactqp.qp.friction.methods.SMALL_CONTACTS`
 whose first sweep :func:`solve_few` tries in one compiled call before the general route:
@@ -57,8 +70,14 @@ class SmallFrictionResult(FrictionResult):
         (``size`` each) and the figures; ``scaled`` whether the problem was posed in other
         units than given."""
         result = cls.__new__(cls)
-        result.__dict__.update(_out=out, _size=size, _tol=tol, _scaled=scaled,
-                               iterations=iterations, solve_time=seconds, backend=backend)
+        fields = result.__dict__  # item by item: cheaper than update(**fields) by ~0.15 µs
+        fields["_out"] = out
+        fields["_size"] = size
+        fields["_tol"] = tol
+        fields["_scaled"] = scaled
+        fields["iterations"] = iterations
+        fields["solve_time"] = seconds
+        fields["backend"] = backend
         return result
 
     @property
@@ -99,14 +118,42 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
     problem has more contacts, q in contact units needs the scale-first rule, or the call's
     answer fails its certificate: the general route then runs (and tries the method again
     among the others).
+
+    A problem solved a second time is kept packed (:func:`~impactqp.kernels.friction_tiny.pack`:
+    posed in its contacts' units, with its diagonal blocks and their steps) on the problem, as
+    :meth:`~impactqp.FrictionContactProblem.in_contact_units` keeps its units: later solves
+    start from it (:func:`~impactqp.kernels.friction_tiny.solve_packed`). The first solve
+    packs nothing (a simulator poses a new problem at each step), and a problem whose W or q
+    is no longer the object packed is packed again.
     """
     m = problem.n_contacts
     small = m <= methods.SMALL_CONTACTS  # the "kernel" method's own limit
     if not (small or (sweeps and m <= SWEPT_CONTACTS)):
         return None
+    size = problem.q.size
+    out = np.empty(2 * size + _FIGURES)
+    kept = problem.__dict__.get(_KEPT)
+    if kept is not None and kept[0] is problem.W and kept[1] is problem.q:
+        floats, ints, scaled = kept[2]
+        if floats is None:  # solved once: pack it
+            floats, ints = pack(*_given(problem), _budgets(small))
+            scaled = bool(ints[_SCALED])
+            problem.__dict__[_KEPT] = (problem.W, problem.q, (floats, ints, scaled))
+        its, outcome = solve_packed(floats, ints, tol, out)
+    else:
+        problem.__dict__[_KEPT] = (problem.W, problem.q, _UNPACKED)
+        its, outcome, scaled = solve_given(*_given(problem), (tol, *_budgets(small)), out)
+    if outcome != CERTIFIED:
+        return None
+    return SmallFrictionResult.of_call(out, size, tol, its, time.perf_counter() - start,
+                                       scaled, "kernel" if small else "nsgs-short")
+
+
+def _given(problem: FrictionContactProblem) -> tuple:
+    """(W, rows, q, μ, d) of :func:`~impactqp.kernels.friction_tiny.solve_given` for
+    ``problem``: W dense, or its compressed arrays (CSC kept as columns, other formats as
+    CSR rows)."""
     W = problem.W
-    q = problem.q
-    size = q.size
     if isinstance(W, np.ndarray):
         W = np.ascontiguousarray(W)
         rows = _DENSE
@@ -116,15 +163,11 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
         rows = (W.indptr.astype(np.int32, copy=False), W.indices.astype(np.int32, copy=False),
                 np.asarray(W.data, dtype=float), W.format == "csc")
         W = _NO_W
-    limits = _limits.get((tol, small))
-    if limits is None:
-        limits = _limits.setdefault((tol, small), (
-            tol, NEWTON_STEPS, methods.NSGS_SHORT,
-            methods.SMALL_LOCAL if small else methods.NSGS_LOCAL, small))
-    out = np.empty(2 * size + _FIGURES)
-    its, outcome, scaled = solve_given(W, rows, q, kernel_mu(problem.mu), problem.contact_dim,
-                                       limits, out)
-    if outcome != CERTIFIED:
-        return None
-    return SmallFrictionResult.of_call(out, size, tol, its, time.perf_counter() - start,
-                                       scaled, "kernel" if small else "nsgs-short")
+    return W, rows, problem.q, kernel_mu(problem.mu), problem.contact_dim
+
+
+def _budgets(small: bool) -> tuple[int, int, int, bool]:
+    """(Newton steps, sweeps, local iterations, whole) of the ``"kernel"`` method
+    (``small``) or of the first sweep of ``"nsgs-short"``."""
+    return (NEWTON_STEPS, methods.NSGS_SHORT,
+            methods.SMALL_LOCAL if small else methods.NSGS_LOCAL, small)
