@@ -13,13 +13,8 @@ import scipy.sparse as sp
 import impactqp as iq
 from benchmarks import friction_data
 from benchmarks.friction_tiny import ONE_SWEEP, TINY
-from impactqp.kernels.friction_tiny import (
-    CERTIFIED,
-    NEEDS_SCALING,
-    PACKED_HEADER,
-    pack,
-    solve_packed,
-)
+from impactqp.kernels.friction_packed import PACKED_HEADER, pack, solve_packed
+from impactqp.kernels.friction_tiny import CERTIFIED, NEEDS_SCALING
 from impactqp.laws import friction_small
 from impactqp.laws.friction_small import SmallFrictionResult
 from impactqp.model.friction import certify_friction

@@ -18,7 +18,8 @@ from benchmarks import friction_data
 from benchmarks.friction_tiny import ONE_SWEEP, TINY
 from impactqp.errors import BackendUnsuitableError, CertificateError
 from impactqp.friction import FrictionResult
-from impactqp.kernels.friction_tiny import CERTIFIED, NOT_CERTIFIED, solve_given
+from impactqp.kernels.friction_packed import solve_given
+from impactqp.kernels.friction_tiny import CERTIFIED, NOT_CERTIFIED
 from impactqp.laws import friction_small
 from impactqp.laws.friction_small import SmallFrictionResult
 from impactqp.model.friction import certify_friction

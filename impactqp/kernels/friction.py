@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction_blocks import exact_contact, local_steps, nonzero_rows
+from .friction_blocks import diagonal_blocks, exact_contact, local_steps, nonzero_rows
 from .jit import inline_kernel, kernel
 
 CHECK_GAP = 8
@@ -247,29 +247,12 @@ def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
 
 @kernel
 def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
-    """Projected Gauss–Seidel over the contacts (docs/theory.md §15), updating ``r`` in place;
-    W given by its compressed rows (``indptr``, ``indices``, ``data``: scipy's CSR arrays),
-    so that a sweep costs the entries of W: :func:`nsgs_blocks` on W's diagonal blocks and
-    their local steps (:func:`diagonal_blocks`), gathered at each call. Returns (sweeps done,
-    ‖F‖/‖q‖ at the end)."""
+    """:func:`nsgs_blocks` on W's compressed rows (scipy's CSR ``indptr``, ``indices``,
+    ``data``), its diagonal blocks and their steps gathered at each call
+    (:func:`~impactqp.kernels.friction_blocks.diagonal_blocks`). Returns (sweeps, ‖F‖/‖q‖)."""
     Wcc = diagonal_blocks(indptr, indices, data, mu.size, d)
     return nsgs_blocks((indptr, indices, data), (Wcc, local_steps(Wcc)), q, mu, d, r, tol,
                        max_sweeps, local_iters)
-
-
-@kernel(interpretable=True)
-def diagonal_blocks(indptr, indices, data, m, d):
-    """The m diagonal d × d blocks W_cc of W given by its compressed rows (duplicates
-    summed)."""
-    Wcc = np.zeros((m, d, d))
-    for c in range(m):
-        k = c * d
-        for i in range(d):
-            for p in range(indptr[k + i], indptr[k + i + 1]):
-                j = indices[p] - k
-                if 0 <= j < d:
-                    Wcc[c, i, j] += data[p]
-    return Wcc
 
 
 @kernel
@@ -277,7 +260,7 @@ def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
     """Projected Gauss–Seidel over the contacts (docs/theory.md §15), updating ``r`` in place;
     W given by its compressed ``rows`` (indptr, indices, data: scipy's CSR arrays), so that a
     sweep costs the entries of W, and ``blocks`` = (W_cc, ρ_c): its diagonal blocks
-    (:func:`diagonal_blocks`) and their steps
+    (:func:`~impactqp.kernels.friction_blocks.diagonal_blocks`) and their steps
     (:func:`~impactqp.kernels.friction_blocks.local_steps`), which a caller solving the same
     W again keeps.
 

@@ -2,7 +2,7 @@
 (docs/theory.md §15).
 
 :func:`solve_few` hands W (dense, or compressed as scipy holds it), q and μ to
-:func:`impactqp.kernels.friction_tiny.solve_given`, which poses the problem in its contacts'
+:func:`impactqp.kernels.friction_packed.solve_given`, which poses the problem in its contacts'
 units, solves it by the ``"kernel"`` method (or, for a few dozen contacts, sweeps it once),
 scales the answer back and recomputes its certificate from W and q as given, and returns the
 verdict. Nothing but that verdict is
@@ -19,13 +19,8 @@ from functools import cached_property
 import numpy as np
 
 from ..kernels.friction import kernel_mu
-from ..kernels.friction_tiny import (
-    CERTIFIED,
-    FRICTION_FIGURES,
-    pack,
-    solve_given,
-    solve_packed,
-)
+from ..kernels.friction_packed import pack, solve_given, solve_packed
+from ..kernels.friction_tiny import CERTIFIED, FRICTION_FIGURES
 from ..model.friction import FrictionCertificate, FrictionContactProblem, friction_certificate
 from ..qp.friction import methods
 from ..qp.friction.newton import NEWTON_STEPS
@@ -34,15 +29,15 @@ from .result import FrictionResult
 __all__ = ["SmallFrictionResult", "solve_few"]
 
 _DENSE = (np.empty(0, dtype=np.int32), np.empty(0, dtype=np.int32), np.empty(0), False)
-"""The ``rows`` of :func:`~impactqp.kernels.friction_tiny.solve_given` for a dense W."""
+"""The ``rows`` of :func:`~impactqp.kernels.friction_packed.solve_given` for a dense W."""
 _NO_W = np.empty((0, 0))
-"""The ``W`` of :func:`~impactqp.kernels.friction_tiny.solve_given` for a compressed W."""
+"""The ``W`` of :func:`~impactqp.kernels.friction_packed.solve_given` for a compressed W."""
 _FIGURES = len(FRICTION_FIGURES)
 _KEPT = "_packed_few"
 """The attribute of a problem :func:`solve_few` has solved, a :class:`_Kept`."""
 _SCALED = 4
 """The entry of a packed problem's integer array that says whether its units are not all 1
-(:data:`~impactqp.kernels.friction_tiny.PACKED_HEADER`)."""
+(:data:`~impactqp.kernels.friction_packed.PACKED_HEADER`)."""
 SWEPT_CONTACTS = 64
 """Most contacts of a problem beyond :data:`~impactqp.qp.friction.methods.SMALL_CONTACTS`
 whose first sweep :func:`solve_few` tries in one compiled call before the general route:
@@ -106,7 +101,7 @@ class SmallFrictionResult(FrictionResult):
 def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
               sweeps: bool = True) -> SmallFrictionResult | None:
     """The certified answer of one compiled call
-    (:func:`impactqp.kernels.friction_tiny.solve_given`), ``start`` the
+    (:func:`impactqp.kernels.friction_packed.solve_given`), ``start`` the
     ``time.perf_counter()`` of the solve's start: for at most
     :data:`~impactqp.qp.friction.methods.SMALL_CONTACTS` contacts the ``"kernel"``
     method's; with ``sweeps``, for at most :data:`SWEPT_CONTACTS`, that of one sweep of the
@@ -115,10 +110,10 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
     answer fails its certificate: the general route then runs (and tries the method again
     among the others).
 
-    A problem solved a second time is kept packed (:func:`~impactqp.kernels.friction_tiny.pack`:
+    A problem solved a second time is kept packed (:func:`~impactqp.kernels.friction_packed.pack`:
     posed in its contacts' units, with its diagonal blocks and their steps) on the problem, as
     :meth:`~impactqp.FrictionContactProblem.in_contact_units` keeps its units: later solves
-    start from it (:func:`~impactqp.kernels.friction_tiny.solve_packed`). The first solve
+    start from it (:func:`~impactqp.kernels.friction_packed.solve_packed`). The first solve
     packs nothing (a simulator poses a new problem at each step), and a problem whose W or q
     is no longer the object packed is packed again.
     """
@@ -148,7 +143,7 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
 class _Kept:
     """What :func:`solve_few` keeps on a problem it has solved: the W and q objects it
     solved, whether by the ``"kernel"`` method (``small``), and from its second solve on
-    the problem packed by :func:`~impactqp.kernels.friction_tiny.pack` (``floats``,
+    the problem packed by :func:`~impactqp.kernels.friction_packed.pack` (``floats``,
     ``ints``) with whether its units are not all 1 (``scaled``)."""
 
     __slots__ = ("W", "q", "small", "floats", "ints", "scaled")
@@ -161,7 +156,7 @@ class _Kept:
 
 
 def _given(problem: FrictionContactProblem) -> tuple:
-    """(W, rows, q, μ, d) of :func:`~impactqp.kernels.friction_tiny.solve_given` for
+    """(W, rows, q, μ, d) of :func:`~impactqp.kernels.friction_packed.solve_given` for
     ``problem``: W dense, or its compressed arrays (CSC kept as columns, other formats as
     CSR rows)."""
     W = problem.W
