@@ -1,5 +1,5 @@
 """A problem of a few contacts solved again (impactqp/laws/friction_small.py,
-impactqp/kernels/friction_tiny.py's pack and solve_packed): its second solve packs it, later
+impactqp/kernels/friction_packed.py's pack and solve_packed): its second solve packs it, later
 ones start from the pack, every solve gives the first one's answer, which the general route
 and certify_friction confirm; the pack is the problem posed as the model poses it; a
 problem whose q or W is replaced is packed again."""
@@ -32,11 +32,11 @@ def test_solves_again_give_the_first_answer(name: str) -> None:
     problem = friction_data.load(name).problem
     assert kept(problem) is None
     first = iq.solve_friction(problem, tol=TOL)
-    assert kept(problem).floats is None  # a first solve packs nothing
+    assert kept(problem).packed is None  # a first solve packs nothing
     second = iq.solve_friction(problem, tol=TOL)
-    floats = kept(problem).floats
+    packed = kept(problem).packed
     third = iq.solve_friction(problem, tol=TOL)
-    assert kept(problem).floats is floats  # packed once
+    assert kept(problem).packed is packed  # packed once
     for again in (second, third):
         assert type(again) is SmallFrictionResult and again.backend == first.backend
         np.testing.assert_array_equal(again.r, first.r)

@@ -128,11 +128,12 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
         problem.__dict__[_KEPT] = _Kept(problem.W, problem.q, small)
         its, outcome, scaled = solve_given(*_given(problem), (tol, *_budgets(small)), out)
     else:
-        if kept.floats is None:  # solved once: pack it
-            kept.floats, kept.ints = pack(*_given(problem), _budgets(small))
-            kept.scaled = bool(kept.ints[_SCALED])
-        its, outcome = solve_packed(kept.floats, kept.ints, tol, out)
-        scaled = kept.scaled
+        packed = kept.packed
+        if packed is None:  # solved once: pack it
+            floats, ints = pack(*_given(problem), _budgets(small))
+            packed = kept.packed = (floats, ints, bool(ints[_SCALED]))  # one assignment
+        its, outcome = solve_packed(packed[0], packed[1], tol, out)
+        scaled = packed[2]
     if outcome != CERTIFIED:
         return None
     return SmallFrictionResult.of_call(out, problem.q.size, tol, its,
@@ -143,16 +144,15 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
 class _Kept:
     """What :func:`solve_few` keeps on a problem it has solved: the W and q objects it
     solved, whether by the ``"kernel"`` method (``small``), and from its second solve on
-    the problem packed by :func:`~impactqp.kernels.friction_packed.pack` (``floats``,
-    ``ints``) with whether its units are not all 1 (``scaled``)."""
+    ``packed``: the problem packed by :func:`~impactqp.kernels.friction_packed.pack`
+    (floats, ints) and whether its units are not all 1, set in one assignment (a thread
+    solving the same problem sees all of it or none)."""
 
-    __slots__ = ("W", "q", "small", "floats", "ints", "scaled")
+    __slots__ = ("W", "q", "small", "packed")
 
     def __init__(self, W, q: np.ndarray, small: bool) -> None:
         self.W, self.q, self.small = W, q, small
-        self.floats: np.ndarray | None = None
-        self.ints: np.ndarray | None = None
-        self.scaled = False
+        self.packed: tuple[np.ndarray, np.ndarray, bool] | None = None
 
 
 def _given(problem: FrictionContactProblem) -> tuple:
