@@ -5,10 +5,11 @@
 :func:`impactqp.kernels.friction_packed.solve_given`, which poses the problem in its contacts'
 units, solves it by the ``"kernel"`` method (or, for a few dozen contacts, sweeps it once),
 scales the answer back and recomputes its certificate from W and q as given, and returns the
-verdict. Nothing but that verdict is
-turned into Python objects at the call: the :class:`SmallFrictionResult` holds the array the
-call filled (r, u and the certificate's figures) and builds the certificate, the error and
-the attempts from it when they are read.
+verdict. A problem solved again is solved from the pack its second solve keeps on it
+(:func:`impactqp.kernels.friction_packed.solve_packed`). Nothing but the verdict is turned
+into Python objects at the call: the :class:`SmallFrictionResult` holds the array the call
+filled (r, u and the certificate's figures) and builds the certificate, the error and the
+attempts from it when they are read.
 """
 
 from __future__ import annotations
