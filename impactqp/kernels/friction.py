@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction_blocks import exact_contact, local_steps, nonzero_rows
+from .friction_blocks import diagonal_blocks, exact_contact, local_steps, nonzero_rows
 from .jit import inline_kernel, kernel
 
 CHECK_GAP = 8
@@ -86,18 +86,26 @@ def kernel_mu(mu: np.ndarray) -> np.ndarray:
     return np.array(mu, dtype=float)
 
 
+@inline_kernel
+def natural_map_into(r, u, mu, d, F):
+    """``F`` = r − P_{K_μ}(r − ũ) contact by contact, ũ = u + μ‖u_T‖e_n (F neither r nor
+    u): the one definition, without an array of its own."""
+    for c in range(mu.size):
+        k = c * d
+        modified_contact(u, mu[c], k, d, F)
+        for j in range(d):
+            F[k + j] = r[k + j] - F[k + j]
+        project_contact(F, mu[c], k, d, F)  # in place: each entry is read before written
+        for j in range(d):
+            F[k + j] = r[k + j] - F[k + j]
+
+
 @kernel(interpretable=True)
 def natural_map(r, u, mu, d):
-    """F = r − P_{K_μ}(r − ũ) contact by contact, ũ = u + μ‖u_T‖e_n."""
-    ut = modified_velocity(u, mu, d)
-    x = np.empty_like(u)
+    """F = r − P_{K_μ}(r − ũ) contact by contact, ũ = u + μ‖u_T‖e_n
+    (:func:`natural_map_into`)."""
     F = np.empty_like(u)
-    for i in range(r.size):
-        x[i] = r[i] - ut[i]
-    for c in range(mu.size):
-        project_contact(x, mu[c], c * d, d, F)
-    for i in range(r.size):
-        F[i] = r[i] - F[i]
+    natural_map_into(r, u, mu, d, F)
     return F
 
 
@@ -239,76 +247,45 @@ def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
 
 @kernel
 def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
+    """:func:`nsgs_blocks` on W's compressed rows (scipy's CSR ``indptr``, ``indices``,
+    ``data``), its diagonal blocks and their steps gathered at each call
+    (:func:`~impactqp.kernels.friction_blocks.diagonal_blocks`). Returns (sweeps, ‖F‖/‖q‖)."""
+    Wcc = diagonal_blocks(indptr, indices, data, mu.size, d)
+    return nsgs_blocks((indptr, indices, data), (Wcc, local_steps(Wcc)), q, mu, d, r, tol,
+                       max_sweeps, local_iters)
+
+
+@kernel
+def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
     """Projected Gauss–Seidel over the contacts (docs/theory.md §15), updating ``r`` in place;
-    W given by its compressed rows (``indptr``, ``indices``, ``data``: scipy's CSR arrays),
-    so that a sweep costs the entries of W.
+    W given by its compressed ``rows`` (indptr, indices, data: scipy's CSR arrays), so that a
+    sweep costs the entries of W, and ``blocks`` = (W_cc, ρ_c): its diagonal blocks
+    (:func:`~impactqp.kernels.friction_blocks.diagonal_blocks`) and their steps
+    (:func:`~impactqp.kernels.friction_blocks.local_steps`), which a caller solving the same
+    W again keeps.
 
     Each contact's local problem (the others held) is solved exactly where a closed form
     holds (:func:`~impactqp.kernels.friction_blocks.exact_contact`: apart, sticking, a planar
     contact sliding), else by at most
-    ``local_iters`` steps of the projected fixed point r_c ← P_{K_μ}(r_c − ρ_c ũ_c) (ρ_c of
-    :func:`~impactqp.kernels.friction_blocks.local_steps`), fewer once a step moves r_c by
-    less than 10⁻⁶‖r_c‖; the sweeps stop when ‖F‖ ≤ tol·‖q‖.
+    ``local_iters`` steps of the projected fixed point r_c ← P_{K_μ}(r_c − ρ_c ũ_c), fewer
+    once a step moves r_c by less than 10⁻⁶‖r_c‖; the sweeps stop when ‖F‖ ≤ tol·‖q‖.
     ‖F‖ (a product by W, as dear as a sweep) is evaluated after the first sweep, then after
     as many sweeps as its decrease since the last evaluation predicts are left to reach tol
     (at most :data:`CHECK_GAP`, and one while it does not decrease) and after the last.
     Returns (sweeps done, ‖F‖/‖q‖ at the end).
     """
-    m = mu.size
+    indptr, indices, data = rows
     n = r.size
     qn = np.sqrt(np.sum(q * q))
     if qn == 0.0:
         qn = 1.0
     u = np.empty(n)
-    x = np.empty(d)
-    rc = np.empty(d)
-    uc = np.empty(d)
-    mc = np.empty(d)
-    base = np.empty(d)  # q_c + Σ_{j≠c} W_cj r_j
-    Wcc = np.zeros((m, d, d))  # the diagonal blocks
-    for c in range(m):
-        k = c * d
-        for i in range(d):
-            for p in range(indptr[k + i], indptr[k + i + 1]):
-                j = indices[p] - k
-                if 0 <= j < d:
-                    Wcc[c, i, j] += data[p]
-    rhos = local_steps(Wcc)
+    F = np.empty(n)
+    scratch = np.empty(5 * d)
     err = np.inf
     last_err, last_at, check_at = np.inf, 0, 1
     for sweep in range(max_sweeps):
-        for c in range(m):
-            k = c * d
-            rho = rhos[c]
-            for i in range(d):
-                v = q[k + i]
-                for p in range(indptr[k + i], indptr[k + i + 1]):
-                    v += data[p] * r[indices[p]]
-                for j in range(d):
-                    v -= Wcc[c, i, j] * r[k + j]
-                base[i] = v
-                rc[i] = r[k + i]
-            exact = exact_contact(Wcc[c], base, mu[c], d, rc)
-            for _ in range(0 if exact else local_iters):
-                for i in range(d):
-                    v = base[i]
-                    for j in range(d):
-                        v += Wcc[c, i, j] * rc[j]
-                    uc[i] = v
-                modified_contact(uc, mu[c], 0, d, mc)
-                for i in range(d):
-                    x[i] = rc[i] - rho * mc[i]
-                change = 0.0
-                size = 0.0
-                project_contact(x, mu[c], 0, d, mc)
-                for i in range(d):
-                    change += (mc[i] - rc[i]) ** 2
-                    size += mc[i] * mc[i]
-                    rc[i] = mc[i]
-                if change <= 1e-12 * (size + 1e-300):  # squares: 10⁻⁶ in norm
-                    break
-            for i in range(d):
-                r[k + i] = rc[i]
+        sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch)
         done = sweep + 1
         if done < check_at and done < max_sweeps:
             continue
@@ -317,7 +294,7 @@ def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
             for p in range(indptr[i], indptr[i + 1]):
                 v += data[p] * r[indices[p]]
             u[i] = v
-        F = natural_map(r, u, mu, d)
+        natural_map_into(r, u, mu, d, F)
         err = np.sqrt(np.sum(F * F)) / qn
         if err <= tol:
             return done, err
@@ -327,3 +304,57 @@ def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
             gap = int(min(max(left, 1.0), CHECK_GAP))
         last_err, last_at, check_at = err, done, done + gap
     return max_sweeps, err
+
+
+@inline_kernel
+def sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch):
+    """One sweep of :func:`nsgs_blocks` over the contacts, updating ``r`` in place, with
+    ``scratch`` of 5·d floats: each contact's local problem solved exactly where a closed
+    form holds, else by at most ``local_iters`` projected fixed-point steps. A contact whose
+    normal row b_n is ≥ 0 is apart (r_c = 0) before its tangential rows are summed: most
+    contacts of a pile of spheres are (41 of NESpheres-30's 44 in its one sweep)."""
+    indptr, indices, data = rows
+    Wcc, rhos = blocks
+    x = scratch[:d]
+    rc = scratch[d:2 * d]
+    uc = scratch[2 * d:3 * d]
+    mc = scratch[3 * d:4 * d]
+    base = scratch[4 * d:5 * d]  # q_c + Σ_{j≠c} W_cj r_j
+    for c in range(mu.size):
+        k = c * d
+        rho = rhos[c]
+        for i in range(d):
+            v = q[k + i]
+            for p in range(indptr[k + i], indptr[k + i + 1]):
+                v += data[p] * r[indices[p]]
+            for j in range(d):
+                v -= Wcc[c, i, j] * r[k + j]
+            base[i] = v
+            rc[i] = r[k + i]
+            if i == 0 and v >= 0.0:  # apart (the first case of exact_contact): r_c = 0
+                break
+        if base[0] >= 0.0:
+            for i in range(d):
+                r[k + i] = 0.0
+            continue
+        exact = exact_contact(Wcc[c], base, mu[c], d, rc)
+        for _ in range(0 if exact else local_iters):
+            for i in range(d):
+                v = base[i]
+                for j in range(d):
+                    v += Wcc[c, i, j] * rc[j]
+                uc[i] = v
+            modified_contact(uc, mu[c], 0, d, mc)
+            for i in range(d):
+                x[i] = rc[i] - rho * mc[i]
+            change = 0.0
+            size = 0.0
+            project_contact(x, mu[c], 0, d, mc)
+            for i in range(d):
+                change += (mc[i] - rc[i]) ** 2
+                size += mc[i] * mc[i]
+                rc[i] = mc[i]
+            if change <= 1e-12 * (size + 1e-300):  # squares: 10⁻⁶ in norm
+                break
+        for i in range(d):
+            r[k + i] = rc[i]

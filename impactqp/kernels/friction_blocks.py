@@ -64,6 +64,21 @@ def local_steps(Wcc):
 
 
 @kernel(interpretable=True)
+def diagonal_blocks(indptr, indices, data, m, d):
+    """The m diagonal d × d blocks W_cc of W given by its compressed rows (duplicates
+    summed)."""
+    Wcc = np.zeros((m, d, d))
+    for c in range(m):
+        k = c * d
+        for i in range(d):
+            for p in range(indptr[k + i], indptr[k + i + 1]):
+                j = indices[p] - k
+                if 0 <= j < d:
+                    Wcc[c, i, j] += data[p]
+    return Wcc
+
+
+@kernel(interpretable=True)
 def nonzero_rows(W):
     """W's compressed rows (scipy's CSR arrays ``indptr``, ``indices``, ``data``) with its
     zero entries left out: a sweep then costs the entries that are there (W of contacts
@@ -153,4 +168,5 @@ def exact_contact(Wc, base, mu, d, out):
                 return True
     return False
 
-__all__ = ["extreme_sum", "local_steps", "exact_contact", "nonzero_rows", "sticking"]
+__all__ = ["diagonal_blocks", "extreme_sum", "local_steps", "exact_contact", "nonzero_rows",
+           "sticking"]

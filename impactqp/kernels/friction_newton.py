@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction import alart_curnier, natural_map, nsgs_rows, project_cones
+from .friction import alart_curnier, natural_map, nsgs_blocks, nsgs_rows, project_cones
 from .friction_blocks import nonzero_rows
 from .jit import inline_kernel, kernel
 
@@ -305,9 +305,10 @@ tol/2 after 2 sweeps, 5e-12 after 4, then 0.65 of ‖F‖ a sweep)."""
 
 
 @kernel(interpretable=True)
-def sweeps_on(rows, q, mu, d, r, tol, local_iters, done, err):
-    """The projected Gauss–Seidel on W's nonzero ``rows`` (indptr, indices, data) from the
-    answer in ``r`` of ``done`` sweeps, at ‖F‖/‖q‖ = ``err`` (docs/theory.md §15): none
+def sweeps_on(rows, blocks, q, mu, d, r, tol, local_iters, done, err):
+    """The projected Gauss–Seidel on W's nonzero ``rows`` (indptr, indices, data) and its
+    diagonal ``blocks`` with their steps (:func:`~impactqp.kernels.friction.nsgs_blocks`)
+    from the answer in ``r`` of ``done`` sweeps, at ‖F‖/‖q‖ = ``err`` (docs/theory.md §15): none
     where ``err`` is beyond :data:`SWEEP_GATE` and Newton costs less than
     :data:`FIRST_SWEEPS` sweeps; otherwise more while their rate says they reach
     :data:`ROUND_OFF` within :data:`FIRST_SWEEPS`, or, one at a time, while each keeps at
@@ -333,7 +334,7 @@ def sweeps_on(rows, q, mu, d, r, tol, local_iters, done, err):
                 ask = 1
             else:
                 break
-        more, new = nsgs_rows(indptr, indices, data, q, mu, d, r, ROUND_OFF, ask, local_iters)
+        more, new = nsgs_blocks(rows, blocks, q, mu, d, r, ROUND_OFF, ask, local_iters)
         last, last_done, err = err, done, new
         done += more
     if ROUND_OFF < err <= 0.5 * tol:  # within tol: one Newton step to round-off

@@ -8,7 +8,9 @@ problem in them (W̃ = DWD, q̂ = Dq, D = diag(1/s)), the solve of the ``"kernel
 problem as given (r = r̂/s, u = s∘û) and the certificate of that answer, recomputed from W
 and q as given by :func:`impactqp.kernels.coulomb_certificate.friction_figures`. A problem
 whose q in contact units needs the scale-first rule (max|q̂ᵢ| outside 1e±100) is left to
-the general route, which applies it.
+the general route, which applies it. The posing of W by its nonzero rows
+(:func:`posed_rows`) and the certificate (:func:`judged`) serve the packed route of
+:mod:`impactqp.kernels.friction_packed` too.
 """
 
 from __future__ import annotations
@@ -19,9 +21,8 @@ from typing import NamedTuple
 import numpy as np
 
 from .coulomb_certificate import FRICTION_FIGURES, friction_figures
-from .friction import natural_map, nsgs_rows
-from .friction_newton import ROUND_OFF, scales, solve_small, sweeps_on
-from .friction_slip import sliding_alone
+from .friction import natural_map
+from .friction_newton import scales, solve_small
 from .jit import inline_kernel, kernel
 from .units import contact_units
 
@@ -72,7 +73,7 @@ def _units(diagonal, q, d):
 
 
 @inline_kernel(interpretable=True)
-def _judged(rw, uw, u, s, qu, mu, d, tol, figures):
+def judged(rw, uw, u, s, qu, mu, d, tol, figures):
     """The certificate of an answer (r, u) as given, from r̂ = s∘r in ``rw`` and
     û = W̃r̂ + q̂ in ``uw`` recomputed by the caller from W̃ and q̂: the figures of
     :func:`~impactqp.kernels.coulomb_certificate.friction_figures` into ``figures``, with
@@ -154,11 +155,11 @@ def solve_tiny(W, q, mu, d, limits, r, u, figures):
         for j in range(size):
             total += Wu[i, j] * ru[j]
         uw[i] = total
-    return its, _judged(ru, uw, u, s, qu, mu, d, limits.tol, figures), scaled
+    return its, judged(ru, uw, u, s, qu, mu, d, limits.tol, figures), scaled
 
 
 @inline_kernel(interpretable=True)
-def _row_products(indptr, indices, data, x, q, out):
+def row_products(indptr, indices, data, x, q, out):
     """out = A x + q for A given by its compressed rows."""
     for i in range(q.size):
         total = q[i]
@@ -168,7 +169,7 @@ def _row_products(indptr, indices, data, x, q, out):
 
 
 @inline_kernel(interpretable=True)
-def _posed(W, rows, q, d):
+def posed_rows(W, rows, q, d):
     """The problem in its contacts' units, W̃ = DWD by its nonzero compressed rows and
     q̂ = Dq (D = diag(1/s), s of :func:`_units`), from W dense or compressed (as
     :func:`solve_given` takes it): one pass over W's entries.
@@ -232,85 +233,5 @@ def _posed(W, rows, q, d):
     return s, scaled, posed, starts, columns, values, qu
 
 
-@kernel(interpretable=True)
-def solve_given(W, rows, q, mu, d, limits, out):
-    """Solve and certify a problem of a few contacts, W as the problem holds it (dense or
-    compressed), in one call (docs/theory.md §15): posed in its contacts' units by its
-    nonzero entries (:func:`_posed`), one sweep of the projected Gauss–Seidel from r = 0
-    (:func:`~impactqp.kernels.friction.nsgs_rows`; a single 3-D contact it left sliding is
-    solved sliding by its slip angle, :func:`~impactqp.kernels.friction_slip.sliding_alone`),
-    more by :func:`~impactqp.kernels.friction_newton.sweeps_on` while their rate is worth it,
-    ended where needed by one Newton step to round-off (as the ``"kernel"`` method answers,
-    without its restart from r = 0). Their answer is kept where it is within tol/2;
-    otherwise, with ``whole``, the method whole by :func:`solve_tiny`. The answer is scaled
-    back (r = r̂/s) and certified from r as given
-    (r̂ = s∘r, û = W̃r̂ + q̂ recomputed, the velocity given u = s∘û: W r + q, the product
-    the sweeps' own ‖F‖ did not share).
-
-    Parameters
-    ----------
-    W : (d·m, d·m) float array
-        W when it is dense; ignored (any 2-D float array) when ``rows`` hold it.
-    rows : (indptr, indices, data, by_columns)
-        W compressed as scipy keeps it (CSR rows, or CSC columns when ``by_columns``; int32
-        indices), duplicates summed; empty arrays (``indptr`` of size 0) when W is dense.
-    q, mu, d
-        As for :func:`solve_tiny`.
-    limits : (tol, newton_steps, sweeps, local_iters, whole)
-        The fields of :class:`TinyLimits` as a plain tuple (numba types a NamedTuple at
-        each call in about 2 µs, a plain tuple in a few hundred ns), and ``whole``: False to
-        end after the first sweep (then kept where it is within tol/2, the first sweep of
-        the ``"nsgs-short"`` method, with ``local_iters`` of that method).
-    out : (2·d·m + 7,) float array
-        Receives r, u and the figures of the certificate, in that order.
-
-    Returns
-    -------
-    (iterations, outcome, scaled), as :func:`solve_tiny`; :data:`NOT_CERTIFIED` without
-    ``whole`` where the first sweep did not reach tol/2 (``out`` then unspecified).
-    """
-    size = q.size
-    tol, newton_steps, sweeps, local_iters, whole = limits
-    s, scaled, posed, indptr, indices, data, qu = _posed(W, rows, q, d)
-    if not posed:
-        return 0, NEEDS_SCALING, True
-    r, u, figures = out[:size], out[size:2 * size], out[2 * size:]
-    target = ROUND_OFF if whole else 0.5 * tol
-    ru = np.zeros(size)
-    ask = np.int64(1)  # an int64, not a literal 1: one compiled sweep
-    done, err = nsgs_rows(indptr, indices, data, qu, mu, d, ru, target, ask, local_iters)
-    if whole and err > target and size == 3 and d == 3:  # one contact, sliding
-        err = sliding_alone(indptr, indices, data, qu, mu, ru, err)
-    if whole:
-        done, err = sweeps_on((indptr, indices, data), qu, mu, d, ru, tol, local_iters, done,
-                              err)
-    if err <= 0.5 * tol:  # target, or within tol and taken to round-off
-        for i in range(size):  # the answer as given, r = r̂/s, and r̂ = s∘r from it
-            r[i] = ru[i] / s[i]
-            ru[i] = r[i] * s[i]
-        uw = np.empty(size)  # û = W̃r̂ + q̂ of the certificate; u = s∘û (W r + q as given)
-        _row_products(indptr, indices, data, ru, qu, uw)
-        for i in range(size):
-            u[i] = uw[i] * s[i]
-        return done, _judged(ru, uw, u, s, qu, mu, d, tol, figures), scaled
-    if not whole:
-        return done, NOT_CERTIFIED, scaled
-    given, positions, entries, by_columns = rows
-    if given.size == 0:  # W dense: solve_tiny poses it again
-        dense = W
-    else:  # W as given, dense, duplicates summed
-        dense = np.zeros((size, size))
-        for a in range(size):
-            for p in range(given[a], given[a + 1]):
-                if by_columns:
-                    dense[positions[p], a] += entries[p]
-                else:
-                    dense[a, positions[p]] += entries[p]
-    its, outcome, scaled = solve_tiny(dense, q, mu, d,
-                                      TinyLimits(tol, newton_steps, sweeps, local_iters),
-                                      r, u, figures)
-    return done + its, outcome, scaled
-
-
 __all__ = ["CERTIFIED", "FRICTION_FIGURES", "LOG2_RANGE", "NEEDS_SCALING", "NOT_CERTIFIED",
-           "TinyLimits", "solve_given", "solve_tiny"]
+           "TinyLimits", "judged", "posed_rows", "row_products", "solve_tiny"]

@@ -1,0 +1,235 @@
+"""A local frictional problem of a few contacts packed once and solved in one compiled call
+(docs/theory.md §15).
+
+:func:`solve_given` poses a problem as given (W dense or compressed) in its contacts' units
+(:func:`impactqp.kernels.friction_tiny.posed_rows`), packs it with what its sweeps read
+(:func:`pack`) and solves and certifies it (:func:`solve_packed`); a caller solving the same
+problem again keeps the pack and calls :func:`solve_packed` alone. The certificate is
+recomputed from r as given by :func:`impactqp.kernels.friction_tiny.judged`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .friction import sweep_once
+from .friction_blocks import diagonal_blocks, exact_contact, local_steps
+from .friction_newton import ROUND_OFF, scales, solve_small, sweeps_on
+from .friction_slip import sliding_3d
+from .friction_tiny import (
+    CERTIFIED,
+    NEEDS_SCALING,
+    NOT_CERTIFIED,
+    judged,
+    posed_rows,
+    row_products,
+)
+from .jit import inline_kernel, kernel
+
+PACKED_HEADER = 9
+"""Leading entries of the integer array of :func:`pack`: d·m, d, m, the entries of W̃ kept,
+whether some contact's unit is not 1, whether the problem is posed, then the budgets
+(Newton steps, sweeps, local iterations) and ``whole``."""
+
+
+@kernel(interpretable=True)
+def pack(W, rows, q, mu, d, budgets):
+    """A problem of a few contacts posed in its contacts' units
+    (:func:`~impactqp.kernels.friction_tiny.posed_rows`) with what its sweeps read (W̃'s
+    diagonal blocks and their local steps) and the budgets of its solve, in two arrays, so
+    that a solve of the same problem again (:func:`solve_packed`) starts from them: numba
+    takes each array argument of a call from Python for about 0.3 µs, and returns one for
+    about 1 µs, so the problem travels as two (docs/theory.md §15).
+
+    Parameters
+    ----------
+    W, rows, q, mu, d
+        As for :func:`solve_given`.
+    budgets : (newton_steps, sweeps, local_iters, whole)
+        The integer fields of ``limits`` of :func:`solve_given`.
+
+    Returns
+    -------
+    (floats, ints)
+        ``ints``: :data:`PACKED_HEADER` entries, then W̃'s ``indptr`` (d·m + 1) and
+        ``indices``; ``floats``: s, q̂ (d·m each), μ, the local steps ρ_c (m each), the
+        diagonal blocks W̃_cc (m·d·d) and W̃'s entries. Where the problem cannot be posed
+        as it is (the header says so) the rest is not to be used.
+    """
+    size = q.size
+    m = mu.size
+    s, scaled, posed, indptr, indices, data, qu = posed_rows(W, rows, q, d)
+    entries = indptr[size]
+    ints = np.empty(PACKED_HEADER + size + 1 + entries, dtype=np.int32)
+    newton_steps, sweeps, local_iters, whole = budgets
+    ints[0], ints[1], ints[2], ints[3] = size, d, m, entries
+    ints[4], ints[5] = scaled, posed
+    ints[6], ints[7], ints[8] = newton_steps, sweeps, local_iters
+    ints[PACKED_HEADER:PACKED_HEADER + size + 1] = indptr
+    ints[PACKED_HEADER + size + 1:] = indices[:entries]
+    block = m * d * d
+    floats = np.empty(2 * size + 2 * m + block + entries)
+    floats[:size] = s
+    floats[size:2 * size] = qu
+    floats[2 * size:2 * size + m] = mu
+    Wcc = diagonal_blocks(indptr, indices, data, m, d)
+    floats[2 * size + m:2 * size + 2 * m] = local_steps(Wcc)
+    floats[2 * size + 2 * m:2 * size + 2 * m + block] = Wcc.ravel()
+    floats[2 * size + 2 * m + block:] = data[:entries]
+    if not whole:
+        ints[8] = -local_iters - 1  # the sign carries ``whole``: one int32 array
+    return floats, ints
+
+
+@inline_kernel(interpretable=True)
+def _unpacked(floats, ints):
+    """The arrays of :func:`pack` as views: (s, q̂, μ, (indptr, indices, data), (W̃_cc, ρ),
+    d, scaled, posed, (newton_steps, sweeps, local_iters, whole))."""
+    size, d, m, entries = ints[0], ints[1], ints[2], ints[3]
+    block = m * d * d
+    indptr = ints[PACKED_HEADER:PACKED_HEADER + size + 1]
+    indices = ints[PACKED_HEADER + size + 1:PACKED_HEADER + size + 1 + entries]
+    s = floats[:size]
+    qu = floats[size:2 * size]
+    mu = floats[2 * size:2 * size + m]
+    rhos = floats[2 * size + m:2 * size + 2 * m]
+    Wcc = floats[2 * size + 2 * m:2 * size + 2 * m + block].reshape((m, d, d))
+    data = floats[2 * size + 2 * m + block:2 * size + 2 * m + block + entries]
+    local = ints[8]
+    whole = local >= 0
+    budgets = (np.int64(ints[6]), np.int64(ints[7]), np.int64(local if whole else -local - 1),
+               whole)
+    return (s, qu, mu, (indptr, indices, data), (Wcc, rhos), np.int64(d), ints[4] != 0,
+            ints[5] != 0, budgets)
+
+
+@inline_kernel(interpretable=True)
+def _finish(ru, s, rows, qu, mu, d, tol, out):
+    """The answer r̂ in ``ru`` scaled back into ``out`` (r = r̂/s) and certified from r as
+    given (r̂ = s∘r, û = W̃r̂ + q̂ recomputed from W̃'s ``rows``, the velocity given
+    u = s∘û: W r + q), its figures after r and u in ``out``. Returns the verdict of
+    :func:`~impactqp.kernels.friction_tiny.judged`."""
+    size = qu.size
+    r, u, figures = out[:size], out[size:2 * size], out[2 * size:]
+    for i in range(size):  # the answer as given, r = r̂/s, and r̂ = s∘r from it
+        r[i] = ru[i] / s[i]
+        ru[i] = r[i] * s[i]
+    uw = np.empty(size)  # û = W̃r̂ + q̂ of the certificate; u = s∘û (W r + q as given)
+    row_products(rows[0], rows[1], rows[2], ru, qu, uw)
+    for i in range(size):
+        u[i] = uw[i] * s[i]
+    return judged(ru, uw, u, s, qu, mu, d, tol, figures)
+
+
+@kernel(interpretable=True)
+def solve_packed(floats, ints, tol, out):
+    """Solve and certify a problem of a few contacts packed by :func:`pack`, in one call
+    (docs/theory.md §15). A problem of one contact is solved by its cases in closed form
+    (:func:`~impactqp.kernels.friction_blocks.exact_contact`: apart, sticking, a planar
+    contact sliding) or, a 3-D contact sliding, by its slip angle
+    (:func:`~impactqp.kernels.friction_slip.sliding_3d`); a problem of more by one sweep of
+    the projected Gauss–Seidel from r = 0 on W̃
+    (:func:`~impactqp.kernels.friction.sweep_once`). That answer is certified at once
+    (:func:`_finish`: scaled back, r = r̂/s, and recomputed from r as given, r̂ = s∘r,
+    û = W̃r̂ + q̂, the velocity given u = s∘û) and kept where it passes with ‖F‖/‖q̂‖ within
+    :data:`~impactqp.kernels.friction_newton.ROUND_OFF` (tol/2 without ``whole``): one
+    product by W̃ serves as both the sweep's stopping test and the certificate, which
+    reads nothing of the sweep but r. Otherwise, with ``whole``, the sweeps go on from
+    there by :func:`~impactqp.kernels.friction_newton.sweeps_on` while their rate is worth
+    it, ended where needed by one Newton step to round-off (as the ``"kernel"`` method
+    answers, without its restart from r = 0), and their answer is kept where it is within
+    tol/2; else the ``"kernel"`` method whole
+    (:func:`~impactqp.kernels.friction_newton.solve_small`) runs on the dense W̃. Either
+    answer is certified again by :func:`_finish`.
+
+    Parameters
+    ----------
+    floats, ints : ndarray
+        The problem as :func:`pack` returns it.
+    tol : float
+        Tolerance of the certificate.
+    out : (2·d·m + 7,) float array
+        Receives r, u and the figures of the certificate, in that order.
+
+    Returns
+    -------
+    (iterations, outcome)
+        ``outcome`` as for :func:`~impactqp.kernels.friction_tiny.solve_tiny`;
+        :data:`NOT_CERTIFIED` without ``whole`` where the first sweep did not reach tol/2
+        (``out`` then unspecified).
+    """
+    s, qu, mu, rows, blocks, d, _, posed, budgets = _unpacked(floats, ints)
+    if not posed:
+        return 0, NEEDS_SCALING
+    newton_steps, sweeps, local_iters, whole = budgets
+    size = qu.size
+    ru = np.zeros(size)
+    if whole and mu.size == 1:  # one contact: its cases in closed form, or its slip angle
+        if not exact_contact(blocks[0][0], qu, mu[0], d, ru) and d == 3:
+            sliding_3d(blocks[0][0], qu, mu[0], ru)
+    else:
+        sweep_once(rows, blocks, qu, mu, d, ru, local_iters, np.empty(5 * d))
+    done = 1
+    # the certificate of this answer; its natural map is the sweeps' measure from here
+    outcome = _finish(ru, s, rows, qu, mu, d, tol, out)
+    err = out[2 * size]
+    if outcome == CERTIFIED and err <= (ROUND_OFF if whole else 0.5 * tol):
+        return done, outcome
+    if not whole:
+        return done, NOT_CERTIFIED
+    done, err = sweeps_on(rows, blocks, qu, mu, d, ru, tol, local_iters, done, err)
+    if err <= 0.5 * tol:  # within tol and taken to round-off
+        return done, _finish(ru, s, rows, qu, mu, d, tol, out)
+    indptr, indices, data = rows
+    dense = np.zeros((size, size))  # W̃ dense, for the method whole
+    for i in range(size):
+        for p in range(indptr[i], indptr[i + 1]):
+            dense[i, indices[p]] += data[p]
+    diagonal = np.empty(size)
+    for i in range(size):
+        diagonal[i] = dense[i, i]
+    its, _ = solve_small(dense, qu, mu, scales(diagonal, d), d, tol, ru, newton_steps, sweeps,
+                         local_iters)
+    return done + its, _finish(ru, s, rows, qu, mu, d, tol, out)
+
+
+@kernel(interpretable=True)
+def solve_given(W, rows, q, mu, d, limits, out):
+    """Solve and certify a problem of a few contacts, W as the problem holds it (dense or
+    compressed), in one call (docs/theory.md §15): posed in its contacts' units by its
+    nonzero entries and packed (:func:`pack`), then solved and certified by
+    :func:`solve_packed`.
+
+    Parameters
+    ----------
+    W : (d·m, d·m) float array
+        W when it is dense; ignored (any 2-D float array) when ``rows`` hold it.
+    rows : (indptr, indices, data, by_columns)
+        W compressed as scipy keeps it (CSR rows, or CSC columns when ``by_columns``; int32
+        indices), duplicates summed; empty arrays (``indptr`` of size 0) when W is dense.
+    q, mu, d
+        As for :func:`~impactqp.kernels.friction_tiny.solve_tiny`.
+    limits : (tol, newton_steps, sweeps, local_iters, whole)
+        The fields of :class:`~impactqp.kernels.friction_tiny.TinyLimits` as a plain tuple
+        (numba types a NamedTuple at each call in about 2 µs, a plain tuple in a few hundred
+        ns), and ``whole``: False to end after the first sweep (then kept where it is
+        within tol/2, the first sweep of the ``"nsgs-short"`` method, with ``local_iters``
+        of that method).
+    out : (2·d·m + 7,) float array
+        Receives r, u and the figures of the certificate, in that order.
+
+    Returns
+    -------
+    (iterations, outcome, scaled), as :func:`~impactqp.kernels.friction_tiny.solve_tiny`;
+    :data:`NOT_CERTIFIED` without ``whole`` where the first sweep did not reach tol/2
+    (``out`` then unspecified).
+    """
+    tol, newton_steps, sweeps, local_iters, whole = limits
+    floats, ints = pack(W, rows, q, mu, d, (newton_steps, sweeps, local_iters, whole))
+    if ints[5] == 0:
+        return 0, NEEDS_SCALING, True
+    its, outcome = solve_packed(floats, ints, tol, out)
+    return its, outcome, ints[4] != 0
+
+
+__all__ = ["PACKED_HEADER", "pack", "solve_given", "solve_packed"]
