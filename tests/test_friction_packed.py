@@ -129,3 +129,40 @@ def test_one_contact_in_each_of_its_cases() -> None:
         assert cert.ok
         general = iq.solve_friction(problem, tol=1e-12, backend="newton")
         np.testing.assert_allclose(out[:d], general.r, atol=1e-10)
+
+
+def _fresh(problem: iq.FrictionContactProblem, backend: str = "auto"):
+    """The answer of a new problem holding ``problem``'s present arrays."""
+    again = iq.FrictionContactProblem(problem.W.copy(), problem.q.copy(), problem.mu.copy(),
+                                      contact_dim=problem.contact_dim)
+    return iq.solve_friction(again, tol=TOL, backend=backend)
+
+
+@pytest.mark.parametrize("backend", ["auto", "newton", "nsgs"])
+def test_a_q_rewritten_in_place_is_solved_as_it_now_is(backend) -> None:
+    """A simulator may reuse one problem and rewrite q in place at each step: neither the
+    kept pack nor the kept contact units may answer for the q they were made from (they did:
+    a certified answer of the old q)."""
+    problem = friction_data.load("Confeti-ex13-4c").problem
+    rng = np.random.default_rng(3)
+    for _step in range(4):
+        for _ in range(3):  # packed from the second solve on
+            r = iq.solve_friction(problem, tol=TOL, backend=backend)
+        fresh = _fresh(problem, backend)
+        assert certify_friction(problem, r.r, r.u, tol=TOL).ok
+        np.testing.assert_allclose(r.u, fresh.u, atol=1e-6 * np.abs(fresh.u).max())
+        units = problem.in_contact_units()
+        np.testing.assert_allclose(units.problem.q * 2.0 ** units.k * units.s, problem.q,
+                                   rtol=1e-15, atol=0.0)
+        problem.q[:] = problem.q * rng.uniform(0.5, 1.5, problem.q.size)  # in place
+
+
+def test_a_replaced_mu_is_solved_as_it_now_is() -> None:
+    problem = friction_data.load("Confeti-ex13-4c").problem
+    for _ in range(3):
+        iq.solve_friction(problem, tol=TOL)
+    problem.mu = np.full(problem.n_contacts, 0.05)
+    problem.mu.setflags(write=False)
+    r = iq.solve_friction(problem, tol=TOL)
+    np.testing.assert_allclose(r.u, _fresh(problem).u, atol=1e-6 * np.abs(r.u).max())
+    assert problem.holds(problem.state()) and not problem.holds(None)

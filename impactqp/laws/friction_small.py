@@ -115,8 +115,9 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
     posed in its contacts' units, with its diagonal blocks and their steps) on the problem, as
     :meth:`~impactqp.FrictionContactProblem.in_contact_units` keeps its units: later solves
     start from it (:func:`~impactqp.kernels.friction_packed.solve_packed`). The first solve
-    packs nothing (a simulator poses a new problem at each step), and a problem whose W or q
-    is no longer the object packed is packed again.
+    packs nothing (a simulator poses a new problem at each step), and a problem that no
+    longer :meth:`~impactqp.FrictionContactProblem.holds` the state it was packed in (q
+    rewritten, W or μ replaced) is solved from its arrays and packed again.
     """
     m = problem.n_contacts
     small = m <= methods.SMALL_CONTACTS  # the "kernel" method's own limit
@@ -124,9 +125,8 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
         return None
     out = np.empty(2 * problem.q.size + _FIGURES)
     kept = problem.__dict__.get(_KEPT)
-    if (kept is None or kept.W is not problem.W or kept.q is not problem.q
-            or kept.small is not small):
-        problem.__dict__[_KEPT] = _Kept(problem.W, problem.q, small)
+    if kept is None or kept.small is not small or not problem.holds(kept.state):
+        problem.__dict__[_KEPT] = _Kept(problem.state(), small)
         its, outcome, scaled = solve_given(*_given(problem), (tol, *_budgets(small)), out)
     else:
         packed = kept.packed
@@ -143,16 +143,17 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
 
 
 class _Kept:
-    """What :func:`solve_few` keeps on a problem it has solved: the W and q objects it
-    solved, whether by the ``"kernel"`` method (``small``), and from its second solve on
+    """What :func:`solve_few` keeps on a problem it has solved: the problem's
+    :meth:`~impactqp.FrictionContactProblem.state` it solved, whether by the ``"kernel"``
+    method (``small``), and from its second solve on
     ``packed``: the problem packed by :func:`~impactqp.kernels.friction_packed.pack`
     (floats, ints) and whether its units are not all 1, set in one assignment (a thread
     solving the same problem sees all of it or none)."""
 
-    __slots__ = ("W", "q", "small", "packed")
+    __slots__ = ("state", "small", "packed")
 
-    def __init__(self, W, q: np.ndarray, small: bool) -> None:
-        self.W, self.q, self.small = W, q, small
+    def __init__(self, state: tuple, small: bool) -> None:
+        self.state, self.small = state, small
         self.packed: tuple[np.ndarray, np.ndarray, bool] | None = None
 
 

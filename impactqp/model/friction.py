@@ -75,6 +75,13 @@ class FrictionContactProblem:
     ------
     InputError, ShapeError, NonFiniteError
         A d other than 2 or 3, shapes that do not fit, NaN or infinity, a negative μ.
+
+    Notes
+    -----
+    W, q and μ are the problem's own copies (μ read-only). q may be rewritten in place
+    between solves: what impactqp keeps for a problem (its contact units, the pack of a
+    few-contact problem) is checked against q, and against the W and μ objects, at each
+    solve (:meth:`holds`). W edited in place is not seen: give a new W a new problem.
     """
 
     def __init__(self, W, q, mu, *, contact_dim: int = 3) -> None:
@@ -97,6 +104,7 @@ class FrictionContactProblem:
         self.contact_dim = d
         self.n_contacts = m
         self._units: ContactUnits | None = None
+        self._units_state: tuple | None = None
 
     @classmethod
     def of_checked(cls, W, q: np.ndarray, mu: np.ndarray,
@@ -106,7 +114,7 @@ class FrictionContactProblem:
         problem = cls.__new__(cls)
         problem.W, problem.q, problem.mu = W, q, mu
         problem.contact_dim, problem.n_contacts = contact_dim, mu.size
-        problem._units = None
+        problem._units = problem._units_state = None
         return problem
 
     @classmethod
@@ -117,7 +125,20 @@ class FrictionContactProblem:
         s = 1, only the scale-first rule on q is applied."""
         problem = cls.of_checked(W, q, mu, contact_dim)
         problem._units = _units_of(problem, np.ones(q.size))
+        problem._units_state = problem.state()
         return problem
+
+    def state(self) -> tuple:
+        """What a result kept for this problem depends on, to tell later whether it still
+        holds (:meth:`holds`): the W and μ objects, d, and the bytes of q (q may be rewritten
+        in place, as a simulator reusing one problem for each step would)."""
+        return (self.W, self.mu, self.contact_dim, self.q.tobytes())
+
+    def holds(self, state: tuple | None) -> bool:
+        """Whether ``state`` (from :meth:`state`) is still this problem's: the same W and μ
+        objects, the same d, and q equal byte for byte."""
+        return (state is not None and state[0] is self.W and state[1] is self.mu
+                and state[2] == self.contact_dim and state[3] == self.q.tobytes())
 
     def in_contact_units(self) -> ContactUnits:
         """The problem posed in its contacts' units (docs/theory.md §15): W̃ = DWD,
@@ -127,17 +148,19 @@ class FrictionContactProblem:
         nearest it. Its
         reaction r̂ = 2⁻ᵏ s∘r and velocity û = 2⁻ᵏ u/s; the cones do not change (a positive
         factor per contact), so r solves this problem exactly when r̂ solves that one. The
-        same object every time (it is computed once); a problem already in its units is
-        its own unit problem.
+        same object every time while the problem :meth:`holds` the state it was computed
+        for (computed again where q, W or μ has changed since); a problem already in its
+        units is its own unit problem.
 
         Raises
         ------
         OutOfRangeError
             W̃ is not finite (``|W_ij|`` far beyond √(W_ii W_jj)): floats cannot pose it.
         """
-        if self._units is None:
+        if self._units is None or not self.holds(self._units_state):
             s = contact_units(np.ascontiguousarray(_diagonal(self.W)), self.contact_dim)
             self._units = _units_of(self, s)
+            self._units_state = self.state()
         return self._units
 
     def velocity(self, r: np.ndarray) -> np.ndarray:
@@ -228,6 +251,7 @@ def _units_of(problem: FrictionContactProblem, s: np.ndarray) -> ContactUnits:
                                   "the floats")
     unit = FrictionContactProblem.of_checked(W, q_unit, problem.mu, problem.contact_dim)
     unit._units = ContactUnits(unit, np.ones(q.size), 0)
+    unit._units_state = unit.state()
     return ContactUnits(unit, s, k)
 
 
