@@ -24,7 +24,7 @@ from .jit import inline_kernel, kernel
 from .residuals import RESIDUALS, chain_residuals
 
 
-@inline_kernel
+@kernel(internal=True)
 def _add(total, compensation, x):
     """Neumaier's compensated sum: (total + x, updated compensation)."""
     t = total + x
@@ -35,7 +35,7 @@ def _add(total, compensation, x):
     return t, compensation
 
 
-@inline_kernel
+@kernel(internal=True)
 def _pava(m, u, starts, weight, total):
     """Blocks of the weighted isotonic regression of u: returns their count nb, with
     ``starts[:nb + 1]`` (a last entry N), block weights and weighted sums.

@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from .friction import natural_map
-from .jit import inline_kernel
+from .jit import inline_kernel, kernel
 
 SLIP_SAMPLES = 16
 """Slip angles at which :func:`sliding_3d` looks for a sign change of its function (it has at
@@ -20,7 +20,7 @@ SLIP_STEPS = 60
 """Most steps of the bracketing root search of :func:`sliding_3d`."""
 
 
-@inline_kernel
+@kernel(internal=True)
 def _slip(Wc, base, mu, theta):
     """The slip function of :func:`sliding_3d` at the angle ``theta``: (G, a, e·u_t·a) with
     a = W_nn − μ(W_n1 cos θ + W_n2 sin θ) and a·u_t = a·b_t − b_n(W_tn − μW_tt e)."""
@@ -33,7 +33,7 @@ def _slip(Wc, base, mu, theta):
     return c * t2 - s * t1, a, c * t1 + s * t2
 
 
-@inline_kernel
+@kernel(internal=True)
 def _root(Wc, base, mu, a, b, g_a, g_b):
     """A root of the slip function in [a, b], where it changes sign, by regula falsi with
     the Illinois rule (the retained end's value halved), to the floats' resolution."""

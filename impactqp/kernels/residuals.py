@@ -35,13 +35,13 @@ SCALE_RANGE = (1e-60, 1e60)
 """Largest entries of u⁻ whose squares need no rescaling; outside, inputs are divided by it."""
 
 
-@inline_kernel
+@kernel(internal=True)
 def _low(a, b):
     """min(a, b) that keeps a NaN of either."""
     return a if (a < b or a != a) else b
 
 
-@inline_kernel
+@kernel(internal=True)
 def _high(a, b):
     """max(a, b) that keeps a NaN of either."""
     return a if (a > b or a != a) else b
@@ -51,7 +51,7 @@ NEW_FOLD = (np.inf, np.inf, 0.0, 0.0)
 """The neutral fold of the contacts: (min Λᵢsᵢ, min wᵢ/sᵢ, max |Λᵢwᵢ|, Σ |Λᵢwᵢ|)."""
 
 
-@inline_kernel
+@kernel(internal=True)
 def fold_contact(acc, lam, w, s):
     """``acc`` (see :data:`NEW_FOLD`) with one more contact: impulse Λ, w = γ⁺ + Eγ⁻, scale s."""
     p = abs(lam * w)
@@ -114,7 +114,7 @@ def unit_of(um, up, lam):
     return c if c > 0.0 else 1.0
 
 
-@inline_kernel
+@kernel(internal=True)
 def velocity_unit(V2_minus, V2_plus):
     """V = ‖u⁻‖, or for u⁻ = 0 the answer's own size, at least 1 (docs/theory.md §8); one
     square root, of the one square it returns."""
