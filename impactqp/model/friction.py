@@ -129,9 +129,8 @@ class FrictionContactProblem:
         return problem
 
     def state(self) -> tuple:
-        """What a result kept for this problem depends on, to tell later whether it still
-        holds (:meth:`holds`): the W and μ objects, d, and the bytes of q (q may be rewritten
-        in place, as a simulator reusing one problem for each step would)."""
+        """What a result kept for this problem depends on (:meth:`holds`): the W and μ
+        objects, d, and q's bytes (a simulator may rewrite q in place at each step)."""
         return (self.W, self.mu, self.contact_dim, self.q.tobytes())
 
     def holds(self, state: tuple | None) -> bool:
