@@ -116,14 +116,14 @@ LONGEST_FIRST = ("friction", "impacts", "simulations", "batches", "LZB",
 """The stages by their compile time (measured), the order a parallel compile of three
 processes or more starts them in, one stage per task."""
 
-PAIRED = (("friction", "frictional simulations", "LZB"),
-          ("impacts", "batches", "chains", "simulations"))
+PAIRED = (("friction", "frictional simulations"),
+          ("impacts", "batches", "chains", "simulations", "LZB"))
 """The stages of a compile in two processes, one group each, run in this order: the stages
 of a group share most of their kernels (the frictional steps of a simulation call
 friction's sweeps; batches, chains and the frictionless Moreau–Jean loops the active-set
 search and residuals of an impact), so each is compiled once in its process instead of in
-both. LZB shares nothing and goes where it evens the groups' CPU times (measured: 76.0 s
-and 72.3 s)."""
+both. LZB shares nothing and goes where it evens the groups' CPU times (measured, one
+process per group from an empty cache: 57.5 s and 62.7 s)."""
 
 
 @dataclass(frozen=True)

@@ -21,6 +21,7 @@ from ..base.arrays import as_array, as_count
 from ..base.checks import DEFAULT_TOL
 from ..errors import DerivativeUnsupportedError, ShapeError
 from ..kernels import derivative as compiled
+from ..kernels.jit import read_only
 from ..laws import small
 from ..laws.base import MOREAU_FAMILY
 from ..laws.batch import _in_chunks, as_rows, solve_batch
@@ -96,7 +97,7 @@ def _compiled(problem, law, U, dU, Ubar, tol, kink_tol, n_jobs):
                              placeholder.copy() if dUp is None else dUp[a:b],
                              placeholder.copy() if Uout is None else Uout[a:b],
                              out.status[a:b], out.margin[a:b])
-        compiled.derivative_rows(st.kernel_pack, np.ascontiguousarray(U[a:b]),
+        compiled.derivative_rows(st.kernel_pack, read_only(np.ascontiguousarray(U[a:b])),
                                  placeholder if dU is None else dU[a:b],
                                  placeholder if Ubar is None else Ubar[a:b], spec, settings,
                                  np.zeros(m, dtype=bool), rows)

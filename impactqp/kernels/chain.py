@@ -227,7 +227,7 @@ def _solve_chain_into(packed, um, left, right, eps, tol, out, starts, weight):
     lo = 0 if left else 1
     res = out[2 * n + 1:2 * n + 1 + len(RESIDUALS)]
     chain_residuals(um, up, L[lo:lo + m], masses, packed[n:2 * n], packed[2 * n:], left, right,
-                    eps, eps, True, res)
+                    eps, eps, np.bool_(True), res)  # a run-time flag: one signature
     for i in range(res.size):
         if not res[i] <= tol:
             return False

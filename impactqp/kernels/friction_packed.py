@@ -103,7 +103,7 @@ def _unpacked(floats, ints):
             ints[5] != 0, budgets)
 
 
-@inline_kernel(interpretable=True)
+@kernel(internal=True)
 def _finish(ru, s, rows, qu, mu, d, tol, out):
     """The answer r̂ in ``ru`` scaled back into ``out`` (r = r̂/s) and certified from r as
     given (r̂ = s∘r, û = W̃r̂ + q̂ recomputed from W̃'s ``rows``, the velocity given

@@ -106,7 +106,7 @@ def sliding_alone(indptr, indices, data, q, mu, r, err):
     uc = np.empty(3)
     for i in range(3):
         uc[i] = q[i] + Wc[i, 0] * rc[0] + Wc[i, 1] * rc[1] + Wc[i, 2] * rc[2]
-    F = natural_map(rc, uc, mu, 3)
+    F = natural_map(rc, uc, mu, rc.size)  # a size, not the literal 3: one signature
     qn = np.sqrt(np.sum(q * q))
     found = np.sqrt(np.sum(F * F)) / (qn if qn > 0.0 else 1.0)
     if not found < err:

@@ -167,6 +167,16 @@ def inline_kernel(function: F | None = None, *, interpretable: bool = False) -> 
     return kernel(function, interpretable=interpretable, inline=True)
 
 
+def read_only(a: Any) -> Any:
+    """A read-only view of the array ``a`` (no copy): a kernel's callers pass arrays with
+    one set of flags, since each other set compiles the kernel (and every kernel it calls
+    with them) once more. u⁻ is kept read-only by the problems, so callers pass read-only
+    velocities."""
+    view = a.view()
+    view.setflags(write=False)
+    return view
+
+
 NOTICE_AFTER = 1.0
 """Seconds impactqp's kernels may compile before :class:`CompileNotice` says so."""
 

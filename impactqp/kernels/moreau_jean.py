@@ -162,7 +162,7 @@ def _solve_dense(cl, contacts, law, tol, dense_work, res, work):
             total += Xv[x, y] * lam[y]
         up[x] = total
     dense_step_residuals(Mv, Wv, Xv, sc[:mc], um[:nc], up[:nc], lam[:mc], vp[:nc], Ev, 0.0,
-                         False, res, work)
+                         np.bool_(False), res, work)  # run-time flags: one signature each
     for x in range(CHECKED):
         if not res[x] <= tol:  # NaN fails
             return False
@@ -196,7 +196,8 @@ def _solve_chain(cl, units, chain, left, right, tol, chain_work, res):
     for x in range(mc):
         sc[x] = units[C[x]]
     chain_step_residuals(um[:nc], up[:nc], lam[:mc], vp[:nc], masses[first:first + nc],
-                         inverse[first:first + nc], sc[:mc], left, right, e, 0.0, False, res)
+                         inverse[first:first + nc], sc[:mc], left, right, e, 0.0, np.bool_(False),
+                         res)
     for x in range(CHECKED):
         if not res[x] <= tol:  # NaN fails
             return False

@@ -250,7 +250,7 @@ def in_range(top):
     return SCALE_RANGE[0] < top < SCALE_RANGE[1]
 
 
-@inline_kernel
+@kernel(internal=True)
 def _chain_pass(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, eps, moreau,
                 f, out):
     """:func:`chain_step_residuals` with the inputs multiplied by f; returns whether
@@ -285,7 +285,7 @@ def _chain_pass(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, e
     return in_range(top)
 
 
-@inline_kernel(interpretable=True)
+@kernel(interpretable=True)
 def chain_residuals(um, up, lam, masses, inverse, s, left_wall, right_wall, E, eps, moreau,
                     out):
     """The residuals of one impact of a 1-D chain (docs/theory.md §5, §8) in one O(N) loop.
@@ -301,7 +301,7 @@ def chain_residuals(um, up, lam, masses, inverse, s, left_wall, right_wall, E, e
                          moreau, out)
 
 
-@inline_kernel
+@kernel
 def chain_step_residuals(um, up, lam, ur, masses, inverse, s, left_wall, right_wall, E, eps,
                          moreau, out):
     """:func:`chain_residuals` with the restitution acting on the contact velocities of

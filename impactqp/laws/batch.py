@@ -24,6 +24,7 @@ from ..base.arrays import as_array, as_count
 from ..base.checks import DEFAULT_TOL, BatchCertificate, certified_rows
 from ..errors import BackendUnsuitableError, CertificateError, ShapeError
 from ..kernels.impact import solve_impact_rows
+from ..kernels.jit import read_only
 from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
 from ..qp import backends
@@ -171,7 +172,7 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
         elif fast == "compiled":  # each chunk warm-starts from its own cold support
             packed, E, eps, moreau = compiled
             Up[a:b], Lam[a:b], table, done = solve_impact_rows(
-                packed, np.ascontiguousarray(Ua), E, eps, moreau, tol,
+                packed, read_only(np.ascontiguousarray(Ua)), E, eps, moreau, tol,
                 np.zeros(st.m, dtype=bool))
             for i, key in enumerate(res):
                 res[key][a:b] = table[:, i]

@@ -42,6 +42,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.checks import DEFAULT_TOL
+from ..kernels.jit import read_only
 from ..kernels.moreau_jean import CHECKED, Chain, Impacts, run, worst_step
 from ..kernels.residuals import RESIDUALS
 from ..kernels.step import Contacts, Force, Record, Scheme, activation, end_step
@@ -116,14 +117,6 @@ class _FreeVelocity:
                          self.constant, np.zeros(n), True)
         shift = self.solver.solve_mass(self.residual(t0, self.system.q0, self.system.v0))
         return Force(np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0), shift, False)
-
-
-def read_only(a: np.ndarray) -> np.ndarray:
-    """A read-only view of ``a``: the compiled loop's arguments keep one set of array flags
-    (each other set is one more compilation of the loop)."""
-    view = a.view()
-    view.setflags(write=False)
-    return view
 
 
 def moreau_jean(system: LinearSystem, law: ImpactLaw, t_end: float, h: float,
