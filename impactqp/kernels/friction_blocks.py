@@ -170,3 +170,17 @@ def exact_contact(Wc, base, mu, d, out):
 
 __all__ = ["diagonal_blocks", "extreme_sum", "local_steps", "exact_contact", "nonzero_rows",
            "sticking"]
+
+
+@kernel(internal=True)
+def densified(rows, size):
+    """(W, its diagonal) as dense arrays from W's nonzero compressed ``rows`` (indptr,
+    indices, data) of ``size`` rows: for a Newton step on the dense W of a few contacts."""
+    indptr, indices, data = rows
+    dense = np.zeros((size, size))
+    diagonal = np.empty(size)
+    for i in range(size):
+        for p in range(indptr[i], indptr[i + 1]):
+            dense[i, indices[p]] += data[p]
+        diagonal[i] = dense[i, i]
+    return dense, diagonal

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .friction import alart_curnier, natural_map, nsgs_blocks, nsgs_rows, project_cones
-from .friction_blocks import nonzero_rows
+from .friction_blocks import densified, nonzero_rows
 from .jit import inline_kernel, kernel
 
 
@@ -316,7 +316,7 @@ def sweeps_on(rows, blocks, q, mu, d, r, tol, local_iters, done, err):
     :data:`POLISH_SWEEPS` are left, and then one Newton step on the dense W
     (:func:`to_round_off`). Returns (sweeps and steps done, ‖F‖/‖q‖ of the sweeps, at most
     tol/2 where ``r`` is within it)."""
-    indptr, indices, data = rows
+    indices = rows[1]
     ask = np.int64(1)  # an int64, not a literal 1: one compiled sweep
     last, last_done = np.inf, 0
     if err > SWEEP_GATE and sweep_budget(q.size, mu.size, indices.size, FIRST_SWEEPS,
@@ -338,13 +338,6 @@ def sweeps_on(rows, blocks, q, mu, d, r, tol, local_iters, done, err):
         last, last_done, err = err, done, new
         done += more
     if ROUND_OFF < err <= 0.5 * tol:  # within tol: one Newton step to round-off
-        size = q.size
-        dense = np.zeros((size, size))
-        for i in range(size):
-            for p in range(indptr[i], indptr[i + 1]):
-                dense[i, indices[p]] += data[p]
-        diagonal = np.empty(size)
-        for i in range(size):
-            diagonal[i] = dense[i, i]
+        dense, diagonal = densified(rows, q.size)
         done += to_round_off(dense, q, mu, scales(diagonal, d), d, r, tol)
     return done, err

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from .friction import sweep_once
-from .friction_blocks import diagonal_blocks, exact_contact, local_steps
+from .friction_blocks import densified, diagonal_blocks, exact_contact, local_steps
 from .friction_newton import ROUND_OFF, scales, solve_small, sweeps_on
 from .friction_slip import sliding_3d
 from .friction_tiny import (
@@ -180,14 +180,7 @@ def solve_packed(floats, ints, tol, out):
     done, err = sweeps_on(rows, blocks, qu, mu, d, ru, tol, local_iters, done, err)
     if err <= 0.5 * tol:  # within tol and taken to round-off
         return done, _finish(ru, s, rows, qu, mu, d, tol, out)
-    indptr, indices, data = rows
-    dense = np.zeros((size, size))  # W̃ dense, for the method whole
-    for i in range(size):
-        for p in range(indptr[i], indptr[i + 1]):
-            dense[i, indices[p]] += data[p]
-    diagonal = np.empty(size)
-    for i in range(size):
-        diagonal[i] = dense[i, i]
+    dense, diagonal = densified(rows, size)  # W̃ dense, for the method whole
     its, _ = solve_small(dense, qu, mu, scales(diagonal, d), d, tol, ru, newton_steps, sweeps,
                          local_iters)
     return done + its, _finish(ru, s, rows, qu, mu, d, tol, out)
