@@ -11,6 +11,9 @@ Each step calls the one definition of the formulas (:func:`~impactqp.kernels.res
 :func:`~impactqp.kernels.residuals.chain_values`), in the order the single pass calls them,
 so a row's residuals are those of ``chain_residuals`` bit for bit. The certificate reads u⁻,
 u⁺ and Λ as the batch holds them, nothing of the solve.
+
+The solve of a short chain's rows (:func:`chain_impact_rows`) passes blocks of rows the same
+way, formula by formula; it shares no number with the certificate.
 """
 
 from __future__ import annotations
@@ -190,3 +193,109 @@ def _values(state, eps, moreau, out, rows):
         out[3, i] = values[3]
         out[4, i] = values[4]
         out[5, i] = values[5]
+
+
+@kernel
+def chain_impact_rows(Um, masses, weight, left_wall, right_wall, eps, Up, Lam):
+    """Moreau's impact with restitution ε (docs/theory.md §3, §5) for every row of U⁻ of a
+    short chain, u⁺ into the rows of ``Up`` and Λ into those of ``Lam`` (nothing certified
+    here: the batch recomputes the certificate by :func:`chain_residual_columns`).
+
+    ``weight[a, b]`` is m_a + … + m_b (a < b). Blocks of :data:`BLOCK` rows are passed
+    formula by formula, each step over the block's rows at once (:func:`_impacts`)."""
+    k, n = Um.shape
+    mean = np.empty((n, n, BLOCK))
+    z = np.empty((n, BLOCK))
+    run = np.empty((2, BLOCK))
+    for start in range(0, k, BLOCK):
+        stop = min(start + BLOCK, k)
+        _impacts(Um[start:stop], masses, weight, (left_wall, right_wall), eps, Up[start:stop],
+                 Lam[start:stop], mean, z, run)
+
+
+@inline_kernel
+def _impacts(Um, m, weight, walls, eps, Up, Lam, mean, z, run):
+    """The impacts of one block's rows: z by the min–max formula of the weighted isotonic
+    regression, zⱼ = max_{a≤j} min_{b≥j} mean(u⁻_a..u⁻_b) (weights m; ``mean[a, b]``),
+    clipped at 0 on a wall side (both walls: z = 0); the impulses Λ_z by anchored sums of
+    dⱼ = mⱼ(zⱼ − u⁻ⱼ) (Λ = 0 exactly at the anchors); then u⁺ = (1+ε)z − εu⁻, Λ = (1+ε)Λ_z."""
+    rows, n = Um.shape
+    left, right = walls
+    if left and right:
+        z[:, :rows] = 0.0
+    else:
+        _projection(Um, m, weight, left, right, mean, z, run)
+    d = mean[0]  # the means are used up: dⱼ in their place
+    for j in range(n):
+        for i in range(rows):
+            d[j, i] = (z[j, i] - Um[i, j]) * m[j]
+    if left and right:  # z = 0: Λ_min = max_i Cᵢ − Cⱼ with C₀ = 0
+        run[:, :rows] = 0.0
+        for j in range(n):
+            for i in range(rows):
+                c = run[0, i] + d[j, i]
+                run[0, i] = c
+                run[1, i] = max(run[1, i], c)
+        for i in range(rows):
+            run[0, i] = 0.0
+            Lam[i, 0] = run[1, i]
+        for j in range(n):
+            for i in range(rows):
+                c = run[0, i] + d[j, i]
+                run[0, i] = c
+                Lam[i, j + 1] = run[1, i] - c
+    elif left:  # from the right: L_N = 0, Lⱼ = L_{j+1} + dⱼ unless j is an anchor
+        for j in range(n - 1, -1, -1):
+            for i in range(rows):
+                value = d[j, i] if j == n - 1 else run[0, i] + d[j, i]
+                anchor = z[j, i] > z[j - 1, i] if j else z[0, i] > 0.0
+                run[0, i] = 0.0 if anchor else value
+                Lam[i, j] = run[0, i]
+    else:  # from the left: L₀ = 0, L_{j+1} = Lⱼ − dⱼ unless an anchor
+        for j in range(1, n + right):
+            for i in range(rows):
+                value = -d[0, i] if j == 1 else run[0, i] - d[j - 1, i]
+                anchor = z[j, i] > z[j - 1, i] if j < n else z[n - 1, i] < 0.0
+                run[0, i] = 0.0 if anchor else value
+                Lam[i, j - 1] = run[0, i]
+    if eps == 0.0:
+        for j in range(n):
+            for i in range(rows):
+                Up[i, j] = z[j, i]
+        return
+    for j in range(n):
+        for i in range(rows):
+            Up[i, j] = (1.0 + eps) * z[j, i] - eps * Um[i, j]
+    for c in range(Lam.shape[1]):
+        for i in range(rows):
+            Lam[i, c] = (1.0 + eps) * Lam[i, c]
+
+
+@inline_kernel
+def _projection(Um, m, weight, left, right, mean, z, run):
+    """z of one block's rows (at most one wall) by the min–max formula (:func:`_impacts`)."""
+    rows, n = Um.shape
+    for a in range(n):
+        for i in range(rows):
+            mean[a, a, i] = Um[i, a]
+    for a in range(n - 1):
+        for i in range(rows):
+            run[0, i] = Um[i, a] * m[a]
+        for b in range(a + 1, n):
+            for i in range(rows):
+                total = run[0, i] + Um[i, b] * m[b]
+                run[0, i] = total
+                mean[a, b, i] = total / weight[a, b]
+    for j in range(n):
+        for a in range(j + 1):
+            for i in range(rows):
+                low = mean[a, j, i]
+                for b in range(j + 1, n):
+                    low = min(low, mean[a, b, i])
+                z[j, i] = low if a == 0 else max(z[j, i], low)
+        if left:
+            for i in range(rows):
+                z[j, i] = max(z[j, i], 0.0)
+        elif right:
+            for i in range(rows):
+                z[j, i] = min(z[j, i], 0.0)

@@ -4,7 +4,7 @@ through the same law objects as single impacts.
 The route comes from the planner that :func:`impactqp.solve` asks too
 (:func:`impactqp.laws.planner.plan`, mode ``"batch"``): dense impacts of the laws of a
 compiled family run the compiled impact row by row, certificate included; Moreau's family
-on a short chain runs column by column; closed-form laws run on all
+on a short chain runs in compiled passes over blocks of rows; closed-form laws run on all
 rows at once; other program laws run on a fast-path backend that solves many linear terms
 at once (isotonic regression for chains, the active-set search); rows they cannot settle,
 and every row of other structures, go through :func:`impactqp.solve`. Every row's
@@ -162,12 +162,7 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
     def work(a: int, b: int) -> np.ndarray:
         Ua, done = U[a:b], None
         if fast == "chain":
-            u = [np.ascontiguousarray(Ua[:, j]) for j in range(U.shape[1])]
-            up, lam = rows.solve(u)
-            for j, col in enumerate(up):
-                Up[a:b, j] = col
-            for i, col in enumerate(lam):
-                Lam[a:b, i] = col
+            rows.solve(Ua, Up[a:b], Lam[a:b])
             rows.residuals(Ua, Up[a:b], Lam[a:b], columns[:, a:b])
         elif fast == "compiled":  # each chunk warm-starts from its own cold support
             packed, E, eps, moreau = compiled
@@ -199,7 +194,7 @@ def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: s
 
     Rows are processed in chunks of :data:`!CHUNK_ROWS`, so memory beyond the input and the
     output stays bounded. Moreau's law on a short chain (``"auto"`` or ``"isotonic"``) runs
-    column by column (:mod:`!impactqp.laws.chain_rows`).
+    in compiled passes over blocks of rows (:mod:`!impactqp.laws.chain_rows`).
 
     Parameters
     ----------
