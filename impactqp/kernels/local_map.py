@@ -100,7 +100,7 @@ def local_cell(packed, Minv, E, eps, um, lam, kink_tol, out):
     if status[0] != SMOOTH:
         return status[0]
     active = one.active[0]
-    cells = new_cells(m, 0)
+    cells = new_cells(m, np.int64(0))  # typed as derivative_rows' call: one signature
     k = factor_cell(ops.G, active, cells, 0)
     count = 0
     for i in range(m):

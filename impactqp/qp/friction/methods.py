@@ -218,7 +218,7 @@ def small(data: FrictionData, tol: float) -> FrictionSolution:
         The call ended outside half the tolerance (the next method takes over)."""
     W = data.dense
     r = np.empty_like(data.q)
-    its, ok = solve_small(W, data.q, data.mu, scales(W.diagonal(), data.d), data.d, tol, r,
+    its, ok = solve_small(W, data.q, data.mu, scales(W.diagonal().copy(), data.d), data.d, tol, r,
                           NEWTON_STEPS, NSGS_SHORT, SMALL_LOCAL)
     if not ok:
         raise SolverError(f"kernel: not within tol/2 after {int(its)} iterations")

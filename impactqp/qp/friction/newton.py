@@ -160,7 +160,8 @@ class FrictionData:
     @property
     def rho(self) -> np.ndarray:
         if self._rho is None:
-            self._rho = scales(self.W.diagonal(), self.d)
+            # a contiguous writable copy, the array kernels pass: one compiled signature
+            self._rho = scales(self.W.diagonal().copy(), self.d)
         return self._rho
 
     @property
