@@ -105,6 +105,29 @@ def _slow(rows: list[dict]) -> list[tuple[str, float]]:
     return out
 
 
+def slow(rows: list[dict]) -> list[tuple[str, int, float]]:
+    """(problem, contacts, default / NSGS) of the problems where the default misses its time
+    target (:func:`_slow`), slowest first."""
+    sizes = {r["family"]: r["size"] for r in rows if r["family"].startswith(PREFIX)}
+    return sorted(((short(f), int(sizes[f]), v) for f, v in _slow(rows)),
+                  key=lambda item: -item[2])
+
+
+def fastest_others(rows: list[dict]) -> list[tuple[str, int]]:
+    """(method, problems it is the fastest on) of the methods other than the default that are
+    the fastest on some problem, most first."""
+    times = profile_times(rows)
+    if DEFAULT not in times:
+        return []
+    counts: dict[str, int] = {}
+    for cells in zip(*times.values(), strict=True):
+        best = min(cells)
+        if math.isfinite(best) and cells[list(times).index(DEFAULT)] != best:
+            winner = list(times)[cells.index(best)]
+            counts[winner] = counts.get(winner, 0) + 1
+    return sorted(counts.items(), key=lambda item: -item[1])
+
+
 def _factors(rows: list[dict]) -> dict[str, float]:
     """Per problem: the default's time over the fastest solver's (∞ where it failed)."""
     times = profile_times(rows)

@@ -54,6 +54,22 @@ def test_summary_explains_only_problems_it_ran() -> None:
     assert "KaplasTower (570 contacts" in why_missed("friction", full)
 
 
+def test_friction_explanation_gives_its_own_runs_figures() -> None:
+    """The reasons name only the problems this run found slow, with this run's ratio, and the
+    fastest-solver sentence counts this run's winners."""
+    from benchmarks.friction import BASELINE, DEFAULT
+    from benchmarks.report import why_missed
+
+    rows = [_agg("friction:LMGC-00046", 9, DEFAULT, 1.3e-4),
+            _agg("friction:LMGC-00046", 9, BASELINE, 1e-4),
+            _agg("friction:KaplasTower", 570, DEFAULT, 0.9),
+            _agg("friction:KaplasTower", 570, BASELINE, 1.0)]
+    text = why_missed("friction", rows)
+    assert "on 1 problem:" in text and "LMGC-00046 (9 contacts, 1.30×)" in text
+    assert "KaplasTower" not in text  # faster than NSGS in this run
+    assert "siconos:NSGS on 1 " in text  # the one problem NSGS was the fastest on
+
+
 def test_no_suite_time_is_advertised() -> None:
     """The suites' run time is what summary.md records; no fixed figure stands beside them."""
     texts = [README, *(p.read_text(encoding="utf-8") for p in (ROOT / "docs").glob("*.rst")),
