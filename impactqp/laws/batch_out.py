@@ -109,8 +109,9 @@ def reused(out: Any, U: np.ndarray, m: int, names: tuple[str, ...] | None,
     residuals = {key: _buffer(f"residuals[{key!r}]", value, (k,), contiguous=False)
                  for key, value in given.items()}  # (the chain's table is checked below)
     columns = _rows_of_table(residuals, names, k) if table and names else None
-    arrays = {"u_plus": Up, "impulses": Lam,
-              **{f"residuals[{key!r}]": value for key, value in residuals.items()}}
+    arrays = {"u_plus": Up, "impulses": Lam}  # a table's rows are apart by construction
+    arrays.update({"residuals": columns} if columns is not None else
+                  {f"residuals[{key!r}]": value for key, value in residuals.items()})
     for name, value in arrays.items():
         if _overlap(value, U):
             raise InputError(f"out.{name} shares memory with U_minus (the certificate reads "
