@@ -22,11 +22,12 @@ Buffers = tuple[np.ndarray, np.ndarray, dict, "np.ndarray | None"]
 
 def fresh(U: np.ndarray, m: int, table: tuple[str, ...] | None) -> Buffers:
     """New arrays for k = ``len(U)`` rows: U⁺ like U, Λ (k, m) and, when ``table`` names
-    the residuals, one (r, k) table whose rows are them (else residuals come later)."""
+    the residuals, one (r, k) table whose rows are them (else residuals come later). None is
+    zeroed: every route of a batch writes every entry (as it must into a reused ``out``)."""
     k = U.shape[0]
     columns = None if table is None else np.empty((len(table), k))
     residuals = {} if table is None else dict(zip(table, columns))
-    return np.empty((k, U.shape[1])), np.zeros((k, m)), residuals, columns
+    return np.empty((k, U.shape[1])), np.empty((k, m)), residuals, columns
 
 
 def _buffer(name: str, value: Any, shape: tuple[int, ...], contiguous: bool = True
