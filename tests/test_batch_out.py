@@ -138,8 +138,25 @@ def test_residuals_of_another_law_or_layout_are_refused(batch3):
         iq.moreau_batch(p, U, out=sector)
     with pytest.raises(InputError, match="out holds the residuals"):
         iq.sector_law_batch(p, U, out=r)
-    loose = {key: value.copy() for key, value in r.residuals.items()}
-    with pytest.raises(InputError, match=r"rows of one \(6, 20\) table"):
-        iq.moreau_batch(p, U, out=dataclasses.replace(r, residuals=loose))
     with pytest.raises(InputError, match="residuals must be a dict"):
-        iq.moreau_batch(p, U, out=dataclasses.replace(r, residuals=list(loose.values())))
+        iq.moreau_batch(p, U, out=dataclasses.replace(r, residuals=list(r.residuals.values())))
+
+
+def test_residuals_apart_from_a_table_are_filled_too():
+    """The chain pass writes its residual columns side by side; an out whose residuals are
+    separate arrays, or strided columns (a result of the one-by-one route), gets the same
+    numbers through a scratch block."""
+    p = iq.newtons_cradle(3)
+    U = np.random.default_rng(7).standard_normal((100, 3))
+    ref = iq.moreau_batch(p, U, 0.3)
+    r = iq.moreau_batch(p, U, 0.3)
+    loose = dataclasses.replace(r, residuals={key: np.full(100, np.nan)
+                                              for key in r.residuals})
+    one_by_one = spoiled(iq.moreau_batch(p, U[::-1], 0.3, backend="clarabel"))
+    for out in (loose, one_by_one):
+        b = iq.moreau_batch(p, U, 0.3, out=out)
+        assert b.backend == "isotonic" and b.u_plus is out.u_plus
+        assert all(b.residuals[key] is value for key, value in out.residuals.items())
+        np.testing.assert_array_equal(b.u_plus, ref.u_plus)
+        for key, value in ref.residuals.items():
+            np.testing.assert_array_equal(b.residuals[key], value)

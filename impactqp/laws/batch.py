@@ -142,8 +142,9 @@ def _in_chunks(k: int, work, n_jobs: int) -> np.ndarray:
 def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, out: Buffers, fast,
                 tol: float):
     """``work(a, b)`` for :func:`_in_chunks`: solve rows a..b into the buffers' U⁺ and Λ,
-    write their residuals into the buffers' residuals (by name; for the chain, the columns
-    of its table) and return the indices of the rows that are not certified."""
+    write their residuals into the buffers' residuals (by name; the chain's pass writes the
+    columns of their table, or of a scratch block copied into them) and return the indices
+    of the rows that are not certified."""
     st, k = problem.structure, U.shape[0]
     Up, Lam, res, columns = out
     named = bool(res)  # the residuals' names were known before the first chunk
@@ -161,7 +162,10 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, out: Buff
         Ua, done = U[a:b], None
         if fast == "chain":
             rows.solve(Ua, Up[a:b], Lam[a:b])
-            rows.residuals(Ua, Up[a:b], Lam[a:b], columns[:, a:b])
+            block = np.empty((len(res), b - a)) if columns is None else columns[:, a:b]
+            rows.residuals(Ua, Up[a:b], Lam[a:b], block)
+            for key, value in zip(res, block) if columns is None else ():  # out's own arrays
+                res[key][a:b] = value
         elif fast == "compiled":  # each chunk warm-starts from its own cold support
             packed, E, eps, moreau = compiled
             Up[a:b], Lam[a:b], table, done = solve_impact_rows(
@@ -258,7 +262,7 @@ def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: s
         raise InputError(f"out must be the BatchResult of an earlier batch, got "
                          f"{type(out).__name__}")
     else:
-        buffers = batch_out.reused(out, U, st.m, names, fast == "chain")
+        buffers = batch_out.reused(out, U, st.m, names)
     Up, Lam, res, _ = buffers
     if not law.forms or fast is not None:
         rows = _in_chunks(k, _chunk_rows(problem, law, U, buffers, fast, tol), n_jobs)

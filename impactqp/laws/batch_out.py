@@ -3,9 +3,10 @@ passed back as ``out=`` (a stream of batches then writes into pages it has alrea
 instead of having the system map and zero about 88 bytes per 3-ball row at every call).
 
 A buffer is taken only when the batch can write every entry of it and read nothing of it
-before: float64, C-contiguous where compiled passes write it (U⁺, Λ, the chain's residual
-table), writable, of the batch's shape, and sharing no memory with
-u⁻ or with another buffer (the certificate reads u⁻, u⁺ and Λ after the solve wrote them).
+before: float64, C-contiguous where compiled passes write it (U⁺, Λ), writable, of the
+batch's shape, and sharing no memory with u⁻ or with another buffer (the certificate
+reads u⁻, u⁺ and Λ after the solve wrote them). Residuals that are not the rows of one
+table are filled chunk by chunk from a scratch block.
 """
 
 from __future__ import annotations
@@ -54,25 +55,23 @@ def _overlap(a: np.ndarray, b: np.ndarray) -> bool:
     return bool(np.shares_memory(a, b))
 
 
-def _rows_of_table(residuals: dict, names: tuple[str, ...], k: int) -> np.ndarray:
-    """The (r, k) array whose rows are ``residuals`` in the order ``names``, or InputError."""
-    first = residuals[names[0]]
-    table = first.base
+def _table(residuals: dict, names: tuple[str, ...], k: int) -> np.ndarray | None:
+    """The (r, k) array whose rows are ``residuals`` in the order ``names`` (a compiled pass
+    writes the residual columns of a block into it side by side), or None when they are
+    not the rows of one such array (then they are filled chunk by chunk from a scratch)."""
+    table = residuals[names[0]].base if names else None
     if not (isinstance(table, np.ndarray) and table.shape == (len(names), k)
             and table.dtype == np.float64 and table.flags.c_contiguous
             and table.flags.writeable):
-        raise InputError(f"out.residuals must be the rows of one ({len(names)}, {k}) "
-                         "table, as a batch of this law on this structure returns them")
+        return None
     start = table.__array_interface__["data"][0]
-    for i, name in enumerate(names):
-        if residuals[name].__array_interface__["data"][0] != start + i * k * 8:
-            raise InputError(f"out.residuals[{name!r}] is not row {i} of the residual "
-                             "table its siblings belong to")
+    if any(residuals[name].__array_interface__["data"][0] != start + i * k * 8
+           for i, name in enumerate(names)):
+        return None
     return table
 
 
-def reused(out: Any, U: np.ndarray, m: int, names: tuple[str, ...] | None,
-           table: bool) -> Buffers:
+def reused(out: Any, U: np.ndarray, m: int, names: tuple[str, ...] | None) -> Buffers:
     """The arrays of ``out`` (an earlier batch's result) checked for a batch of the rows of
     ``U`` with m contacts.
 
@@ -86,10 +85,7 @@ def reused(out: Any, U: np.ndarray, m: int, names: tuple[str, ...] | None,
         Contacts.
     names : tuple of str, optional
         The residuals the batch writes, when known before solving (then ``out`` must hold
-        exactly them).
-    table : bool
-        Whether they must be the rows of one (r, k) table (the compiled chain pass writes
-        the residual columns side by side).
+        exactly them; when they are the rows of one table, it is returned as such).
 
     Raises
     ------
@@ -108,8 +104,8 @@ def reused(out: Any, U: np.ndarray, m: int, names: tuple[str, ...] | None,
     if names is not None and tuple(given) != names:
         raise InputError(f"out holds the residuals {tuple(given)}, this batch writes {names}")
     residuals = {key: _buffer(f"residuals[{key!r}]", value, (k,), contiguous=False)
-                 for key, value in given.items()}  # (the chain's table is checked below)
-    columns = _rows_of_table(residuals, names, k) if table and names else None
+                 for key, value in given.items()}
+    columns = _table(residuals, names, k) if names else None
     arrays = {"u_plus": Up, "impulses": Lam}  # a table's rows are apart by construction
     arrays.update({"residuals": columns} if columns is not None else
                   {f"residuals[{key!r}]": value for key, value in residuals.items()})
