@@ -22,15 +22,16 @@ import numpy as np
 
 from ..base.arrays import as_array, as_count
 from ..base.checks import DEFAULT_TOL, BatchCertificate, certified_rows
-from ..errors import BackendUnsuitableError, CertificateError, ShapeError
+from ..errors import BackendUnsuitableError, CertificateError, InputError, ShapeError
 from ..kernels.impact import solve_impact_rows
 from ..kernels.jit import read_only
 from ..kernels.residuals import RESIDUALS
 from ..model.problem import ImpactProblem
 from ..qp import backends
 from ..qp.certified import FAST_PATHS
-from . import small
+from . import batch_out, small
 from .base import MOREAU_FAMILY, ImpactLaw
+from .batch_out import Buffers
 from .chain_rows import ChainRows
 from .moreau import Moreau
 from .pipeline import solve
@@ -138,11 +139,15 @@ def _in_chunks(k: int, work, n_jobs: int) -> np.ndarray:
     return np.concatenate(found)
 
 
-def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.ndarray,
-                Lam: np.ndarray, res: dict, fast, tol: float):
-    """``work(a, b)`` for :func:`_in_chunks`: solve rows a..b into Up, Lam, write their
-    residuals into ``res`` and return the indices of the rows that are not certified."""
+def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, out: Buffers, fast,
+                tol: float):
+    """``work(a, b)`` for :func:`_in_chunks`: solve rows a..b into the buffers' U⁺ and Λ,
+    write their residuals into the buffers' residuals (by name; the chain's pass writes the
+    columns of their table, or of a scratch block copied into them) and return the indices
+    of the rows that are not certified."""
     st, k = problem.structure, U.shape[0]
+    Up, Lam, res, columns = out
+    named = bool(res)  # the residuals' names were known before the first chunk
     module = None
     if fast == "chain":
         rows = ChainRows(st, law.eps)
@@ -152,18 +157,15 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
                     law.eps if moreau else 0.0, moreau)
     elif fast is not None:
         module = backends.load(backends.REGISTRY[fast[0]])
-    if fast == "chain":  # the residual columns are written where the batch keeps them
-        columns = np.empty((len(RESIDUALS), k))
-        res.update(zip(RESIDUALS, columns))
-    elif fast == "compiled":
-        names = RESIDUALS if compiled[3] else RESIDUALS[:4]
-        res.update({key: np.empty(k) for key in names})
 
     def work(a: int, b: int) -> np.ndarray:
         Ua, done = U[a:b], None
         if fast == "chain":
             rows.solve(Ua, Up[a:b], Lam[a:b])
-            rows.residuals(Ua, Up[a:b], Lam[a:b], columns[:, a:b])
+            block = np.empty((len(res), b - a)) if columns is None else columns[:, a:b]
+            rows.residuals(Ua, Up[a:b], Lam[a:b], block)
+            for key, value in zip(res, block) if columns is None else ():  # out's own arrays
+                res[key][a:b] = value
         elif fast == "compiled":  # each chunk warm-starts from its own cold support
             packed, E, eps, moreau = compiled
             Up[a:b], Lam[a:b], table, done = solve_impact_rows(
@@ -178,7 +180,11 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
                 _, form, qp = fast
                 X, Y, done = module.solve_many(qp, law.linear_terms(problem, Ua, form))
                 Up[a:b], Lam[a:b] = law.recover_rows(problem, form, Ua, X, Y)
-            for key, value in law.residuals(st, Ua, Up[a:b], Lam[a:b]).items():
+            values = law.residuals(st, Ua, Up[a:b], Lam[a:b])
+            if named and tuple(values) != tuple(res):  # out= of another law
+                raise InputError(f"out holds the residuals {tuple(res)}, this batch writes "
+                                 f"{tuple(values)}")
+            for key, value in values.items():
                 if key not in res:  # the first chunk runs alone
                     res[key] = np.empty(k)
                 res[key][a:b] = value
@@ -189,7 +195,8 @@ def _chunk_rows(problem: ImpactProblem, law: ImpactLaw, U: np.ndarray, Up: np.nd
 
 
 def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: str = "auto",
-                *, tol: float = DEFAULT_TOL, n_jobs: int = 1) -> BatchResult:
+                *, tol: float = DEFAULT_TOL, n_jobs: int = 1,
+                out: BatchResult | None = None) -> BatchResult:
     """``law`` for every row of ``U_minus`` on the structure of ``problem``.
 
     Rows are processed in chunks of :data:`!CHUNK_ROWS`, so memory beyond the input and the
@@ -210,16 +217,25 @@ def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: s
         Certificate tolerance per row.
     n_jobs : int
         Threads working on chunks at once (results do not depend on it).
+    out : BatchResult, optional
+        The result of an earlier batch of the same law on the same structure with as many
+        rows: its arrays (``u_plus``, ``impulses``, ``residuals``) are overwritten and
+        returned in the new result, so a stream of batches writes into memory it has
+        already touched (at 10⁷ rows a fresh result is ~0.9 GB of new pages). The old result
+        then holds the new numbers; after an error its arrays hold no meaningful values.
+        Its arrays must be float64, C-contiguous, writable, of the batch's shapes, hold the
+        residuals this batch writes, and share no memory with ``U_minus`` or each other.
 
     Returns
     -------
     BatchResult
-        Certified row by row.
+        Certified row by row (with ``out``, holding ``out``'s arrays).
 
     Raises
     ------
     ShapeError, InputError, UnknownBackendError, BackendUnsuitableError
-        Bad input (named).
+        Bad input (named); an unusable ``out`` (ShapeError for a shape, InputError for the
+        rest, each naming the array and what is wrong).
     CertificateError
         A closed-form law's row fails its certificate, or no backend certifies a row.
     """
@@ -238,10 +254,18 @@ def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: s
         used = backend if fast is None else fast[0]
     else:
         fast, used = None, law.closed_form_backend
-    Up, Lam = np.empty_like(U), np.zeros((k, st.m))
-    res: dict[str, np.ndarray] = {}
+    names = (RESIDUALS if fast == "chain" or (fast == "compiled" and law.family == MOREAU_FAMILY)
+             else RESIDUALS[:4] if fast == "compiled" else None)
+    if out is None:
+        buffers = batch_out.fresh(U, st.m, names)
+    elif not isinstance(out, BatchResult):
+        raise InputError(f"out must be the BatchResult of an earlier batch, got "
+                         f"{type(out).__name__}")
+    else:
+        buffers = batch_out.reused(out, U, st.m, names)
+    Up, Lam, res, _ = buffers
     if not law.forms or fast is not None:
-        rows = _in_chunks(k, _chunk_rows(problem, law, U, Up, Lam, res, fast, tol), n_jobs)
+        rows = _in_chunks(k, _chunk_rows(problem, law, U, buffers, fast, tol), n_jobs)
     else:  # every row goes through the single-impact pipeline
         rows = np.arange(k)
     if not law.forms and rows.size:
@@ -253,10 +277,13 @@ def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: s
                   tol=tol)
         Up[i], Lam[i] = r.u_plus, r.impulses
         used = used if fast is not None else r.backend
-    if not res:
+    if not res:  # no chunk ran, or every row went through the pipeline
         res = law.residuals(st, U, Up, Lam)
     elif rows.size:
         fixed = law.residuals(st, U[rows], Up[rows], Lam[rows])
+        if tuple(fixed) != tuple(res):  # out= of another law
+            raise InputError(f"out holds the residuals {tuple(res)}, this batch writes "
+                             f"{tuple(fixed)}")
         for key in res:
             res[key][rows] = fixed[key]
     return BatchResult(u_plus=Up, impulses=Lam, residuals=res, backend=used,
@@ -265,9 +292,9 @@ def solve_batch(problem: ImpactProblem, law: ImpactLaw, U_minus: Any, backend: s
 
 def moreau_batch(problem: ImpactProblem, U_minus: Any, eps: float = 0.0,
                  backend: str = "auto", *, tol: float = DEFAULT_TOL,
-                 n_jobs: int = 1) -> BatchResult:
+                 n_jobs: int = 1, out: BatchResult | None = None) -> BatchResult:
     """Moreau's law (docs/theory.md §3) for every row of ``U_minus``:
-    ``solve_batch(problem, Moreau(eps), U_minus, backend, tol=tol)``.
+    ``solve_batch(problem, Moreau(eps), U_minus, backend, tol=tol, n_jobs=n_jobs, out=out)``.
 
     Parameters
     ----------
@@ -283,6 +310,8 @@ def moreau_batch(problem: ImpactProblem, U_minus: Any, eps: float = 0.0,
         Certificate tolerance per row.
     n_jobs : int
         Threads working on chunks of rows at once.
+    out : BatchResult, optional
+        An earlier result whose arrays are overwritten and reused (:func:`solve_batch`).
 
     Returns
     -------
@@ -293,13 +322,14 @@ def moreau_batch(problem: ImpactProblem, U_minus: Any, eps: float = 0.0,
     RestitutionError, ShapeError, UnknownBackendError, BackendUnsuitableError, CertificateError
     """
     check_problem(problem)
-    return solve_batch(problem, Moreau(eps), U_minus, backend, tol=tol, n_jobs=n_jobs)
+    return solve_batch(problem, Moreau(eps), U_minus, backend, tol=tol, n_jobs=n_jobs,
+                       out=out)
 
 
-def sector_law_batch(problem: ImpactProblem, U_minus: Any, *,
-                     tol: float = DEFAULT_TOL, n_jobs: int = 1) -> BatchResult:
+def sector_law_batch(problem: ImpactProblem, U_minus: Any, *, tol: float = DEFAULT_TOL,
+                     n_jobs: int = 1, out: BatchResult | None = None) -> BatchResult:
     """The sector law u⁺ = sort(u⁻) (docs/theory.md §6) for every row of ``U_minus`` on an
-    equal-mass chain: ``solve_batch(problem, SectorLaw(), U_minus, tol=tol)``.
+    equal-mass chain: ``solve_batch(problem, SectorLaw(), U_minus, tol=tol, out=out)``.
 
     Parameters
     ----------
@@ -311,6 +341,8 @@ def sector_law_batch(problem: ImpactProblem, U_minus: Any, *,
         Tolerance of the recomputed certificates.
     n_jobs : int
         Threads working on chunks of rows at once.
+    out : BatchResult, optional
+        An earlier result whose arrays are overwritten and reused (:func:`solve_batch`).
 
     Returns
     -------
@@ -324,4 +356,4 @@ def sector_law_batch(problem: ImpactProblem, U_minus: Any, *,
     CertificateError
         When a row fails its recomputed certificate (rounding with wildly mixed magnitudes).
     """
-    return solve_batch(problem, SectorLaw(), U_minus, tol=tol, n_jobs=n_jobs)
+    return solve_batch(problem, SectorLaw(), U_minus, tol=tol, n_jobs=n_jobs, out=out)
