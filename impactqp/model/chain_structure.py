@@ -14,9 +14,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import Matrix
-from ..errors import MassMatrixError, NonFiniteError, ShapeError
+from ..errors import MassMatrixError, NonFiniteError, OutOfRangeError, ShapeError
 from ..kernels.chain import pack_chain
-from .structure import ChainInfo, ImpactStructure
+from .structure import TINY, ChainInfo, ImpactStructure
 
 
 def chain_directions(n_balls: int, *, left_wall: bool = False, right_wall: bool = False,
@@ -71,15 +71,22 @@ class ChainStructure(ImpactStructure):
         masses = chain.masses
         if masses.ndim != 1 or masses.size == 0:
             raise ShapeError(f"masses must be a non-empty 1-D array, got shape {masses.shape}")
-        if not np.isfinite(masses.sum()):  # NaN and ±inf make the sum non-finite
+        lo, hi = masses.min(), masses.max()
+        if not (np.isfinite(lo) and np.isfinite(hi)):  # NaN propagates; ±inf is an extreme
             raise NonFiniteError("masses must be finite")
-        if not masses.min() > 0:
+        if not lo > 0:
             raise MassMatrixError(f"masses must be positive; got "
                                   f"{masses[masses <= 0][:5].tolist()}")
         self.sparse = bool(sparse)
         self.chain = chain
         self.n = masses.size
         self.m = masses.size - 1 + chain.left_wall + chain.right_wall
+        if self.m and not TINY <= lo <= hi <= 1.0 / TINY:
+            raise OutOfRangeError(
+                f"masses span [{lo:.3g}, {hi:.3g}]: beyond [{TINY:.3g}, "
+                f"{1.0 / TINY:.3g}] the Delassus matrix G (1/mᵢ + 1/mᵢ₊₁) leaves the normal "
+                "floats; state the masses in another unit (u⁺ does not change when every "
+                "mass is multiplied by a constant)")
         self.diagonal_mass = True
         self._diag = self.mass_diagonal = masses
 

@@ -19,9 +19,13 @@ from scipy.linalg import lapack
 
 from ..base.arrays import Matrix, as_count, as_dense, as_matrix
 from ..base.rowwise import row_max, row_sum
-from ..errors import InputError, MassMatrixError, ShapeError
+from ..errors import InputError, MassMatrixError, OutOfRangeError, ShapeError
 from ..kernels.impact import pack_operators
 from ..kernels.units import contact_units
+
+TINY = float(np.finfo(float).tiny)
+"""The smallest normal float: below it a number keeps fewer than 53 bits."""
+HUGE = float(np.finfo(float).max)
 
 
 @dataclass(frozen=True)
@@ -107,12 +111,42 @@ class ImpactStructure:
         self.chain = chain
         self.contact_dim = contact_dim
         self._check_symmetric()
+        diagonal = np.asarray(M.diagonal(), dtype=float)
+        if np.any((diagonal > 0) & (diagonal < TINY)):
+            raise OutOfRangeError(
+                f"M's diagonal reaches {diagonal[diagonal > 0].min():.3g}, below the normal "
+                f"floats ({TINY:.3g}): M⁻¹ and the Delassus matrix G = WᵀM⁻¹W are beyond "
+                "them; state M in a larger unit (u⁺ does not change when M is multiplied by "
+                "a constant)")
         self._factorize()
         col_norms = np.sqrt(np.asarray(abs(W).power(2).sum(axis=0)).ravel()) if self.sparse \
             else np.linalg.norm(W, axis=0)
         if np.any(col_norms == 0):
             raise ShapeError(f"W column(s) {np.flatnonzero(col_norms == 0).tolist()} are zero: "
                              "every contact needs a non-zero force direction")
+        self._check_range()
+
+    def _check_range(self) -> None:
+        """Refuse a problem whose Delassus matrix G = WᵀM⁻¹W floats cannot hold
+        (docs/theory.md §1): a diagonal entry Gⱼⱼ > 0 that overflows or falls below the
+        normal floats (M in units so small, or W so large, that M⁻¹ or G leaves them; every
+        law here is posed on G). Dense, diagonal and chain problems check G's diagonal,
+        which their solves use anyway; a sparse non-diagonal M its pivots."""
+        if self.sparse and not self.diagonal_mass:
+            pivots = np.abs(self._lu.U.diagonal())
+            with np.errstate(over="ignore", divide="ignore"):
+                bad = not (pivots.min() >= TINY and np.isfinite(1.0 / pivots.min()))
+            what = f"M's pivots reach {pivots.min():.3g}"
+        else:
+            with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+                diagonal = self.delassus_diagonal
+            bad = not (np.all(np.isfinite(diagonal)) and diagonal.min(initial=1.0) >= TINY)
+            what = f"its diagonal spans [{diagonal.min():.3g}, {diagonal.max():.3g}]"
+        if bad:
+            raise OutOfRangeError(
+                f"the Delassus matrix G = WᵀM⁻¹W is beyond the floats ({what}; normal floats "
+                f"lie in [{TINY:.3g}, {HUGE:.3g}]): state M and W in units nearer one (u⁺ "
+                "does not change when M is multiplied by a constant)")
 
     @property
     def n_contacts(self) -> int:
