@@ -19,15 +19,17 @@ duplicates add up, as in CSparse). Mixed problems (``V``, ``R``, ``s`` or ``G``,
 equality multipliers) are refused, as are rolling-friction files.
 
 Reading is strict: a path that is not a regular file, a file that is not HDF5, missing or
-mis-typed datasets, sizes that do not fit together, indices out of range, non-finite numbers,
-negative μ and a singular M are refused with a :class:`~impactqp.errors.ProblemFileError`
-that names the file and the dataset. A file is read alone: external links (which open other
-files, a FIFO among them, where reading would wait forever), soft links, external raw storage
-(a dataset whose bytes live in another file, /dev/zero reads as zeros) and virtual datasets
-are refused by name, before anything they point at is opened (:mod:`.hdf5_reader`).
-Dimensions above :data:`MAX_FCLIB_DIM` and datasets declaring more than
-:data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES` are refused before anything is allocated
-or decompressed, and only the entries the problem needs are read.
+mis-typed datasets, sizes that do not fit together, indices out of range, non-finite
+numbers, negative μ, a W with a negative diagonal entry (no Delassus matrix has one) and an
+M that is singular or not positive definite (no mass matrix is) are refused with a
+:class:`~impactqp.errors.ProblemFileError` that names the file and the dataset. A file is
+read alone: external links (which open other files, a FIFO among them, where reading would
+wait forever), soft links, external raw storage (a dataset whose bytes live in another file,
+/dev/zero reads as zeros) and virtual datasets are refused by name, before anything they
+point at is opened (:mod:`.hdf5_reader`). Dimensions above :data:`MAX_FCLIB_DIM` and
+datasets declaring more than :data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES` are refused
+before anything is allocated or decompressed, and only the entries the problem needs are
+read.
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ import scipy.sparse.linalg as spla
 from ..base.outputs import atomic_output
 from ..errors import InputError, ProblemFileError
 from ..model.friction import FrictionContactProblem
+from .delassus import negative_diagonal
 from .hdf5_reader import CheckedReader, h5py_module
 from .siconos_text import looks_like_siconos_text, read_siconos_text
 
@@ -115,8 +118,34 @@ def _local(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]
     if W.shape[0] != W.shape[1]:
         raise reader.error(f"{root}/W", f"must be square, got {W.shape}")
     contacts = _contacts(reader, f"{root}/W", W.shape[0], d)
+    negative = negative_diagonal(W, d)
+    if negative is not None:
+        raise reader.error(f"{root}/W", negative)
     q = reader.floats(f"{root}/vectors/q", W.shape[0])
     return W, q, reader.mu(root, contacts), d
+
+
+def _mass_factor(reader: _Reader, M: sp.csc_matrix):
+    """The sparse LU of a global problem's M, once M is known to be a mass matrix: its
+    symmetric part positive definite (½vᵀMv > 0 for v ≠ 0), decided by an LU with diagonal
+    pivots in a symmetric order (an LDLᵀ: every pivot positive exactly when it is; it is
+    M's own LU when M is symmetric, as it nearly always is)."""
+    symmetric = (M != M.T).nnz == 0
+    try:
+        lu = spla.splu(M if symmetric else sp.csc_matrix((M + M.T) * 0.5),
+                       permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+        pivots = lu.U.diagonal()
+        definite = np.array_equal(lu.perm_r, lu.perm_c) and np.all(pivots > 0)
+        own = lu if symmetric and definite else spla.splu(M)  # RuntimeError: M is singular
+    except RuntimeError:
+        raise reader.error("fclib_global/M", "is singular; the global problem cannot be "
+                                             "reduced to W = Hᵀ M⁻¹ H") from None
+    if not definite:
+        raise reader.error("fclib_global/M", "is not positive definite (a pivot of its LDLᵀ is "
+                                             f"{pivots.min():.3g}): a mass matrix gives every "
+                                             "velocity a positive kinetic energy ½vᵀMv")
+    return own
 
 
 def _reduce(reader: _Reader, M: sp.csc_matrix, H: sp.csc_matrix,
@@ -124,11 +153,7 @@ def _reduce(reader: _Reader, M: sp.csc_matrix, H: sp.csc_matrix,
     """Hᵀ M⁻¹ H and Hᵀ M⁻¹ f, with M⁻¹ applied by one sparse LU and checked column block by
     column block (docs/theory.md §1: the Delassus matrix and the free contact velocity)."""
     name = "fclib_global/M"
-    try:
-        lu = spla.splu(M)
-    except RuntimeError as exc:
-        raise reader.error(name, f"is singular ({exc}); the global problem cannot be reduced "
-                                 "to W = Hᵀ M⁻¹ H") from None
+    lu = _mass_factor(reader, M)
     magnitude = abs(M)
     blocks = []
     rhs = sp.hstack([H, sp.csc_matrix(f.reshape(-1, 1))], format="csc")
@@ -205,11 +230,12 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
     ------
     ProblemFileError
         Not a regular file, not HDF5, neither problem group, a mixed problem (``V``/``R`` or
-        ``G``/``b``), a missing or malformed dataset, non-finite numbers, negative μ or a
-        singular M; a link that is not a hard one (an external link reaches into another
-        file), a dataset stored outside the file (external raw storage, a virtual dataset),
-        one declaring more than :data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES`, or a
-        problem that does not fit in memory. The message names the file and the dataset.
+        ``G``/``b``), a missing or malformed dataset, non-finite numbers, negative μ, a negative
+        diagonal entry of W, or an M that is singular or not positive definite; a link that is not
+        a hard one (an external link reaches into another file), a dataset stored outside the file
+        (external raw storage, a virtual dataset), one declaring more than
+        :data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES`, or a problem that does not fit in
+        memory. The message names the file and the dataset.
         For a Siconos text file: the errors of
         :func:`~impactqp.io.siconos_text.read_siconos_text` (truncated, non-numeric or
         non-finite numbers, counts that do not fit, negative μ, a damaged gzip stream), each

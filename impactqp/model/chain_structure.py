@@ -14,9 +14,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import Matrix
-from ..errors import MassMatrixError, NonFiniteError, OutOfRangeError, ShapeError
+from ..errors import MassMatrixError, NonFiniteError, ShapeError
 from ..kernels.chain import pack_chain
-from .structure import TINY, ChainInfo, ImpactStructure
+from .structure import ChainInfo, ImpactStructure
+from .validation import check_chain_masses
 
 
 def chain_directions(n_balls: int, *, left_wall: bool = False, right_wall: bool = False,
@@ -81,12 +82,8 @@ class ChainStructure(ImpactStructure):
         self.chain = chain
         self.n = masses.size
         self.m = masses.size - 1 + chain.left_wall + chain.right_wall
-        if self.m and not TINY <= lo <= hi <= 1.0 / TINY:
-            raise OutOfRangeError(
-                f"masses span [{lo:.3g}, {hi:.3g}]: beyond [{TINY:.3g}, "
-                f"{1.0 / TINY:.3g}] the Delassus matrix G (1/mᵢ + 1/mᵢ₊₁) leaves the normal "
-                "floats; state the masses in another unit (u⁺ does not change when every "
-                "mass is multiplied by a constant)")
+        if self.m:
+            check_chain_masses(lo, hi)
         self.diagonal_mass = True
         self._diag = self.mass_diagonal = masses
 

@@ -17,15 +17,12 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
-from ..base.arrays import Matrix, as_count, as_dense, as_matrix
+from ..base.arrays import Matrix, as_dense, as_matrix
 from ..base.rowwise import row_max, row_sum
-from ..errors import InputError, MassMatrixError, OutOfRangeError, ShapeError
+from ..errors import MassMatrixError, ShapeError
 from ..kernels.impact import pack_operators
 from ..kernels.units import contact_units
-
-TINY = float(np.finfo(float).tiny)
-"""The smallest normal float: below it a number keeps fewer than 53 bits."""
-HUGE = float(np.finfo(float).max)
+from .validation import check_contact_dim, check_delassus_diagonal, check_mass, check_pivots
 
 
 @dataclass(frozen=True)
@@ -43,17 +40,6 @@ class ChainInfo:
     masses: np.ndarray
     left_wall: bool = False
     right_wall: bool = False
-
-
-def _check_contact_dim(value: object, chain: ChainInfo | None) -> int:
-    """``contact_dim`` as an int in {1, 2, 3}, or InputError (also for a frictional chain)."""
-    d = as_count("contact_dim", value)
-    if d not in (1, 2, 3):
-        raise InputError(f"contact_dim must be 1 (frictionless), 2 (planar friction) or 3 "
-                         f"(spatial friction), got {d}")
-    if chain is not None and d != 1:
-        raise InputError("a chain's contacts are frictionless: contact_dim must be 1")
-    return d
 
 
 class ImpactStructure:
@@ -90,7 +76,7 @@ class ImpactStructure:
 
     def __init__(self, M: Matrix, W: Matrix, *, chain: ChainInfo | None = None,
                  contact_dim: int = 1) -> None:
-        contact_dim = _check_contact_dim(contact_dim, chain)
+        contact_dim = check_contact_dim(contact_dim, chain)
         M, W = as_matrix("M", M), as_matrix("W", W)
         self.sparse = sp.issparse(M) or sp.issparse(W)
         if self.sparse:
@@ -110,43 +96,17 @@ class ImpactStructure:
         self.n, self.m = n, W.shape[1]
         self.chain = chain
         self.contact_dim = contact_dim
-        self._check_symmetric()
-        diagonal = np.asarray(M.diagonal(), dtype=float)
-        if np.any((diagonal > 0) & (diagonal < TINY)):
-            raise OutOfRangeError(
-                f"M's diagonal reaches {diagonal[diagonal > 0].min():.3g}, below the normal "
-                f"floats ({TINY:.3g}): M⁻¹ and the Delassus matrix G = WᵀM⁻¹W are beyond "
-                "them; state M in a larger unit (u⁺ does not change when M is multiplied by "
-                "a constant)")
+        check_mass(M, self.sparse)
         self._factorize()
         col_norms = np.sqrt(np.asarray(abs(W).power(2).sum(axis=0)).ravel()) if self.sparse \
             else np.linalg.norm(W, axis=0)
         if np.any(col_norms == 0):
             raise ShapeError(f"W column(s) {np.flatnonzero(col_norms == 0).tolist()} are zero: "
                              "every contact needs a non-zero force direction")
-        self._check_range()
-
-    def _check_range(self) -> None:
-        """Refuse a problem whose Delassus matrix G = WᵀM⁻¹W floats cannot hold
-        (docs/theory.md §1): a diagonal entry Gⱼⱼ > 0 that overflows or falls below the
-        normal floats (M in units so small, or W so large, that M⁻¹ or G leaves them; every
-        law here is posed on G). Dense, diagonal and chain problems check G's diagonal,
-        which their solves use anyway; a sparse non-diagonal M its pivots."""
         if self.sparse and not self.diagonal_mass:
-            pivots = np.abs(self._lu.U.diagonal())
-            with np.errstate(over="ignore", divide="ignore"):
-                bad = not (pivots.min() >= TINY and np.isfinite(1.0 / pivots.min()))
-            what = f"M's pivots reach {pivots.min():.3g}"
+            check_pivots(self._lu.U.diagonal())
         else:
-            with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-                diagonal = self.delassus_diagonal
-            bad = not (np.all(np.isfinite(diagonal)) and diagonal.min(initial=1.0) >= TINY)
-            what = f"its diagonal spans [{diagonal.min():.3g}, {diagonal.max():.3g}]"
-        if bad:
-            raise OutOfRangeError(
-                f"the Delassus matrix G = WᵀM⁻¹W is beyond the floats ({what}; normal floats "
-                f"lie in [{TINY:.3g}, {HUGE:.3g}]): state M and W in units nearer one (u⁺ "
-                "does not change when M is multiplied by a constant)")
+            check_delassus_diagonal(lambda: self.delassus_diagonal)
 
     @property
     def n_contacts(self) -> int:
@@ -162,14 +122,6 @@ class ImpactStructure:
             return self
         W = self.W[:, ::d] if not self.sparse else sp.csc_matrix(self.W)[:, ::d]
         return ImpactStructure(self.M, W)
-
-    def _check_symmetric(self) -> None:
-        M = self.M
-        scale = abs(M).max() if self.sparse else np.abs(M).max()
-        asym = abs(M - M.T).max() if self.sparse else np.abs(M - M.T).max()
-        if asym > 1e-12 * max(scale, 1e-300):
-            raise MassMatrixError(f"M must be symmetric; max |M - Mᵀ| = {asym:.3g} "
-                                  f"(largest entry {scale:.3g})")
 
     def _factorize(self) -> None:
         if self.sparse:
