@@ -251,6 +251,9 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
             head = raw.read(64)
     except OSError as exc:
         raise ProblemFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    if not head:
+        raise ProblemFileError(f"{path}: empty; neither an FCLib (HDF5) nor a Siconos text "
+                               "problem file")
     if looks_like_siconos_text(head):
         try:
             return read_siconos_text(path)
