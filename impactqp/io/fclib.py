@@ -8,7 +8,9 @@ FCLib (Acary, Brémond, Huber et al.) stores one problem per file, in one of two
 - ``/fclib_global``: M v = H r + f, u = Hᵀ v + w (``M``, ``H``, ``vectors/f``, ``vectors/w``,
   ``vectors/mu``, ``spacedim``), reduced to the local problem by eliminating v:
   W = Hᵀ M⁻¹ H, q = Hᵀ M⁻¹ f + w. This is the Delassus matrix and free contact velocity of
-  docs/theory.md §1 with H in the role of the force directions and M⁻¹f in that of u⁻.
+  docs/theory.md §1 with H in the role of the force directions and M⁻¹f in that of u⁻
+  (:mod:`.fclib_reduce`: sparse for a block-diagonal M, by dense blocks under a work limit
+  otherwise).
 
 Per contact the d = ``spacedim`` (2 or 3) entries are the normal first, then the tangents;
 μ has one entry per contact. A matrix is a group ``nzmax, m, n, nz, p, i, x`` in the
@@ -40,25 +42,17 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..base.outputs import atomic_output
 from ..errors import InputError, ProblemFileError
 from ..model.friction import FrictionContactProblem
 from .delassus import negative_diagonal
+from .fclib_reduce import reduce_global
 from .hdf5_reader import CheckedReader, h5py_module
 from .siconos_text import looks_like_siconos_text, read_siconos_text
 
 MAX_FCLIB_DIM = 1_000_000
 """Largest row or column count of a matrix in an FCLib file (degrees of freedom, d·contacts)."""
-
-REDUCTION_BLOCK = 256
-"""Columns of H solved at a time in the global-to-local reduction (bounds the dense work
-array to n × 256 floats)."""
-
-REDUCTION_RTOL = 1e-8
-"""Largest componentwise backward error |M Y − H| ≤ rtol·(|M||Y| + |H|) accepted for
-Y = M⁻¹H; above it M is taken as singular (the reduced W would not be Hᵀ M⁻¹ H)."""
 
 MIXED_PARTS = {"fclib_local": ("V", "R", "vectors/s"), "fclib_global": ("G", "vectors/b")}
 
@@ -125,54 +119,6 @@ def _local(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]
     return W, q, reader.mu(root, contacts), d
 
 
-def _mass_factor(reader: _Reader, M: sp.csc_matrix):
-    """The sparse LU of a global problem's M, once M is known to be a mass matrix: its
-    symmetric part positive definite (½vᵀMv > 0 for v ≠ 0), decided by an LU with diagonal
-    pivots in a symmetric order (an LDLᵀ: every pivot positive exactly when it is; it is
-    M's own LU when M is symmetric, as it nearly always is)."""
-    symmetric = (M != M.T).nnz == 0
-    try:
-        lu = spla.splu(M if symmetric else sp.csc_matrix((M + M.T) * 0.5),
-                       permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                       options={"SymmetricMode": True})
-        pivots = lu.U.diagonal()
-        definite = np.array_equal(lu.perm_r, lu.perm_c) and np.all(pivots > 0)
-        own = lu if symmetric and definite else spla.splu(M)  # RuntimeError: M is singular
-    except RuntimeError:
-        raise reader.error("fclib_global/M", "is singular; the global problem cannot be "
-                                             "reduced to W = Hᵀ M⁻¹ H") from None
-    if not definite:
-        raise reader.error("fclib_global/M", "is not positive definite (a pivot of its LDLᵀ is "
-                                             f"{pivots.min():.3g}): a mass matrix gives every "
-                                             "velocity a positive kinetic energy ½vᵀMv")
-    return own
-
-
-def _reduce(reader: _Reader, M: sp.csc_matrix, H: sp.csc_matrix,
-            f: np.ndarray) -> tuple[sp.csc_matrix, np.ndarray]:
-    """Hᵀ M⁻¹ H and Hᵀ M⁻¹ f, with M⁻¹ applied by one sparse LU and checked column block by
-    column block (docs/theory.md §1: the Delassus matrix and the free contact velocity)."""
-    name = "fclib_global/M"
-    lu = _mass_factor(reader, M)
-    magnitude = abs(M)
-    blocks = []
-    rhs = sp.hstack([H, sp.csc_matrix(f.reshape(-1, 1))], format="csc")
-    for start in range(0, rhs.shape[1], REDUCTION_BLOCK):
-        B = rhs[:, start:start + REDUCTION_BLOCK].toarray()
-        with np.errstate(over="ignore", invalid="ignore"):
-            Y = lu.solve(B)
-            # componentwise (Oettli–Prager) backward error of the solve
-            excess = np.abs(M @ Y - B) - REDUCTION_RTOL * (magnitude @ np.abs(Y) + np.abs(B))
-            if not (np.all(np.isfinite(Y)) and np.all(excess <= 0)):
-                raise reader.error(name, "is singular or too ill-conditioned to reduce the "
-                                         "global problem (M⁻¹H does not solve M Y = H)")
-            blocks.append(sp.csc_matrix(H.T @ Y))
-    reduced = sp.hstack(blocks, format="csc")
-    if not np.all(np.isfinite(reduced.data)):
-        raise reader.error(name, "Hᵀ M⁻¹ H or Hᵀ M⁻¹ f overflows the floats; rescale the problem")
-    return sp.csc_matrix(reduced[:, :-1]), reduced[:, -1].toarray().ravel()
-
-
 def _global(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]:
     root = "fclib_global"
     d = reader.spacedim(root)
@@ -187,7 +133,7 @@ def _global(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int
     f = reader.floats(f"{root}/vectors/f", M.shape[0])
     w = reader.floats(f"{root}/vectors/w", H.shape[1])
     mu = reader.mu(root, contacts)
-    W, Hf = _reduce(reader, M, H, f)
+    W, Hf = reduce_global(M, H, f, lambda what: reader.error(f"{root}/M", what))
     return W, Hf + w, mu, d
 
 
