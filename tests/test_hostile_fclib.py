@@ -154,3 +154,15 @@ def test_a_reduction_beyond_the_work_limit_is_refused_before_it_starts(tmp_path,
     with pytest.raises(ProblemFileError, match=r"chain\.hdf5.*fclib_global/M.*work"):
         iq.load_fclib(path)
     assert time.process_time() - start < 1.0
+
+
+def test_a_reduced_w_too_large_to_store_is_refused_before_it_is_formed(tmp_path):
+    """One unknown met by 10⁴ contacts: W = Hᵀ M⁻¹ H would be dense, 9·10⁸ entries (7 GB)."""
+    m = 10_000
+    H = sp.csc_matrix(np.ones((1, 3 * m)))
+    path = _global_file(tmp_path / "star.hdf5", sp.identity(1), H, [0.0], np.ones(3 * m),
+                        np.full(m, 0.3))
+    start = time.process_time()
+    with pytest.raises(ProblemFileError, match=r"star\.hdf5.*fclib_global/M.*entries"):
+        iq.load_fclib(path)
+    assert time.process_time() - start < 2.0

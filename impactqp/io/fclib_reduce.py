@@ -8,8 +8,9 @@ is formed sparse from :data:`BLOCK_LIMIT` solves at most (each column of a probe
 unknown of every block), so W costs what its sparse products cost. Otherwise (a deformable
 body couples everything) M⁻¹H is solved in dense blocks of columns, n·(columns of H + 1)
 entries, which is refused above :data:`REDUCTION_WORK` before it starts: a file of a few
-hundred kilobytes can declare a reduction of hours. Either way M⁻¹ is checked by the
-componentwise (Oettli–Prager) backward error of M Y = B.
+hundred kilobytes can declare a reduction of hours; so is a W of more than
+:data:`REDUCED_ENTRIES` entries, bounded before it is formed. Either way M⁻¹ is checked by
+the componentwise (Oettli–Prager) backward error of M Y = B.
 """
 
 from __future__ import annotations
@@ -37,6 +38,10 @@ BLOCK_LIMIT = 64
 REDUCTION_WORK = 2e9
 """Most entries n·(columns + 1) of M⁻¹[H f] the dense reduction computes (about 100 ns
 each on a loaded 2-core machine: a few minutes)."""
+
+REDUCED_ENTRIES = 1e8
+"""Most entries of W = Hᵀ M⁻¹ H (bounded before it is formed: 1.2 GB stored sparse); a few
+hundred kilobytes of H whose columns all meet one unknown declare a dense W of (3m)²."""
 
 Error = Callable[[str], ProblemFileError]
 """Makes the reader's error about M from what is wrong."""
@@ -125,6 +130,14 @@ def reduce_global(M: sp.csc_matrix, H: sp.csc_matrix, f: np.ndarray,
           "solve M Y = H)"
     if inverse is not None:
         Y = sp.csc_matrix(inverse @ rhs)
+        # W's entries are at most Σₖ (entries of row k of Y)·(entries of row k of H)
+        bound = float(np.dot(np.diff(sp.csr_matrix(Y).indptr), np.diff(sp.csr_matrix(H).indptr)))
+    else:
+        bound = float(rhs.shape[1]) ** 2
+    if bound > REDUCED_ENTRIES:
+        raise error(f"reduces to a W = Hᵀ M⁻¹ H of up to {bound:.3g} entries (the columns of H "
+                    f"share unknowns), over the limit {REDUCED_ENTRIES:.3g}")
+    if inverse is not None:
         if not _solves(M, rhs, Y):
             raise error(ill)
         reduced = sp.csc_matrix(H.T @ Y)
