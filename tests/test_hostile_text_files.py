@@ -61,3 +61,13 @@ def test_save_problem_refuses_coefficients_of_the_wrong_kind(coefficients, tmp_p
     with pytest.raises(InputError, match="coefficient 'e'"):
         iq.save_problem(p, tmp_path / "p.toml", law="newton", coefficients=coefficients)
     assert not (tmp_path / "p.toml").exists()
+
+
+@pytest.mark.parametrize("token", ["1_0", "0.3_0", "-1_0"])
+def test_an_underscore_in_a_siconos_number_is_refused(token, tmp_path):
+    """Python reads '1_0' as 10 (digit grouping); Siconos' C reader stops at the '_'. A file
+    where one appears is damaged, not a W entry of ten."""
+    path = tmp_path / "grouped.dat"
+    path.write_text(f"3\n1\n0\n3\n3\n3 3\n{token} 0 0\n0 1 0\n0 0 1\n-1 0 0\n0.3\n")
+    with pytest.raises(ProblemFileError, match=rf"grouped\.dat.*number 8 of the file.*{token}"):
+        iq.load_fclib(path)
