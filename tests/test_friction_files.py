@@ -297,8 +297,8 @@ def test_fclib_text_figures_parse_back(capsys):
 
 
 def test_fclib_failures_exit_2(capsys, tmp_path):
-    bad = tmp_path / "no_solution.hdf5"  # u_n = −r_n − 1 ≥ 0 with r_n ≥ 0: none
-    iq.save_fclib(iq.FrictionContactProblem(np.array([[-1.0, 0.0], [0.0, 1.0]]), [-1.0, 0.0],
+    bad = tmp_path / "no_solution.hdf5"  # u_n = −1 whatever r: none
+    iq.save_fclib(iq.FrictionContactProblem(np.array([[0.0, 0.0], [0.0, 1.0]]), [-1.0, 0.0],
                                             [0.5], contact_dim=2), bad)
     for argv, message in [([bad], "no method certified"),
                           ([tmp_path / "missing.hdf5"], "cannot read"),

@@ -8,7 +8,9 @@ FCLib (Acary, Brémond, Huber et al.) stores one problem per file, in one of two
 - ``/fclib_global``: M v = H r + f, u = Hᵀ v + w (``M``, ``H``, ``vectors/f``, ``vectors/w``,
   ``vectors/mu``, ``spacedim``), reduced to the local problem by eliminating v:
   W = Hᵀ M⁻¹ H, q = Hᵀ M⁻¹ f + w. This is the Delassus matrix and free contact velocity of
-  docs/theory.md §1 with H in the role of the force directions and M⁻¹f in that of u⁻.
+  docs/theory.md §1 with H in the role of the force directions and M⁻¹f in that of u⁻
+  (:mod:`.fclib_reduce`: sparse for a block-diagonal M, by dense blocks under a work limit
+  otherwise).
 
 Per contact the d = ``spacedim`` (2 or 3) entries are the normal first, then the tangents;
 μ has one entry per contact. A matrix is a group ``nzmax, m, n, nz, p, i, x`` in the
@@ -19,15 +21,17 @@ duplicates add up, as in CSparse). Mixed problems (``V``, ``R``, ``s`` or ``G``,
 equality multipliers) are refused, as are rolling-friction files.
 
 Reading is strict: a path that is not a regular file, a file that is not HDF5, missing or
-mis-typed datasets, sizes that do not fit together, indices out of range, non-finite numbers,
-negative μ and a singular M are refused with a :class:`~impactqp.errors.ProblemFileError`
-that names the file and the dataset. A file is read alone: external links (which open other
-files, a FIFO among them, where reading would wait forever), soft links, external raw storage
-(a dataset whose bytes live in another file, /dev/zero reads as zeros) and virtual datasets
-are refused by name, before anything they point at is opened (:mod:`.hdf5_reader`).
-Dimensions above :data:`MAX_FCLIB_DIM` and datasets declaring more than
-:data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES` are refused before anything is allocated
-or decompressed, and only the entries the problem needs are read.
+mis-typed datasets, sizes that do not fit together, indices out of range, non-finite
+numbers, negative μ, a W with a negative diagonal entry (no Delassus matrix has one) and an
+M that is singular or not positive definite (no mass matrix is) are refused with a
+:class:`~impactqp.errors.ProblemFileError` that names the file and the dataset. A file is
+read alone: external links (which open other files, a FIFO among them, where reading would
+wait forever), soft links, external raw storage (a dataset whose bytes live in another file,
+/dev/zero reads as zeros) and virtual datasets are refused by name, before anything they
+point at is opened (:mod:`.hdf5_reader`). Dimensions above :data:`MAX_FCLIB_DIM` and
+datasets declaring more than :data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES` are refused
+before anything is allocated or decompressed, and only the entries the problem needs are
+read.
 """
 
 from __future__ import annotations
@@ -38,24 +42,17 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..base.outputs import atomic_output
 from ..errors import InputError, ProblemFileError
 from ..model.friction import FrictionContactProblem
+from .delassus import negative_diagonal
+from .fclib_reduce import reduce_global
 from .hdf5_reader import CheckedReader, h5py_module
 from .siconos_text import looks_like_siconos_text, read_siconos_text
 
 MAX_FCLIB_DIM = 1_000_000
 """Largest row or column count of a matrix in an FCLib file (degrees of freedom, d·contacts)."""
-
-REDUCTION_BLOCK = 256
-"""Columns of H solved at a time in the global-to-local reduction (bounds the dense work
-array to n × 256 floats)."""
-
-REDUCTION_RTOL = 1e-8
-"""Largest componentwise backward error |M Y − H| ≤ rtol·(|M||Y| + |H|) accepted for
-Y = M⁻¹H; above it M is taken as singular (the reduced W would not be Hᵀ M⁻¹ H)."""
 
 MIXED_PARTS = {"fclib_local": ("V", "R", "vectors/s"), "fclib_global": ("G", "vectors/b")}
 
@@ -115,37 +112,11 @@ def _local(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]
     if W.shape[0] != W.shape[1]:
         raise reader.error(f"{root}/W", f"must be square, got {W.shape}")
     contacts = _contacts(reader, f"{root}/W", W.shape[0], d)
+    negative = negative_diagonal(W, d)
+    if negative is not None:
+        raise reader.error(f"{root}/W", negative)
     q = reader.floats(f"{root}/vectors/q", W.shape[0])
     return W, q, reader.mu(root, contacts), d
-
-
-def _reduce(reader: _Reader, M: sp.csc_matrix, H: sp.csc_matrix,
-            f: np.ndarray) -> tuple[sp.csc_matrix, np.ndarray]:
-    """Hᵀ M⁻¹ H and Hᵀ M⁻¹ f, with M⁻¹ applied by one sparse LU and checked column block by
-    column block (docs/theory.md §1: the Delassus matrix and the free contact velocity)."""
-    name = "fclib_global/M"
-    try:
-        lu = spla.splu(M)
-    except RuntimeError as exc:
-        raise reader.error(name, f"is singular ({exc}); the global problem cannot be reduced "
-                                 "to W = Hᵀ M⁻¹ H") from None
-    magnitude = abs(M)
-    blocks = []
-    rhs = sp.hstack([H, sp.csc_matrix(f.reshape(-1, 1))], format="csc")
-    for start in range(0, rhs.shape[1], REDUCTION_BLOCK):
-        B = rhs[:, start:start + REDUCTION_BLOCK].toarray()
-        with np.errstate(over="ignore", invalid="ignore"):
-            Y = lu.solve(B)
-            # componentwise (Oettli–Prager) backward error of the solve
-            excess = np.abs(M @ Y - B) - REDUCTION_RTOL * (magnitude @ np.abs(Y) + np.abs(B))
-            if not (np.all(np.isfinite(Y)) and np.all(excess <= 0)):
-                raise reader.error(name, "is singular or too ill-conditioned to reduce the "
-                                         "global problem (M⁻¹H does not solve M Y = H)")
-            blocks.append(sp.csc_matrix(H.T @ Y))
-    reduced = sp.hstack(blocks, format="csc")
-    if not np.all(np.isfinite(reduced.data)):
-        raise reader.error(name, "Hᵀ M⁻¹ H or Hᵀ M⁻¹ f overflows the floats; rescale the problem")
-    return sp.csc_matrix(reduced[:, :-1]), reduced[:, -1].toarray().ravel()
 
 
 def _global(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int]:
@@ -162,7 +133,7 @@ def _global(reader: _Reader) -> tuple[sp.csc_matrix, np.ndarray, np.ndarray, int
     f = reader.floats(f"{root}/vectors/f", M.shape[0])
     w = reader.floats(f"{root}/vectors/w", H.shape[1])
     mu = reader.mu(root, contacts)
-    W, Hf = _reduce(reader, M, H, f)
+    W, Hf = reduce_global(M, H, f, lambda what: reader.error(f"{root}/M", what))
     return W, Hf + w, mu, d
 
 
@@ -205,11 +176,12 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
     ------
     ProblemFileError
         Not a regular file, not HDF5, neither problem group, a mixed problem (``V``/``R`` or
-        ``G``/``b``), a missing or malformed dataset, non-finite numbers, negative μ or a
-        singular M; a link that is not a hard one (an external link reaches into another
-        file), a dataset stored outside the file (external raw storage, a virtual dataset),
-        one declaring more than :data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES`, or a
-        problem that does not fit in memory. The message names the file and the dataset.
+        ``G``/``b``), a missing or malformed dataset, non-finite numbers, negative μ, a negative
+        diagonal entry of W, or an M that is singular or not positive definite; a link that is not
+        a hard one (an external link reaches into another file), a dataset stored outside the file
+        (external raw storage, a virtual dataset), one declaring more than
+        :data:`~impactqp.io.hdf5_reader.MAX_DATASET_BYTES`, or a problem that does not fit in
+        memory. The message names the file and the dataset.
         For a Siconos text file: the errors of
         :func:`~impactqp.io.siconos_text.read_siconos_text` (truncated, non-numeric or
         non-finite numbers, counts that do not fit, negative μ, a damaged gzip stream), each
@@ -225,6 +197,9 @@ def load_fclib(path: str | Path) -> FrictionContactProblem:
             head = raw.read(64)
     except OSError as exc:
         raise ProblemFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    if not head:
+        raise ProblemFileError(f"{path}: empty; neither an FCLib (HDF5) nor a Siconos text "
+                               "problem file")
     if looks_like_siconos_text(head):
         try:
             return read_siconos_text(path)

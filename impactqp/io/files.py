@@ -294,7 +294,7 @@ def _read_capped(path: Path) -> str:
         raise ProblemFileError(f"{path}: more than the {MAX_FILE_BYTES // 2**20} MB limit of "
                                "problem files")
     try:
-        return data.decode("utf-8")
+        return data.decode("utf-8-sig")  # a leading byte-order mark (Windows editors) dropped
     except UnicodeDecodeError as exc:
         raise ProblemFileError(f"{path}: not UTF-8 text ({exc.reason} at byte "
                                f"{exc.start})") from None

@@ -38,8 +38,17 @@ def _coefficient_entries(law: str | None, coefficients: Any) -> dict[str, Any]:
     else:
         raise InputError(f"law {law!r} takes its coefficients as a pair "
                          f"({', '.join(keys)}), got {coefficients!r}")
-    return {key: np.asarray(value, dtype=float).tolist()
+    return {key: _numbers(key, value)
             for key, value in zip(keys, values, strict=True) if value is not None}
+
+
+def _numbers(key: str, value: Any) -> Any:
+    """A coefficient as a number or (nested) lists of numbers, or InputError naming it."""
+    try:
+        return np.asarray(value, dtype=float).tolist()
+    except (TypeError, ValueError):
+        raise InputError(f"coefficient {key!r} must be a number or an array of numbers, got "
+                         f"{value!r}") from None
 
 
 def problem_to_dict(problem: ImpactProblem, *, law: str | None = None, coefficients: Any = None,

@@ -49,6 +49,7 @@ from ..base.outputs import atomic_output
 from ..errors import InputError, ProblemFileError
 from ..model.friction import FrictionContactProblem
 from .csparse_text import read_compressed_sparse
+from .delassus import negative_diagonal
 from .text_numbers import TextNumbers, is_float
 
 MAX_TEXT_BYTES = 2**27
@@ -198,8 +199,9 @@ def read_siconos_text(path: str | Path) -> FrictionContactProblem:
         indices, block numbers, a compressed-sparse header, location or index out of place,
         numbers left over after μ beyond Siconos' old 0/1 flag), a storage other than dense,
         sparse-block or compressed sparse, a half-triplet W, non-finite numbers, negative μ,
-        or more than :data:`MAX_TEXT_BYTES` of text. The message names the file, the field
-        and the position of the number.
+        a negative diagonal entry of W (no Delassus matrix has one), or more than
+        :data:`MAX_TEXT_BYTES` of text. The message names the file, the field and the
+        position of the number.
     """
     path = Path(path)
     numbers = TextNumbers(path, _text(path))
@@ -218,6 +220,9 @@ def read_siconos_text(path: str | Path) -> FrictionContactProblem:
         raise numbers.error("μ", f"friction coefficients must be ≥ 0, found {mu.min()}",
                             at + int(np.argmin(mu)))
     numbers.finish()
+    negative = negative_diagonal(W, d)
+    if negative is not None:
+        raise ProblemFileError(f"{path}: W: {negative}")
     try:
         return FrictionContactProblem(W, q, mu, contact_dim=d)
     except InputError as exc:

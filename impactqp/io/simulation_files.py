@@ -141,7 +141,7 @@ def _parse(path: Path) -> Any:
     try:
         if not path.is_file() or path.stat().st_size > MAX_FILE_BYTES:
             raise ProblemFileError(f"{path}: not a regular file of at most 10 MB")
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a leading byte-order mark dropped
         if path.suffix.lower() == ".toml":
             try:
                 import tomllib

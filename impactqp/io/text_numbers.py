@@ -21,6 +21,10 @@ class TextNumbers:
         self.path = path
         self.tokens = text.split()
         self.pos = 0
+        if "_" in text:  # Python's int() and float() take '1_0' as 10; C's readers do not
+            bad = next(k for k, t in enumerate(self.tokens) if "_" in t)
+            raise self.error("a number", f"{self.tokens[bad]!r} is not a number ('_' is not "
+                                         "a digit)", bad)
 
     def error(self, field: str, what: str, at: int | None = None) -> ProblemFileError:
         where = self.pos if at is None else at

@@ -17,6 +17,7 @@ from ..base.arrays import Matrix
 from ..errors import MassMatrixError, NonFiniteError, ShapeError
 from ..kernels.chain import pack_chain
 from .structure import ChainInfo, ImpactStructure
+from .validation import check_chain_masses
 
 
 def chain_directions(n_balls: int, *, left_wall: bool = False, right_wall: bool = False,
@@ -71,15 +72,18 @@ class ChainStructure(ImpactStructure):
         masses = chain.masses
         if masses.ndim != 1 or masses.size == 0:
             raise ShapeError(f"masses must be a non-empty 1-D array, got shape {masses.shape}")
-        if not np.isfinite(masses.sum()):  # NaN and ±inf make the sum non-finite
+        lo, hi = masses.min(), masses.max()
+        if not (np.isfinite(lo) and np.isfinite(hi)):  # NaN propagates; ±inf is an extreme
             raise NonFiniteError("masses must be finite")
-        if not masses.min() > 0:
+        if not lo > 0:
             raise MassMatrixError(f"masses must be positive; got "
                                   f"{masses[masses <= 0][:5].tolist()}")
         self.sparse = bool(sparse)
         self.chain = chain
         self.n = masses.size
         self.m = masses.size - 1 + chain.left_wall + chain.right_wall
+        if self.m:
+            check_chain_masses(lo, hi)
         self.diagonal_mass = True
         self._diag = self.mass_diagonal = masses
 

@@ -17,11 +17,12 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
-from ..base.arrays import Matrix, as_count, as_dense, as_matrix
+from ..base.arrays import Matrix, as_dense, as_matrix
 from ..base.rowwise import row_max, row_sum
-from ..errors import InputError, MassMatrixError, ShapeError
+from ..errors import MassMatrixError, ShapeError
 from ..kernels.impact import pack_operators
 from ..kernels.units import contact_units
+from .validation import check_contact_dim, check_delassus_diagonal, check_mass, check_pivots
 
 
 @dataclass(frozen=True)
@@ -39,17 +40,6 @@ class ChainInfo:
     masses: np.ndarray
     left_wall: bool = False
     right_wall: bool = False
-
-
-def _check_contact_dim(value: object, chain: ChainInfo | None) -> int:
-    """``contact_dim`` as an int in {1, 2, 3}, or InputError (also for a frictional chain)."""
-    d = as_count("contact_dim", value)
-    if d not in (1, 2, 3):
-        raise InputError(f"contact_dim must be 1 (frictionless), 2 (planar friction) or 3 "
-                         f"(spatial friction), got {d}")
-    if chain is not None and d != 1:
-        raise InputError("a chain's contacts are frictionless: contact_dim must be 1")
-    return d
 
 
 class ImpactStructure:
@@ -86,7 +76,7 @@ class ImpactStructure:
 
     def __init__(self, M: Matrix, W: Matrix, *, chain: ChainInfo | None = None,
                  contact_dim: int = 1) -> None:
-        contact_dim = _check_contact_dim(contact_dim, chain)
+        contact_dim = check_contact_dim(contact_dim, chain)
         M, W = as_matrix("M", M), as_matrix("W", W)
         self.sparse = sp.issparse(M) or sp.issparse(W)
         if self.sparse:
@@ -106,13 +96,17 @@ class ImpactStructure:
         self.n, self.m = n, W.shape[1]
         self.chain = chain
         self.contact_dim = contact_dim
-        self._check_symmetric()
+        check_mass(M, self.sparse)
         self._factorize()
         col_norms = np.sqrt(np.asarray(abs(W).power(2).sum(axis=0)).ravel()) if self.sparse \
             else np.linalg.norm(W, axis=0)
         if np.any(col_norms == 0):
             raise ShapeError(f"W column(s) {np.flatnonzero(col_norms == 0).tolist()} are zero: "
                              "every contact needs a non-zero force direction")
+        if self.sparse and not self.diagonal_mass:
+            check_pivots(self._lu.U.diagonal())
+        else:
+            check_delassus_diagonal(lambda: self.delassus_diagonal)
 
     @property
     def n_contacts(self) -> int:
@@ -128,14 +122,6 @@ class ImpactStructure:
             return self
         W = self.W[:, ::d] if not self.sparse else sp.csc_matrix(self.W)[:, ::d]
         return ImpactStructure(self.M, W)
-
-    def _check_symmetric(self) -> None:
-        M = self.M
-        scale = abs(M).max() if self.sparse else np.abs(M).max()
-        asym = abs(M - M.T).max() if self.sparse else np.abs(M - M.T).max()
-        if asym > 1e-12 * max(scale, 1e-300):
-            raise MassMatrixError(f"M must be symmetric; max |M - Mᵀ| = {asym:.3g} "
-                                  f"(largest entry {scale:.3g})")
 
     def _factorize(self) -> None:
         if self.sparse:
