@@ -1,6 +1,7 @@
 """Every backend agrees with the exact active-set enumeration; laws agree across forms."""
 
 import numpy as np
+import scipy.sparse as sp
 import pytest
 
 import impactqp as iq
@@ -98,6 +99,22 @@ def test_unsolvable_lcp_raises_no_solution():
     assert iq.fremond(p, E).certificate.ok
     with pytest.raises(iq.NoSolutionError):
         iq.solve_lcp(np.zeros((1, 1)), [-1.0])
+
+
+def test_positive_definite_lcp_is_never_called_unsolvable():
+    """A middle ball 10¹² times lighter than its neighbours: G is positive definite, so the
+    Newton LCP has a solution, which round-off keeps from certifying at 1e-10; the error
+    says so (CertificateError), never that the law has no solution."""
+    from impactqp.qp.kinds import positive_definite
+
+    p = iq.chain([1.0, 1e-12, 1.0], [1.0, 0.0, 0.0])
+    G = p.delassus
+    assert positive_definite(G.toarray() if sp.issparse(G) else np.asarray(G))
+    with pytest.raises(iq.CertificateError, match="no backend met the certificate"):
+        iq.solve(p, iq.Newton(0.5))
+    A = np.random.default_rng(1).standard_normal((5, 3))
+    assert not positive_definite(A @ A.T)  # rank 3 of 5: decided by linprog, not here
+    assert positive_definite(sp.csr_matrix(A.T @ A + np.eye(3)))
 
 
 def test_cvxpy_compiles_once_per_structure():

@@ -14,6 +14,8 @@ from types import ModuleType
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from scipy.optimize import linprog
 
 from ..errors import CertificateError, NoSolutionError
@@ -60,9 +62,32 @@ class QPKind:
 
 
 def lcp_feasible(qp: QuadraticProgram) -> bool:
-    """For the impulse form: is there x ≥ 0 with Px + c ≥ 0? (For PSD P: solvable iff so.)"""
+    """For the impulse form: is there x ≥ 0 with Px + c ≥ 0? (For PSD P: solvable iff so;
+    a positive definite P always is, decided by its Cholesky factor before any tolerance of
+    a linear-programming solver can say otherwise: docs/theory.md §3.)"""
+    if positive_definite(qp.P):
+        return True
     res = linprog(np.zeros(qp.n_vars), A_ub=-qp.P, b_ub=qp.c, bounds=(0, None), method="highs")
     return bool(res.status == 0)
+
+
+def positive_definite(P: Any) -> bool:
+    """Whether the symmetric matrix P (dense or sparse) is positive definite: its Cholesky
+    factor (dense), or the pivots of its LU in a symmetric order with diagonal pivots, which
+    are LDLᵀ's D (sparse), all positive."""
+    if not sp.issparse(P):
+        try:
+            np.linalg.cholesky(np.asarray(P))
+        except np.linalg.LinAlgError:
+            return False
+        return True
+    try:
+        lu = spla.splu(sp.csc_matrix(P), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:  # exactly singular
+        return False
+    pivots = lu.U.diagonal()
+    return bool(np.all(lu.perm_r == lu.perm_c) and np.all(pivots > 0))
 
 
 class ConeKind:
