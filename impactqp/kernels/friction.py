@@ -81,8 +81,7 @@ def modified_velocity(u, mu, d):
 
 
 def kernel_mu(mu: np.ndarray) -> np.ndarray:
-    """A writable copy of a problem's or law's read-only μ, as the kernels of a time step
-    pass it (``friction.mu[cons]``): one compiled version of each kernel on μ serves both."""
+    """A writable copy of a read-only μ, as a time step's kernels pass it: one signature."""
     return np.array(mu, dtype=float)
 
 
@@ -102,8 +101,7 @@ def natural_map_into(r, u, mu, d, F):
 
 @kernel(interpretable=True)
 def natural_map(r, u, mu, d):
-    """F = r − P_{K_μ}(r − ũ) contact by contact, ũ = u + μ‖u_T‖e_n
-    (:func:`natural_map_into`)."""
+    """F = r − P_{K_μ}(r − ũ), ũ = u + μ‖u_T‖e_n, by :func:`natural_map_into`."""
     F = np.empty_like(u)
     natural_map_into(r, u, mu, d, F)
     return F
@@ -191,7 +189,7 @@ def alart_curnier(r, u, mu, rho, d, jac, A, B):
 
 @kernel
 def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
-    """:func:`nsgs_rows` for a dense W, on its nonzero entries
+    """:func:`nsgs_rows` on a dense W's nonzero entries
     (:func:`~impactqp.kernels.friction_blocks.nonzero_rows`)."""
     indptr, indices, data = nonzero_rows(W)
     return nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters)
@@ -199,9 +197,8 @@ def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
 
 @kernel
 def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
-    """:func:`nsgs_blocks` on W's compressed rows (scipy's CSR ``indptr``, ``indices``,
-    ``data``), W by contacts with its diagonal blocks and their steps gathered at each call
-    (:func:`~impactqp.kernels.friction_rows.contact_rows`). Returns (sweeps, ‖F‖/‖q‖)."""
+    """:func:`nsgs_contacts` on W's compressed rows (scipy's CSR arrays), W gathered by
+    contacts at each call (:func:`~impactqp.kernels.friction_rows.contact_rows`)."""
     rows = contact_rows(indptr, indices, data, mu.size, d)
     return nsgs_contacts(rows, local_steps(rows.diagonal), q, mu, d, r, tol, max_sweeps,
                          local_iters)
@@ -209,13 +206,49 @@ def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
 
 @kernel
 def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
-    """:func:`nsgs_contacts` on W's compressed ``rows`` (indptr, indices, data: scipy's CSR
-    arrays) and ``blocks`` = (W_cc, ρ_c), its diagonal blocks
-    (:func:`~impactqp.kernels.friction_blocks.diagonal_blocks`) and their steps
-    (:func:`~impactqp.kernels.friction_blocks.local_steps`), which a caller solving the same
-    W again keeps: W by contacts is gathered at each call."""
-    return nsgs_contacts(contact_rows(rows[0], rows[1], rows[2], mu.size, d), blocks[1], q,
-                         mu, d, r, tol, max_sweeps, local_iters)
+    """:func:`nsgs_contacts` by :func:`sweep_once` on W's compressed ``rows`` (scipy's CSR
+    arrays) and ``blocks`` = (W_cc, ρ_c) (:func:`~impactqp.kernels.friction_blocks.local_steps`),
+    which a caller solving W again keeps: a few sweeps of a few contacts, where gathering W
+    by contacts at each call costs more than it saves (LMGC-00046: 2 µs a call)."""
+    indptr, indices, data = rows
+    n = r.size
+    u, F, scratch = np.empty(n), np.empty(n), np.empty(3 * d)
+    err, last_err, last_at, check_at = np.inf, np.inf, 0, 1
+    for sweep in range(max_sweeps):
+        sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch)
+        done = sweep + 1
+        if done < check_at and done < max_sweeps:
+            continue
+        for i in range(n):
+            v = q[i]
+            for p in range(indptr[i], indptr[i + 1]):
+                v += data[p] * r[indices[p]]
+            u[i] = v
+        err = relative_error(r, u, q, mu, d, F)
+        if err <= tol:
+            return done, err
+        last_err, last_at, check_at = err, done, next_check(done, err, tol, last_err, last_at)
+    return max_sweeps, err
+
+
+@inline_kernel
+def relative_error(r, u, q, mu, d, F):
+    """‖F‖/‖q‖ (‖F‖ for q = 0) at (r, u), F = r − P_{K_μ}(r − ũ) written into ``F``."""
+    natural_map_into(r, u, mu, d, F)
+    qn = np.sqrt(np.sum(q * q))
+    return np.sqrt(np.sum(F * F)) / (qn if qn > 0.0 else 1.0)
+
+
+@inline_kernel
+def next_check(done, err, tol, last_err, last_at):
+    """The sweep after which the sweeps evaluate ‖F‖ next, at ``err`` after ``done`` and at
+    ``last_err`` after ``last_at``: as many sweeps on as the decrease since then predicts
+    are left to reach tol, at most :data:`CHECK_GAP`, and one while it does not decrease."""
+    gap = 1
+    if tol > 0.0 and err < last_err < np.inf:  # the sweeps left at the rate since then
+        left = np.log(tol / err) / np.log(err / last_err) * (done - last_at)
+        gap = int(min(max(left, 1.0), CHECK_GAP))
+    return done + gap
 
 
 @kernel
@@ -223,24 +256,14 @@ def nsgs_contacts(rows, rhos, q, mu, d, r, tol, max_sweeps, local_iters):
     """Projected Gauss–Seidel over the contacts (docs/theory.md §15), updating ``r`` in place,
     on W by contacts ``rows`` (:class:`~impactqp.kernels.friction_rows.ContactRows`, so that
     a sweep costs W's blocks) with the steps ``rhos`` of the contacts' fixed points
-    (:func:`~impactqp.kernels.friction_blocks.local_steps`).
-
-    Each contact's local problem (the others held) is solved as in :func:`sweep_once`; the
-    sweeps stop when ‖F‖ ≤ tol·‖q‖. ‖F‖ (a product by W, as dear as a sweep) is evaluated
-    after the first sweep, then after as many sweeps as its decrease since the last
-    evaluation predicts are left to reach tol (at most :data:`CHECK_GAP`, and one while it
-    does not decrease) and after the last. Returns (sweeps done, ‖F‖/‖q‖ at the end).
-    """
-    n = r.size
-    qn = np.sqrt(np.sum(q * q))
-    if qn == 0.0:
-        qn = 1.0
-    u = np.empty(n)
-    F = np.empty(n)
+    (:func:`~impactqp.kernels.friction_blocks.local_steps`). Each contact's local problem
+    (the others held) is solved as in :func:`sweep_once`; the sweeps stop when
+    ‖F‖ ≤ tol·‖q‖. ‖F‖ (a product by W, as dear as a sweep) is evaluated after the first
+    sweep, then after the sweeps :func:`next_check` says, and after the last. Returns
+    (sweeps done, ‖F‖/‖q‖ at the end)."""
     start, other, block, Wcc = rows
-    work = np.empty(3 * d)
-    err = np.inf
-    last_err, last_at, check_at = np.inf, 0, 1
+    u, F, work = np.empty(r.size), np.empty(r.size), np.empty(3 * d)
+    err, last_err, last_at, check_at = np.inf, np.inf, 0, 1
     for sweep in range(max_sweeps):
         for c in range(mu.size):  # as sweep_once, b_c by blocks
             k = c * d
@@ -262,30 +285,22 @@ def nsgs_contacts(rows, rhos, q, mu, d, r, tol, max_sweeps, local_iters):
         if done < check_at and done < max_sweeps:
             continue
         velocity_into(rows, q, r, d, u)
-        natural_map_into(r, u, mu, d, F)
-        err = np.sqrt(np.sum(F * F)) / qn
+        err = relative_error(r, u, q, mu, d, F)
         if err <= tol:
             return done, err
-        gap = 1
-        if tol > 0.0 and err < last_err < np.inf:  # the sweeps left at the rate since then
-            left = np.log(tol / err) / np.log(err / last_err) * (done - last_at)
-            gap = int(min(max(left, 1.0), CHECK_GAP))
-        last_err, last_at, check_at = err, done, done + gap
+        last_err, last_at, check_at = err, done, next_check(done, err, tol, last_err, last_at)
     return max_sweeps, err
 
 
 @inline_kernel
 def sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch):
-    """One sweep of the projected Gauss–Seidel over the contacts on W's compressed ``rows``
-    and ``blocks`` (as :func:`nsgs_blocks` takes them), updating ``r`` in place, with
-    ``scratch`` of at least 3·d floats. Each contact's b_c is summed from its rows: its
-    normal row first, and where b_n ≥ 0 the contact is apart (r_c = 0) before its tangential
-    rows are summed (most contacts of a pile of spheres are: 41 of NESpheres-30's 44 in its
-    one sweep); a planar contact is solved by its cases in scalars
-    (:func:`~impactqp.kernels.friction_planar.planar_contact`), any other by
-    :func:`contact_steps`. The cases are tried in the loop itself, not in an inlined helper:
-    numba compiled them so about ten times slower (FC2D-00071: 7.5 against 0.75 µs a sweep).
-    """
+    """One sweep over the contacts on W's compressed ``rows`` and ``blocks`` (as
+    :func:`nsgs_blocks` takes them), updating ``r`` in place (``scratch``: ≥ 3·d floats).
+    A contact is apart (r_c = 0) where its normal row gives b_n ≥ 0, before its tangential
+    rows are summed (41 of NESpheres-30's 44 contacts in its one sweep); a planar contact is
+    solved by its cases in scalars (:func:`~impactqp.kernels.friction_planar.planar_contact`)
+    in the loop itself (in an inlined helper numba compiled them ten times slower), any other
+    by :func:`contact_steps`."""
     indptr, indices, data = rows
     Wcc, rhos = blocks
     for c in range(mu.size):
@@ -314,13 +329,11 @@ def sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch):
 
 @kernel(internal=True, refcounted=False)
 def contact_steps(Wcc, rhos, mu, c, d, r, local_iters, work):
-    """Contact c's local problem u_c = W_cc r_c + b_c, the others held, b_c in
-    ``work[2·d:3·d]``, solved into ``r[c·d:c·d + d]`` where the sweeps' cases in scalars have
-    not (a 3-D contact not apart, a planar one with no case holding in floats): exactly where
-    a closed form holds (:func:`~impactqp.kernels.friction_blocks.exact_contact`:
-    sticking), else by at most ``local_iters`` steps of the projected fixed point
-    r_c ← P_{K_μ}(r_c − ρ_c ũ_c), fewer once a step moves r_c by less than 10⁻⁶‖r_c‖ (r_c in
-    ``work[0:d]``, ũ_c and the step in place in ``work[d:2·d]``)."""
+    """Contact c's local problem u_c = W_cc r_c + b_c (b_c in ``work[2·d:3·d]``) into
+    ``r[c·d:c·d + d]``, where the sweeps' scalar cases have not solved it: sticking
+    (:func:`~impactqp.kernels.friction_blocks.exact_contact`), else at most ``local_iters``
+    steps of the fixed point r_c ← P_{K_μ}(r_c − ρ_c ũ_c), fewer once one moves r_c by less
+    than 10⁻⁶‖r_c‖ (r_c in ``work[0:d]``, ũ_c and the step in place in ``work[d:2·d]``)."""
     k = c * d
     for i in range(d):
         work[i] = r[k + i]
