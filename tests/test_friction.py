@@ -13,12 +13,11 @@ from impactqp.kernels.friction import (
     alart_curnier,
     local_steps,
     modified_velocity,
-    modified_velocity_jacobian,
     natural_map,
     nsgs_rows,
     project_cones,
-    projection_jacobian,
 )
+from impactqp.kernels.friction_jacobians import modified_velocity_jacobian, projection_jacobian
 from impactqp.kernels.friction_newton import lu_solve, scales, solve_small
 from impactqp.model.friction import certify_friction
 from impactqp.qp.friction import methods as friction_methods

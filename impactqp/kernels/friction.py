@@ -18,7 +18,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction_blocks import diagonal_blocks, exact_contact, local_steps, nonzero_rows
+from .friction_blocks import exact_contact, local_steps, nonzero_rows
+from .friction_planar import planar_contact
+from .friction_rows import contact_rows, off_diagonal, velocity_into
 from .jit import inline_kernel, kernel
 
 CHECK_GAP = 8
@@ -79,10 +81,7 @@ def modified_velocity(u, mu, d):
 
 
 def kernel_mu(mu: np.ndarray) -> np.ndarray:
-    """A writable copy of the (read-only) μ of a problem or law, for the kernels: they take μ
-    as the kernels of a time step index it (``friction.mu[cons]``, a writable array), so one
-    compiled version of each serves both (a read-only array is another argument type to
-    numba, which would compile every kernel on μ twice). Taken once per solve."""
+    """A writable copy of a read-only μ, as a time step's kernels pass it: one signature."""
     return np.array(mu, dtype=float)
 
 
@@ -102,8 +101,7 @@ def natural_map_into(r, u, mu, d, F):
 
 @kernel(interpretable=True)
 def natural_map(r, u, mu, d):
-    """F = r − P_{K_μ}(r − ũ) contact by contact, ũ = u + μ‖u_T‖e_n
-    (:func:`natural_map_into`)."""
+    """F = r − P_{K_μ}(r − ũ), ũ = u + μ‖u_T‖e_n, by :func:`natural_map_into`."""
     F = np.empty_like(u)
     natural_map_into(r, u, mu, d, F)
     return F
@@ -132,54 +130,6 @@ def certificate_sums(r, u, mu, d):
         f2 += F[i] * F[i]
         cone += (r[i] - pr[i]) * (r[i] - pr[i])
     return f2, comp, pen, cone
-
-
-@kernel
-def projection_jacobian(x, mu, d):
-    """An element of the (Clarke) Jacobian of P_{K_μ} at x, one d × d block per contact
-    (the derivative of the closed form; on a kink, the branch the closed form takes)."""
-    m = mu.size
-    J = np.zeros((m, d, d))
-    for c in range(m):
-        k = c * d
-        m_ = mu[c]
-        xn = x[k]
-        t = tangent_norm(x, k, d)
-        if t <= m_ * xn:
-            for j in range(d):
-                J[c, j, j] = 1.0
-        elif m_ * t <= -xn:
-            continue
-        else:
-            s = 1.0 / (1.0 + m_ * m_)
-            a = (xn + m_ * t) * s
-            J[c, 0, 0] = s
-            for j in range(1, d):
-                w = x[k + j] / t
-                J[c, 0, j] = s * m_ * w
-                J[c, j, 0] = s * m_ * w
-                for i in range(1, d):
-                    wi = x[k + i] / t
-                    J[c, j, i] = m_ * m_ * s * w * wi - m_ * a / t * w * wi
-                J[c, j, j] += m_ * a / t
-    return J
-
-
-@kernel
-def modified_velocity_jacobian(u, mu, d):
-    """The derivative of u ↦ ũ = u + μ‖u_T‖e_n, one d × d block per contact (the row of
-    e_n gains μ u_Tᵀ/‖u_T‖; nothing where u_T = 0)."""
-    m = mu.size
-    J = np.zeros((m, d, d))
-    for c in range(m):
-        k = c * d
-        for j in range(d):
-            J[c, j, j] = 1.0
-        t = tangent_norm(u, k, d)
-        if t > 0.0:
-            for j in range(1, d):
-                J[c, 0, j] = mu[c] * u[k + j] / t
-    return J
 
 
 @kernel
@@ -239,7 +189,7 @@ def alart_curnier(r, u, mu, rho, d, jac, A, B):
 
 @kernel
 def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
-    """:func:`nsgs_rows` for a dense W, on its nonzero entries
+    """:func:`nsgs_rows` on a dense W's nonzero entries
     (:func:`~impactqp.kernels.friction_blocks.nonzero_rows`)."""
     indptr, indices, data = nonzero_rows(W)
     return nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters)
@@ -247,43 +197,23 @@ def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
 
 @kernel
 def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
-    """:func:`nsgs_blocks` on W's compressed rows (scipy's CSR ``indptr``, ``indices``,
-    ``data``), its diagonal blocks and their steps gathered at each call
-    (:func:`~impactqp.kernels.friction_blocks.diagonal_blocks`). Returns (sweeps, ‖F‖/‖q‖)."""
-    Wcc = diagonal_blocks(indptr, indices, data, mu.size, d)
-    return nsgs_blocks((indptr, indices, data), (Wcc, local_steps(Wcc)), q, mu, d, r, tol,
-                       max_sweeps, local_iters)
+    """:func:`nsgs_contacts` on W's compressed rows (scipy's CSR arrays), W gathered by
+    contacts at each call (:func:`~impactqp.kernels.friction_rows.contact_rows`)."""
+    rows = contact_rows(indptr, indices, data, mu.size, d)
+    return nsgs_contacts(rows, local_steps(rows.diagonal), q, mu, d, r, tol, max_sweeps,
+                         local_iters)
 
 
 @kernel
 def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
-    """Projected Gauss–Seidel over the contacts (docs/theory.md §15), updating ``r`` in place;
-    W given by its compressed ``rows`` (indptr, indices, data: scipy's CSR arrays), so that a
-    sweep costs the entries of W, and ``blocks`` = (W_cc, ρ_c): its diagonal blocks
-    (:func:`~impactqp.kernels.friction_blocks.diagonal_blocks`) and their steps
-    (:func:`~impactqp.kernels.friction_blocks.local_steps`), which a caller solving the same
-    W again keeps.
-
-    Each contact's local problem (the others held) is solved exactly where a closed form
-    holds (:func:`~impactqp.kernels.friction_blocks.exact_contact`: apart, sticking, a planar
-    contact sliding), else by at most
-    ``local_iters`` steps of the projected fixed point r_c ← P_{K_μ}(r_c − ρ_c ũ_c), fewer
-    once a step moves r_c by less than 10⁻⁶‖r_c‖; the sweeps stop when ‖F‖ ≤ tol·‖q‖.
-    ‖F‖ (a product by W, as dear as a sweep) is evaluated after the first sweep, then after
-    as many sweeps as its decrease since the last evaluation predicts are left to reach tol
-    (at most :data:`CHECK_GAP`, and one while it does not decrease) and after the last.
-    Returns (sweeps done, ‖F‖/‖q‖ at the end).
-    """
+    """:func:`nsgs_contacts` by :func:`sweep_once` on W's compressed ``rows`` (scipy's CSR
+    arrays) and ``blocks`` = (W_cc, ρ_c) (:func:`~impactqp.kernels.friction_blocks.local_steps`),
+    which a caller solving W again keeps: a few sweeps of a few contacts, where gathering W
+    by contacts at each call costs more than it saves (LMGC-00046: 2 µs a call)."""
     indptr, indices, data = rows
     n = r.size
-    qn = np.sqrt(np.sum(q * q))
-    if qn == 0.0:
-        qn = 1.0
-    u = np.empty(n)
-    F = np.empty(n)
-    scratch = np.empty(5 * d)
-    err = np.inf
-    last_err, last_at, check_at = np.inf, 0, 1
+    u, F, scratch = np.empty(n), np.empty(n), np.empty(3 * d)
+    err, last_err, last_at, check_at = np.inf, np.inf, 0, 1
     for sweep in range(max_sweeps):
         sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch)
         done = sweep + 1
@@ -294,67 +224,137 @@ def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
             for p in range(indptr[i], indptr[i + 1]):
                 v += data[p] * r[indices[p]]
             u[i] = v
-        natural_map_into(r, u, mu, d, F)
-        err = np.sqrt(np.sum(F * F)) / qn
+        err = relative_error(r, u, q, mu, d, F)
         if err <= tol:
             return done, err
-        gap = 1
-        if tol > 0.0 and err < last_err < np.inf:  # the sweeps left at the rate since then
-            left = np.log(tol / err) / np.log(err / last_err) * (done - last_at)
-            gap = int(min(max(left, 1.0), CHECK_GAP))
-        last_err, last_at, check_at = err, done, done + gap
+        last_err, last_at, check_at = err, done, next_check(done, err, tol, last_err, last_at)
+    return max_sweeps, err
+
+
+@inline_kernel
+def relative_error(r, u, q, mu, d, F):
+    """‖F‖/‖q‖ (‖F‖ for q = 0) at (r, u), F = r − P_{K_μ}(r − ũ) written into ``F``."""
+    natural_map_into(r, u, mu, d, F)
+    qn = np.sqrt(np.sum(q * q))
+    return np.sqrt(np.sum(F * F)) / (qn if qn > 0.0 else 1.0)
+
+
+@inline_kernel
+def next_check(done, err, tol, last_err, last_at):
+    """The sweep after which the sweeps evaluate ‖F‖ next, at ``err`` after ``done`` and at
+    ``last_err`` after ``last_at``: as many sweeps on as the decrease since then predicts
+    are left to reach tol, at most :data:`CHECK_GAP`, and one while it does not decrease."""
+    gap = 1
+    if tol > 0.0 and err < last_err < np.inf:  # the sweeps left at the rate since then
+        left = np.log(tol / err) / np.log(err / last_err) * (done - last_at)
+        gap = int(min(max(left, 1.0), CHECK_GAP))
+    return done + gap
+
+
+@kernel
+def nsgs_contacts(rows, rhos, q, mu, d, r, tol, max_sweeps, local_iters):
+    """Projected Gauss–Seidel over the contacts (docs/theory.md §15), updating ``r`` in place,
+    on W by contacts ``rows`` (:class:`~impactqp.kernels.friction_rows.ContactRows`, so that
+    a sweep costs W's blocks) with the steps ``rhos`` of the contacts' fixed points
+    (:func:`~impactqp.kernels.friction_blocks.local_steps`). Each contact's local problem
+    (the others held) is solved as in :func:`sweep_once`; the sweeps stop when
+    ‖F‖ ≤ tol·‖q‖. ‖F‖ (a product by W, as dear as a sweep) is evaluated after the first
+    sweep, then after the sweeps :func:`next_check` says, and after the last. Returns
+    (sweeps done, ‖F‖/‖q‖ at the end)."""
+    start, other, block, Wcc = rows
+    u, F, work = np.empty(r.size), np.empty(r.size), np.empty(3 * d)
+    err, last_err, last_at, check_at = np.inf, np.inf, 0, 1
+    for sweep in range(max_sweeps):
+        for c in range(mu.size):  # as sweep_once, b_c by blocks
+            k = c * d
+            b0, b1, b2 = off_diagonal(start, other, block, q, r, c, d)
+            if d == 2:
+                exact, rn, rt = planar_contact(Wcc[c, 0, 0], Wcc[c, 0, 1], Wcc[c, 1, 0],
+                                               Wcc[c, 1, 1], b0, b1, mu[c])
+                if exact:
+                    r[k], r[k + 1] = rn, rt
+                    continue
+            elif b0 >= 0.0:  # apart
+                r[k], r[k + 1], r[k + 2] = 0.0, 0.0, 0.0
+                continue
+            work[2 * d], work[2 * d + 1] = b0, b1
+            if d == 3:
+                work[8] = b2
+            contact_steps(Wcc, rhos, mu, c, d, r, local_iters, work)
+        done = sweep + 1
+        if done < check_at and done < max_sweeps:
+            continue
+        velocity_into(rows, q, r, d, u)
+        err = relative_error(r, u, q, mu, d, F)
+        if err <= tol:
+            return done, err
+        last_err, last_at, check_at = err, done, next_check(done, err, tol, last_err, last_at)
     return max_sweeps, err
 
 
 @inline_kernel
 def sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch):
-    """One sweep of :func:`nsgs_blocks` over the contacts, updating ``r`` in place, with
-    ``scratch`` of 5·d floats: each contact's local problem solved exactly where a closed
-    form holds, else by at most ``local_iters`` projected fixed-point steps. A contact whose
-    normal row b_n is ≥ 0 is apart (r_c = 0) before its tangential rows are summed: most
-    contacts of a pile of spheres are (41 of NESpheres-30's 44 in its one sweep)."""
+    """One sweep over the contacts on W's compressed ``rows`` and ``blocks`` (as
+    :func:`nsgs_blocks` takes them), updating ``r`` in place (``scratch``: ≥ 3·d floats).
+    A contact is apart (r_c = 0) where its normal row gives b_n ≥ 0, before its tangential
+    rows are summed (41 of NESpheres-30's 44 contacts in its one sweep); a planar contact is
+    solved by its cases in scalars (:func:`~impactqp.kernels.friction_planar.planar_contact`)
+    in the loop itself (in an inlined helper numba compiled them ten times slower), any other
+    by :func:`contact_steps`."""
     indptr, indices, data = rows
     Wcc, rhos = blocks
-    x = scratch[:d]
-    rc = scratch[d:2 * d]
-    uc = scratch[2 * d:3 * d]
-    mc = scratch[3 * d:4 * d]
-    base = scratch[4 * d:5 * d]  # q_c + Σ_{j≠c} W_cj r_j
     for c in range(mu.size):
         k = c * d
-        rho = rhos[c]
         for i in range(d):
             v = q[k + i]
             for p in range(indptr[k + i], indptr[k + i + 1]):
                 v += data[p] * r[indices[p]]
             for j in range(d):
                 v -= Wcc[c, i, j] * r[k + j]
-            base[i] = v
-            rc[i] = r[k + i]
-            if i == 0 and v >= 0.0:  # apart (the first case of exact_contact): r_c = 0
+            scratch[2 * d + i] = v
+            if i == 0 and v >= 0.0:
                 break
-        if base[0] >= 0.0:
+        if scratch[2 * d] >= 0.0:  # apart
             for i in range(d):
                 r[k + i] = 0.0
             continue
-        exact = exact_contact(Wcc[c], base, mu[c], d, rc)
-        for _ in range(0 if exact else local_iters):
-            for i in range(d):
-                v = base[i]
-                for j in range(d):
-                    v += Wcc[c, i, j] * rc[j]
-                uc[i] = v
-            modified_contact(uc, mu[c], 0, d, mc)
-            for i in range(d):
-                x[i] = rc[i] - rho * mc[i]
-            change = 0.0
-            size = 0.0
-            project_contact(x, mu[c], 0, d, mc)
-            for i in range(d):
-                change += (mc[i] - rc[i]) ** 2
-                size += mc[i] * mc[i]
-                rc[i] = mc[i]
-            if change <= 1e-12 * (size + 1e-300):  # squares: 10⁻⁶ in norm
-                break
+        if d == 2:
+            exact, rn, rt = planar_contact(Wcc[c, 0, 0], Wcc[c, 0, 1], Wcc[c, 1, 0],
+                                           Wcc[c, 1, 1], scratch[4], scratch[5], mu[c])
+            if exact:
+                r[k], r[k + 1] = rn, rt
+                continue
+        contact_steps(Wcc, rhos, mu, c, d, r, local_iters, scratch)
+
+
+@kernel(internal=True, refcounted=False)
+def contact_steps(Wcc, rhos, mu, c, d, r, local_iters, work):
+    """Contact c's local problem u_c = W_cc r_c + b_c (b_c in ``work[2·d:3·d]``) into
+    ``r[c·d:c·d + d]``, where the sweeps' scalar cases have not solved it: sticking
+    (:func:`~impactqp.kernels.friction_blocks.exact_contact`), else at most ``local_iters``
+    steps of the fixed point r_c ← P_{K_μ}(r_c − ρ_c ũ_c), fewer once one moves r_c by less
+    than 10⁻⁶‖r_c‖ (r_c in ``work[0:d]``, ũ_c and the step in place in ``work[d:2·d]``)."""
+    k = c * d
+    for i in range(d):
+        work[i] = r[k + i]
+    exact = d == 3 and exact_contact(Wcc[c], work[2 * d:], mu[c], d, work)
+    for _ in range(0 if exact else local_iters):
         for i in range(d):
-            r[k + i] = rc[i]
+            v = work[2 * d + i]
+            for j in range(d):
+                v += Wcc[c, i, j] * work[j]
+            work[d + i] = v
+        modified_contact(work, mu[c], d, d, work)  # in place: ũ_c
+        for i in range(d):
+            work[d + i] = work[i] - rhos[c] * work[d + i]
+        project_contact(work, mu[c], d, d, work)  # in place
+        change = 0.0
+        size = 0.0
+        for i in range(d):
+            change += (work[d + i] - work[i]) ** 2
+            size += work[d + i] * work[d + i]
+            work[i] = work[d + i]
+        if change <= 1e-12 * (size + 1e-300):  # squares: 10⁻⁶ in norm
+            break
+    for i in range(d):
+        r[k + i] = work[i]

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from .friction_planar import planar_contact, planar_sticking
 from .jit import inline_kernel, kernel
 
 
@@ -109,34 +110,32 @@ def sticking(Wc, base, mu, d, out):
     """Whether the contact sticks: r = −W_cc⁻¹b (u = 0) lies in K_μ; r is then written into
     ``out[0:d]`` (Cramer's rule, d = 2 or 3)."""
     if d == 2:
-        det = Wc[0, 0] * Wc[1, 1] - Wc[0, 1] * Wc[1, 0]
-        if det == 0.0:
-            return False
-        rn = (Wc[0, 1] * base[1] - Wc[1, 1] * base[0]) / det
-        r1 = (Wc[1, 0] * base[0] - Wc[0, 0] * base[1]) / det
-        r2 = 0.0
-    else:
-        c00 = Wc[1, 1] * Wc[2, 2] - Wc[1, 2] * Wc[2, 1]
-        c01 = Wc[1, 2] * Wc[2, 0] - Wc[1, 0] * Wc[2, 2]
-        c02 = Wc[1, 0] * Wc[2, 1] - Wc[1, 1] * Wc[2, 0]
-        det = Wc[0, 0] * c00 + Wc[0, 1] * c01 + Wc[0, 2] * c02
-        if det == 0.0:
-            return False
-        c10 = Wc[0, 2] * Wc[2, 1] - Wc[0, 1] * Wc[2, 2]
-        c11 = Wc[0, 0] * Wc[2, 2] - Wc[0, 2] * Wc[2, 0]
-        c12 = Wc[0, 1] * Wc[2, 0] - Wc[0, 0] * Wc[2, 1]
-        c20 = Wc[0, 1] * Wc[1, 2] - Wc[0, 2] * Wc[1, 1]
-        c21 = Wc[0, 2] * Wc[1, 0] - Wc[0, 0] * Wc[1, 2]
-        c22 = Wc[0, 0] * Wc[1, 1] - Wc[0, 1] * Wc[1, 0]
-        rn = -(c00 * base[0] + c10 * base[1] + c20 * base[2]) / det
-        r1 = -(c01 * base[0] + c11 * base[1] + c21 * base[2]) / det
-        r2 = -(c02 * base[0] + c12 * base[1] + c22 * base[2]) / det
+        stuck, rn, r1 = planar_sticking(Wc[0, 0], Wc[0, 1], Wc[1, 0], Wc[1, 1], base[0],
+                                        base[1], mu)
+        if stuck:
+            out[0] = rn
+            out[1] = r1
+        return stuck
+    c00 = Wc[1, 1] * Wc[2, 2] - Wc[1, 2] * Wc[2, 1]
+    c01 = Wc[1, 2] * Wc[2, 0] - Wc[1, 0] * Wc[2, 2]
+    c02 = Wc[1, 0] * Wc[2, 1] - Wc[1, 1] * Wc[2, 0]
+    det = Wc[0, 0] * c00 + Wc[0, 1] * c01 + Wc[0, 2] * c02
+    if det == 0.0:
+        return False
+    c10 = Wc[0, 2] * Wc[2, 1] - Wc[0, 1] * Wc[2, 2]
+    c11 = Wc[0, 0] * Wc[2, 2] - Wc[0, 2] * Wc[2, 0]
+    c12 = Wc[0, 1] * Wc[2, 0] - Wc[0, 0] * Wc[2, 1]
+    c20 = Wc[0, 1] * Wc[1, 2] - Wc[0, 2] * Wc[1, 1]
+    c21 = Wc[0, 2] * Wc[1, 0] - Wc[0, 0] * Wc[1, 2]
+    c22 = Wc[0, 0] * Wc[1, 1] - Wc[0, 1] * Wc[1, 0]
+    rn = -(c00 * base[0] + c10 * base[1] + c20 * base[2]) / det
+    r1 = -(c01 * base[0] + c11 * base[1] + c21 * base[2]) / det
+    r2 = -(c02 * base[0] + c12 * base[1] + c22 * base[2]) / det
     if not (rn >= 0.0 and np.sqrt(r1 * r1 + r2 * r2) <= mu * rn):
         return False
     out[0] = rn
     out[1] = r1
-    if d == 3:
-        out[2] = r2
+    out[2] = r2
     return True
 
 
@@ -149,24 +148,18 @@ def exact_contact(Wc, base, mu, d, out):
     sliding sign) — are tried in turn; r is written into ``out[0:d]`` for the first that
     holds. Returns False (``out`` untouched) where none does in floats: a sliding 3-D
     contact, left to the caller's projected fixed point."""
+    if d == 2:  # the planar cases, in scalars
+        solved, rn, rt = planar_contact(Wc[0, 0], Wc[0, 1], Wc[1, 0], Wc[1, 1], base[0],
+                                        base[1], mu)
+        if solved:
+            out[0] = rn
+            out[1] = rt
+        return solved
     if base[0] >= 0.0:
         for j in range(d):
             out[j] = 0.0
         return True
-    if sticking(Wc, base, mu, d, out):
-        return True
-    if d == 3:
-        return False
-    for sign in (-1.0, 1.0):  # r_t = sign·μ r_n: sliding with u_t of the other sign
-        slope = Wc[0, 0] + sign * mu * Wc[0, 1]
-        if slope > 0.0:
-            rn = -base[0] / slope
-            ut = (Wc[1, 0] + sign * mu * Wc[1, 1]) * rn + base[1]
-            if -sign * ut >= 0.0:
-                out[0] = rn
-                out[1] = sign * mu * rn
-                return True
-    return False
+    return sticking(Wc, base, mu, d, out)
 
 __all__ = ["diagonal_blocks", "extreme_sum", "local_steps", "exact_contact", "nonzero_rows",
            "sticking"]

@@ -19,12 +19,11 @@ from ...kernels.friction import (
     alart_curnier,
     kernel_mu,
     modified_velocity,
-    modified_velocity_jacobian,
     natural_map,
     project_cones,
-    projection_jacobian,
 )
 from ...kernels.friction_blocks import nonzero_rows
+from ...kernels.friction_jacobians import modified_velocity_jacobian, projection_jacobian
 from ...kernels.friction_newton import scales
 from . import FrictionProgram
 
