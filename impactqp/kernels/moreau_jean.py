@@ -187,8 +187,9 @@ def _solve_chain(cl, units, chain, left, right, tol, chain_work, res):
     for x in range(nc):
         shifted[x] = um[x] + e * vp[x]
     weight = up  # scratch until u⁺ is formed
-    project(masses[first:first + nc], shifted[:nc], left, right, z[:nc], L[:nc + 1],
-            starts[:nc + 1], weight[:nc])
+    # masses writable, the velocities read-only: the signature of an impact's chain
+    project(masses[first:first + nc], read_only(shifted[:nc]), left, right, z[:nc],
+            L[:nc + 1], starts[:nc + 1], weight[:nc])
     lo = 0 if left else 1
     for x in range(mc):
         lam[x] = L[lo + x]
