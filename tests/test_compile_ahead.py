@@ -134,3 +134,30 @@ def test_an_internal_kernel_runs_inside_its_callers_and_refuses_a_call_from_pyth
             residuals._largest(up)
     with pytest.raises(TypeError, match="exclude each other"):
         jit.kernel(lambda x: x, interpretable=True, internal=True)
+
+
+def test_read_only_inside_a_kernel_gives_its_callee_one_signature():
+    """``read_only`` called by a kernel types its array read-only without a copy, so a callee
+    given writable and read-only arrays by its callers compiles once (the Moreau–Jean loop's
+    certificates and an impact's share theirs this way); from Python it is a read-only view."""
+    import numba
+    import numpy as np
+
+    from impactqp.kernels.jit import read_only
+
+    @numba.njit
+    def first(a):
+        return a[0]
+
+    @numba.njit
+    def both(a):
+        b = a.copy()  # writable
+        b[0] = 5.0
+        return first(read_only(b)) + first(read_only(a))
+
+    x = np.arange(1.0, 4.0)
+    view = read_only(x)
+    assert not view.flags.writeable and np.shares_memory(view, x)
+    assert both(x) == 6.0 and both(view) == 6.0
+    if not numba.config.DISABLE_JIT:
+        assert [sig[0].mutable for sig in first.signatures] == [False]

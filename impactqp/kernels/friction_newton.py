@@ -119,9 +119,12 @@ def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
             error = abh_error(W, q, mu, d, rp, qn)
             if error <= 0.5 * tol:
                 if kept_error <= 0.5 * tol or error == 0.0:  # the step more is taken
-                    r[:] = rp if error < kept_error else kept
+                    best = rp if error < kept_error else kept
+                    for i in range(r.size):  # loops: a slice copy compiles numba's shape errors
+                        r[i] = best[i]
                     return steps, True
-                kept[:] = rp
+                for i in range(r.size):
+                    kept[i] = rp[i]
                 kept_error = error
                 kept_at = steps
         if steps == max_steps or steps > kept_at:  # the step more did not do better
@@ -154,12 +157,14 @@ def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
             t *= 0.5
         if not t > 1e-8:
             break  # no descent: stalled
-        r[:] = r_try
-        u[:] = u_try
+        for i in range(r.size):
+            r[i] = r_try[i]
+            u[i] = u_try[i]
         phi = alart_curnier(r, u, mu, rho, d, jac, A, B)
         f = f_try
     if kept_error <= 0.5 * tol:  # the step more failed: the r within tolerance
-        r[:] = kept
+        for i in range(r.size):
+            r[i] = kept[i]
         return steps, True
     return steps, False
 
@@ -170,7 +175,8 @@ def _accept(W, q, mu, d, r, tol):
     qn = np.sqrt(np.sum(q * q))
     rp = project_cones(r, mu, d)
     if abh_error(W, q, mu, d, rp, qn if qn > 0.0 else 1.0) <= 0.5 * tol:
-        r[:] = rp
+        for i in range(r.size):
+            r[i] = rp[i]
         return True
     return False
 
@@ -212,7 +218,7 @@ def sweep_budget(n, m, entries, sweeps, local_iters):
     return min(float(sweeps), newton / (entries + LOCAL_WORK * local * m))
 
 
-@kernel
+@inline_kernel
 def sweeps_first(rows, q, mu, d, r, tol, sweeps, local_iters):
     """The projected Gauss–Seidel from r = 0 on W's nonzero ``rows`` (indptr, indices,
     data), into ``r``, while it costs less than Newton would (:func:`sweep_budget`; none
@@ -264,7 +270,8 @@ def solve_small(W, q, mu, rho, d, tol, r, newton_steps, sweeps, local_iters):
     its = swept_its + steps
     if ok:
         return its, True
-    r[:] = swept
+    for i in range(r.size):
+        r[i] = swept[i]
     if swept_its < sweeps:
         done, _ = nsgs_rows(rows[0], rows[1], rows[2], q, mu, d, r, 0.5 * tol,
                             sweeps - swept_its, local_iters)
@@ -304,7 +311,7 @@ beyond them it takes one Newton step on the dense W̃ (TwoRods1-condensed, 3 con
 tol/2 after 2 sweeps, 5e-12 after 4, then 0.65 of ‖F‖ a sweep)."""
 
 
-@kernel(interpretable=True)
+@inline_kernel(interpretable=True)
 def sweeps_on(rows, blocks, q, mu, d, r, tol, local_iters, done, err):
     """The projected Gauss–Seidel on W's nonzero ``rows`` (indptr, indices, data) and its
     diagonal ``blocks`` with their steps (:func:`~impactqp.kernels.friction.nsgs_blocks`)

@@ -65,17 +65,25 @@ def pack(W, rows, q, mu, d, budgets):
     ints[0], ints[1], ints[2], ints[3] = size, d, m, entries
     ints[4], ints[5] = scaled, posed
     ints[6], ints[7], ints[8] = newton_steps, sweeps, local_iters
-    ints[PACKED_HEADER:PACKED_HEADER + size + 1] = indptr
-    ints[PACKED_HEADER + size + 1:] = indices[:entries]
+    for i in range(size + 1):  # loops: a slice copy compiles numba's shape errors
+        ints[PACKED_HEADER + i] = indptr[i]
+    for p in range(entries):
+        ints[PACKED_HEADER + size + 1 + p] = indices[p]
     block = m * d * d
     floats = np.empty(2 * size + 2 * m + block + entries)
-    floats[:size] = s
-    floats[size:2 * size] = qu
-    floats[2 * size:2 * size + m] = mu
+    for i in range(size):
+        floats[i] = s[i]
+        floats[size + i] = qu[i]
     Wcc = diagonal_blocks(indptr, indices, data, m, d)
-    floats[2 * size + m:2 * size + 2 * m] = local_steps(Wcc)
-    floats[2 * size + 2 * m:2 * size + 2 * m + block] = Wcc.ravel()
-    floats[2 * size + 2 * m + block:] = data[:entries]
+    rhos = local_steps(Wcc)
+    for c in range(m):
+        floats[2 * size + c] = mu[c]
+        floats[2 * size + m + c] = rhos[c]
+        for a in range(d):
+            for b in range(d):
+                floats[2 * size + 2 * m + (c * d + a) * d + b] = Wcc[c, a, b]
+    for p in range(entries):
+        floats[2 * size + 2 * m + block + p] = data[p]
     if not whole:
         ints[8] = -local_iters - 1  # the sign carries ``whole``: one int32 array
     return floats, ints

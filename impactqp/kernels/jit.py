@@ -14,7 +14,10 @@ from typing import Any, TextIO, TypeVar
 
 import numba
 import numba.core.event
+from numba.core import types
+from numba.core.imputils import impl_ret_borrowed, lower_builtin
 from numba.core.registry import CPUDispatcher
+from numba.extending import type_callable
 
 from .first_calls import InterpretableDispatcher
 
@@ -171,10 +174,29 @@ def read_only(a: Any) -> Any:
     """A read-only view of the array ``a`` (no copy): a kernel's callers pass arrays with
     one set of flags, since each other set compiles the kernel (and every kernel it calls
     with them) once more. u⁻ is kept read-only by the problems, so callers pass read-only
-    velocities."""
+    velocities.
+
+    Kernels call it too (compiled to nothing but the array itself, typed read-only): a
+    kernel whose callers hold its inputs some writable and some read-only is called with
+    every input passed through it, and compiles once.
+    """
     view = a.view()
     view.setflags(write=False)
     return view
+
+
+@type_callable(read_only)
+def _type_read_only(context: Any) -> Callable:
+    def typer(a: Any) -> Any:
+        if isinstance(a, types.Array):
+            return a.copy(readonly=True)
+        return None
+    return typer
+
+
+@lower_builtin(read_only, types.Array)
+def _lower_read_only(context: Any, builder: Any, sig: Any, args: Any) -> Any:
+    return impl_ret_borrowed(context, builder, sig.return_type, args[0])
 
 
 NOTICE_AFTER = 1.0

@@ -119,12 +119,17 @@ def local_cell(packed, Minv, E, eps, um, lam, kink_tol, out):
             gcol += abs(ops.G[idx[b], idx[a]])
             kcol += abs(KA[idx[b], idx[a]])
         gnorm, knorm = max(gnorm, gcol), max(knorm, kcol)
-    p.Minv[:] = Minv
-    p.Y[:] = ops.MinvW
-    p.W[:] = ops.Wt.T
-    p.IE[:] = IE
-    p.u[:] = um
-    p.lam[:] = lam
+    for a in range(n):  # loops: a slice copy compiles numba's shape errors
+        p.u[a] = um[a]
+        for b in range(n):
+            p.Minv[a, b] = Minv[a, b]
+        for c in range(m):
+            p.Y[a, c] = ops.MinvW[a, c]
+            p.W[a, c] = ops.Wt[c, a]
+    for c in range(m):
+        p.lam[c] = lam[c]
+        for b in range(m):
+            p.IE[c, b] = IE[c, b]
     for i in range(m):
         total = 0.0
         for c in range(n):

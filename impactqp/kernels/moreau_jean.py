@@ -38,7 +38,7 @@ from .active_set import SOLVED, lcp_psd_work
 from .chain import project
 from .clusters import group, group_work
 from .events import full, mark, open_record, put_floats, put_ints, rollback
-from .jit import kernel
+from .jit import kernel, read_only
 from .residuals import chain_step_residuals, dense_step_residuals
 from .step import activation, end_step, free_velocity, linear_gaps, rows_times, step_q
 
@@ -161,8 +161,10 @@ def _solve_dense(cl, contacts, law, tol, dense_work, res, work):
         for y in range(mc):
             total += Xv[x, y] * lam[y]
         up[x] = total
-    dense_step_residuals(Mv, Wv, Xv, sc[:mc], um[:nc], up[:nc], lam[:mc], vp[:nc], Ev, 0.0,
-                         np.bool_(False), res, work)  # run-time flags: one signature each
+    dense_step_residuals(read_only(Mv), read_only(Wv), read_only(Xv), read_only(sc[:mc]),
+                         read_only(um[:nc]), read_only(up[:nc]), read_only(lam[:mc]),
+                         read_only(vp[:nc]), read_only(Ev), 0.0, np.bool_(False), res, work)
+    # inputs read-only and run-time flags: the signature of an impact's certificate
     for x in range(CHECKED):
         if not res[x] <= tol:  # NaN fails
             return False
@@ -185,8 +187,9 @@ def _solve_chain(cl, units, chain, left, right, tol, chain_work, res):
     for x in range(nc):
         shifted[x] = um[x] + e * vp[x]
     weight = up  # scratch until u⁺ is formed
-    project(masses[first:first + nc], shifted[:nc], left, right, z[:nc], L[:nc + 1],
-            starts[:nc + 1], weight[:nc])
+    # masses writable, the velocities read-only: the signature of an impact's chain
+    project(masses[first:first + nc], read_only(shifted[:nc]), left, right, z[:nc],
+            L[:nc + 1], starts[:nc + 1], weight[:nc])
     lo = 0 if left else 1
     for x in range(mc):
         lam[x] = L[lo + x]
@@ -195,9 +198,10 @@ def _solve_chain(cl, units, chain, left, right, tol, chain_work, res):
     sc = shifted  # scratch again: the contact scales of the run
     for x in range(mc):
         sc[x] = units[C[x]]
-    chain_step_residuals(um[:nc], up[:nc], lam[:mc], vp[:nc], masses[first:first + nc],
-                         inverse[first:first + nc], sc[:mc], left, right, e, 0.0, np.bool_(False),
-                         res)
+    chain_step_residuals(read_only(um[:nc]), read_only(up[:nc]), read_only(lam[:mc]),
+                         read_only(vp[:nc]), read_only(masses[first:first + nc]),
+                         read_only(inverse[first:first + nc]), read_only(sc[:mc]), left, right,
+                         e, 0.0, np.bool_(False), res)  # the signature of a chain's certificate
     for x in range(CHECKED):
         if not res[x] <= tol:  # NaN fails
             return False

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import inline_kernel, kernel
+from .jit import inline_kernel, kernel, read_only
 
 RESIDUALS = ("momentum", "impulse_sign", "law_feasibility", "complementarity",
              "energy_balance", "duality_gap")
@@ -153,7 +153,10 @@ def dense_residuals(M, Wt, MinvW, s, um, up, lam, E, eps, moreau, out, work):
     contact scales s and the law's E (m × m; for Moreau's law, ``moreau``, E = εI is used and
     E may be empty) into ``out`` (order :data:`RESIDUALS`); ``work`` is scratch of at least
     2n + 2m floats (a loop over impacts allocates nothing)."""
-    dense_step_residuals(M, Wt, MinvW, s, um, up, lam, um, E, eps, moreau, out, work)
+    # inputs read-only: one compiled signature for these callers and the Moreau–Jean loop's
+    dense_step_residuals(read_only(M), read_only(Wt), read_only(MinvW), read_only(s),
+                         read_only(um), read_only(up), read_only(lam), read_only(um),
+                         read_only(E), eps, moreau, out, work)
 
 
 @kernel
@@ -297,8 +300,10 @@ def chain_residuals(um, up, lam, masses, inverse, s, left_wall, right_wall, E, e
     makes the residuals. Inputs are divided by :func:`unit_of` only when max|u⁻ⱼ| is
     outside :data:`SCALE_RANGE` (the pass is then made again).
     """
-    chain_step_residuals(um, up, lam, um, masses, inverse, s, left_wall, right_wall, E, eps,
-                         moreau, out)
+    # inputs read-only: one compiled signature for these callers and the Moreau–Jean loop's
+    chain_step_residuals(read_only(um), read_only(up), read_only(lam), read_only(um),
+                         read_only(masses), read_only(inverse), read_only(s), left_wall,
+                         right_wall, E, eps, moreau, out)
 
 
 @kernel

@@ -19,7 +19,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .jit import kernel
+from .jit import inline_kernel, kernel
 
 
 class StepMaps(NamedTuple):
@@ -75,6 +75,14 @@ class StepTangents(NamedTuple):
     pcols: np.ndarray
 
 
+@inline_kernel
+def _put(out, step, S):
+    """``out[step] = S`` by loops: a slice copy compiles numba's shape errors."""
+    for a in range(S.shape[0]):
+        for c in range(S.shape[1]):
+            out[step, a, c] = S[a, c]
+
+
 @kernel
 def forward(maps, tangents, S0, out):
     """The tangents after every step into ``out`` ((steps + 1, 2n, k), ``out[0] = S0``) for
@@ -85,7 +93,7 @@ def forward(maps, tangents, S0, out):
     k = S0.shape[1]
     p = pcols.size
     S = S0.copy()
-    out[0] = S
+    _put(out, 0, S)
     dvf = np.empty((n, k))
     dvn = np.empty((n, k))
     width = contacts.shape[1]
@@ -103,7 +111,9 @@ def forward(maps, tangents, S0, out):
                     dvf[a, c] = total
                 else:
                     dvf[a, c] = S[n + a, c]
-        dvn[:, :] = dvf
+        for a in range(dvf.shape[0]):  # loops: a slice copy compiles numba's shape errors
+            for c in range(dvf.shape[1]):
+                dvn[a, c] = dvf[a, c]
         if j < steps.size and steps[j] == step:
             size = sizes[j]
             for x in range(size):
@@ -132,7 +142,7 @@ def forward(maps, tangents, S0, out):
             for c in range(k):
                 S[a, c] += h * ((1.0 - theta) * S[n + a, c] + theta * dvn[a, c])
                 S[n + a, c] = dvn[a, c]
-        out[step + 1] = S
+        _put(out, step + 1, S)
     return out
 
 

@@ -42,7 +42,6 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.checks import DEFAULT_TOL
-from ..kernels.jit import read_only
 from ..kernels.moreau_jean import CHECKED, Chain, Impacts, run, worst_step
 from ..kernels.residuals import RESIDUALS
 from ..kernels.step import Contacts, Force, Record, Scheme, activation, end_step
@@ -291,10 +290,12 @@ class _CompiledLoop(CompiledDriver):
         self.impacts = Impacts(e, matrix, np.zeros(m, dtype=bool))
         if cache.chain is not None and np.ndim(E) == 0:  # runs of balls: isotonic
             chain = cache.chain
-            self.chain = Chain(True, read_only(cache.diagonal), 1.0 / cache.diagonal,
+            # masses a fresh writable copy in both branches (one compiled loop), as an
+            # impact's chain holds them: the loop's projection compiles once with it
+            self.chain = Chain(True, np.array(cache.diagonal, dtype=float), 1.0 / cache.diagonal,
                                bool(chain.left_wall), bool(chain.right_wall), float(E))
         else:
-            self.chain = Chain(False, read_only(np.zeros(0)), np.zeros(0), False, False, 0.0)
+            self.chain = Chain(False, np.zeros(0), np.zeros(0), False, False, 0.0)
 
     def kernel_data(self) -> tuple:
         return self.contacts, self.force, self.step.scheme, self.impacts, self.chain
