@@ -1,8 +1,8 @@
 """Every backend agrees with the exact active-set enumeration; laws agree across forms."""
 
 import numpy as np
-import scipy.sparse as sp
 import pytest
+import scipy.sparse as sp
 
 import impactqp as iq
 
