@@ -44,3 +44,20 @@ def test_motion_beyond_the_float_range_is_a_named_error():
 def test_a_ball_at_rest_stays_finite_for_any_length_of_time():
     tr = iq.simulate(iq.simulation.bouncing_ball(), iq.Newton(0.9), 1e300, scheme="event-driven")
     assert np.isfinite(tr.q).all() and abs(tr.q[-1, 0]) < 1e-9 and tr.t[-1] == 1e300
+
+
+def test_energy_beyond_the_floats_is_said_not_checked():
+    """q and v stay finite under gravity 1e200 while ½v² overflows: the summary says the
+    energy is beyond the floats instead of printing 'nan' beside 'certificates: all ok'."""
+    import warnings
+
+    from impactqp.simulation import bouncing_ball
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # the summary raises no overflow warning
+        run = iq.simulate(bouncing_ball(gravity=1e200), iq.Newton(0.9), 1.0, h=0.01)
+        assert np.all(np.isfinite(run.q)) and np.all(np.isfinite(run.v))
+        text = run.summary()
+    assert "energy: beyond the floats" in text and "nan" not in text
+    calm = iq.simulate(bouncing_ball(), iq.Newton(0.9), 1.0, h=0.01).summary()
+    assert "largest relative change" in calm and "beyond the floats" not in calm

@@ -165,7 +165,6 @@ class Trajectory:
         """A few lines: scheme, law, records, events, certificates, S-verdicts (with the count
         of each reason why certified events leave S, :meth:`outside_S`), energy."""
         adm = self.admissible()
-        drift = self.energy_drift()
         kept = self.settings.get("keep_events", True)
         return "\n".join([
             f"{self.scheme} simulation of {self.system!r} with {self.law!r}",
@@ -175,9 +174,23 @@ class Trajectory:
             f"u⁺ ∈ S: {int(adm.sum())} of {adm.size}" if kept else
             "  certificates: every impact passed (a failing one stops the run)",
             *(self._outside_S_text() if kept else []),
-            f"  energy: {self.total_energy[0]:.10g} → {self.total_energy[-1]:.10g} "
-            f"(largest relative change {drift:.3g})",
+            self._energy_text(),
         ])
+
+    def _energy_text(self) -> str:
+        """The summary's energy line: E(t₀) → E(t_end) and the drift, or what keeps them
+        from being figures (no potential for the force; ½vᵀMv or V(q) beyond the floats)."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            T, V = self.kinetic_energy, self.potential_energy
+            E = T + V
+        if np.all(np.isfinite(E)):
+            return (f"  energy: {E[0]:.10g} → {E[-1]:.10g} "
+                    f"(largest relative change {self.energy_drift():.3g})")
+        beyond = int(np.sum(np.isinf(T) | np.isinf(V) | (np.isnan(E) & ~np.isnan(V))))
+        if beyond:
+            return (f"  energy: beyond the floats at {beyond} of {E.size} records (½vᵀMv or "
+                    "V(q) overflows although q and v are finite): not checked")
+        return (f"  energy: the force has no potential; kinetic {T[0]:.10g} → {T[-1]:.10g}")
 
     def __repr__(self) -> str:
         return (f"Trajectory(scheme={self.scheme!r}, records={self.t.size}, "
