@@ -115,9 +115,7 @@ def run(args: argparse.Namespace) -> int:
             "events": len(trajectory.events), "certified": trajectory.certified,
             "admissible": int(adm.sum()), "outside_S": trajectory.outside_S(),
             "impact_times": impact_times(trajectory),
-            "energy": {"initial": float(trajectory.total_energy[0]),
-                       "final": float(trajectory.total_energy[-1]),
-                       "largest_relative_change": trajectory.energy_drift()},
+            "energy": _energy(trajectory),
             "final_state": {"q": trajectory.q[-1].tolist(), "v": trajectory.v[-1].tolist()},
             "written": written}, indent=2))
     else:
@@ -125,6 +123,16 @@ def run(args: argparse.Namespace) -> int:
         for name in written:
             print(f"  wrote {name}")
     return 0
+
+
+def _energy(trajectory: Trajectory) -> dict[str, float | None]:
+    """The run's energy figures for JSON: null where one is not a float (overflow, or a
+    force without potential), since JSON has no NaN or infinity."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        E = trajectory.total_energy
+        drift = trajectory.energy_drift()
+    return {name: (float(value) if np.isfinite(value) else None) for name, value in
+            (("initial", E[0]), ("final", E[-1]), ("largest_relative_change", drift))}
 
 
 def register(sub: argparse._SubParsersAction) -> None:
