@@ -235,6 +235,10 @@ WHY_FRICTION = {
                    "the sweeps themselves (over a thousand) are each a little dearer than "
                    "NSGS's, a Newton step (sparse LU of size 1710) saving fewer of them than "
                    "it costs",
+    "TwoRods1-condensed": "its three contacts go to Newton's dense steps, each about as "
+                          "dear as NSGS's whole C call of two sweeps",
+    "Rover4396": "a sliding 3-D contact is solved by Newton, whose dense steps cost as much "
+                 "as NSGS's sweeps on two contacts",
     "FC2D-00394": "NSGS ends in one sweep of about a µs, which the Python call around "
                   "impactqp's compiled one costs alone",
     "FC2D-00031": "NSGS ends in one or two sweeps of a µs or two, about the cost of the "
