@@ -161,3 +161,35 @@ def test_read_only_inside_a_kernel_gives_its_callee_one_signature():
     assert both(x) == 6.0 and both(view) == 6.0
     if not numba.config.DISABLE_JIT:
         assert [sig[0].mutable for sig in first.signatures] == [False]
+
+
+# A long chain solved alone (solve_chain) and a chain batch with a wall and rows outside the
+# unit range (each certified row by row again): the callers of the shared certificate kernels
+# in two modules.
+SHARED = """
+import numpy as np
+import impactqp as iq
+from impactqp.kernels import chain_batch, residuals
+
+masses, u = np.linspace(1.0, 2.0, 2000), np.zeros(2000)
+u[0] = 1.0
+iq.moreau(iq.chain(masses, u), 1.0)
+Um = np.random.default_rng(0).standard_normal((300, 3))
+Um[3] *= 1e70
+ones = np.ones(3)
+chain_batch.chain_residual_columns(Um, Um.copy(), np.ones((300, 3)), ones, ones, ones, False,
+                                   True, 0.5, 0.5, True, np.empty((6, 300)))
+print("signatures", len(residuals.chain_residuals.signatures),
+      len(chain_batch._gather.signatures))
+"""
+
+
+def test_shared_kernels_compile_once_for_both_callers(tmp_path):
+    """chain_residuals (called by the single chain's solve and, for rows outside the unit
+    range, by the batch certificate) and the batch's gather (a ball, then the wall) each hold
+    one signature: another would compile them, and every kernel they call, once more. An
+    empty cache: a caller loaded from the cache compiles none of its callees."""
+    done = subprocess.run([sys.executable, "-c", SHARED], capture_output=True, text=True,
+                          timeout=300, env=_env(tmp_path / "numba"))
+    assert done.returncode == 0, done.stderr
+    assert "signatures 1 1" in done.stdout, done.stdout

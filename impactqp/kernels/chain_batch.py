@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import inline_kernel, kernel
+from .jit import inline_kernel, kernel, read_only
 from .residuals import (
     NEW_FOLD,
     NEW_SUMS,
@@ -76,8 +76,9 @@ def chain_residual_columns(Um, Up, Lam, masses, inverse, s, left_wall, right_wal
         for i in range(stop - start):
             if not in_range(state[11 * BLOCK + i]):
                 r = start + i
-                chain_residuals(Um[r], Up[r], Lam[r], masses, inverse, s, left_wall,
-                                right_wall, E, eps, moreau, row)
+                # u⁻ read-only, as solve_chain passes it: one signature
+                chain_residuals(read_only(Um[r]), Up[r], Lam[r], masses, inverse, s,
+                                left_wall, right_wall, E, eps, moreau, row)
                 for c in range(6):
                     out[c, r] = row[c]
 
@@ -125,7 +126,7 @@ def _block(Um, Up, Lam, masses, inverse, s, walls, law, state, out):
             _contacts(state, s[k], E, rows)
         _shift(state, rows)
     if right_wall:  # the wall is a ball at rest; L_N is the last impulse
-        _gather(state, Um, Up, Lam, -1, m, rows)
+        _gather(state, Um, Up, Lam, np.int64(-1), m, rows)  # not a literal: one signature
         _contacts(state, s[m - 1], E, rows)
     _values(state, eps, moreau, out, rows)
 
