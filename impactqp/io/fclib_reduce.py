@@ -22,6 +22,7 @@ import scipy.sparse as sp
 import scipy.sparse.csgraph as csgraph
 import scipy.sparse.linalg as spla
 
+from ..base.definite import symmetric_ldl
 from ..errors import ProblemFileError
 
 REDUCTION_BLOCK = 256
@@ -54,17 +55,14 @@ def mass_factor(M: sp.csc_matrix, error: Error):
     symmetric, as it nearly always is)."""
     symmetric = (M != M.T).nnz == 0
     try:
-        lu = spla.splu(M if symmetric else sp.csc_matrix((M + M.T) * 0.5),
-                       permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                       options={"SymmetricMode": True})
-        pivots = lu.U.diagonal()
-        definite = np.array_equal(lu.perm_r, lu.perm_c) and np.all(pivots > 0)
+        lu, definite = symmetric_ldl(M if symmetric else (M + M.T) * 0.5)
         own = lu if symmetric and definite else spla.splu(M)  # RuntimeError: M is singular
     except RuntimeError:
         raise error("is singular; the global problem cannot be reduced to W = Hᵀ M⁻¹ H") \
             from None
     if not definite:
-        raise error(f"is not positive definite (a pivot of its LDLᵀ is {pivots.min():.3g}): "
+        pivot = lu.U.diagonal().min()
+        raise error(f"is not positive definite (a pivot of its LDLᵀ is {pivot:.3g}): "
                     "a mass matrix gives every velocity a positive kinetic energy ½vᵀMv")
     return own
 

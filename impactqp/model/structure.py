@@ -18,6 +18,7 @@ import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
 from ..base.arrays import Matrix, as_dense, as_matrix
+from ..base.definite import symmetric_ldl
 from ..base.rowwise import row_max, row_sum
 from ..errors import MassMatrixError, ShapeError
 from ..kernels.impact import pack_operators
@@ -135,11 +136,8 @@ class ImpactStructure:
                                           "are not positive")
                 self._diag = diag
                 return
-            # LU with diagonal pivoting on a symmetric permutation: all pivots > 0 iff SPD.
-            lu = spla.splu(self.M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                           options={"SymmetricMode": True})
-            pivots = lu.U.diagonal()
-            if np.any(pivots <= 0) or not np.array_equal(lu.perm_r, lu.perm_c):
+            lu, definite = symmetric_ldl(self.M)
+            if not definite:
                 raise MassMatrixError("M must be positive definite; its LDLᵀ factorization has "
                                       "a non-positive pivot")
             self._lu = lu

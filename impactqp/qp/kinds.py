@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from scipy.optimize import linprog
 
+from ..base.definite import symmetric_ldl
 from ..errors import CertificateError, NoSolutionError
 from ..kernels.friction import project_cones
 from .backends import CONE, FRICTION, Backend
@@ -73,8 +73,7 @@ def lcp_feasible(qp: QuadraticProgram) -> bool:
 
 def positive_definite(P: Any) -> bool:
     """Whether the symmetric matrix P (dense or sparse) is positive definite: its Cholesky
-    factor (dense), or the pivots of its LU in a symmetric order with diagonal pivots, which
-    are LDLᵀ's D (sparse), all positive."""
+    factor (dense), or its LDLᵀ's pivots all positive (sparse, :func:`symmetric_ldl`)."""
     if not sp.issparse(P):
         try:
             np.linalg.cholesky(np.asarray(P))
@@ -82,12 +81,9 @@ def positive_definite(P: Any) -> bool:
             return False
         return True
     try:
-        lu = spla.splu(sp.csc_matrix(P), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                       options={"SymmetricMode": True})
+        return symmetric_ldl(P)[1]
     except RuntimeError:  # exactly singular
         return False
-    pivots = lu.U.diagonal()
-    return bool(np.all(lu.perm_r == lu.perm_c) and np.all(pivots > 0))
 
 
 class ConeKind:
