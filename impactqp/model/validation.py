@@ -59,6 +59,8 @@ def check_mass(M: Matrix, sparse: bool) -> None:
         raise MassMatrixError(f"M must be symmetric; max |M - Mᵀ| = {asym:.3g} "
                               f"(largest entry {scale:.3g})")
     diagonal = np.asarray(M.diagonal() if sp.issparse(M) else np.diagonal(M), dtype=float)
+    if diagonal.min(initial=TINY) >= TINY:  # the common case, decided in one reduction
+        return
     small = diagonal[(diagonal > 0) & (diagonal < TINY)]
     if small.size:
         raise OutOfRangeError(f"M's diagonal reaches {small.min():.3g}, below the normal floats "
@@ -82,7 +84,7 @@ def check_delassus_diagonal(diagonal: Callable[[], np.ndarray]) -> None:
     """
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
         g = diagonal()
-    if not (np.all(np.isfinite(g)) and g.min(initial=1.0) >= TINY):
+    if g.size and not (g.min() >= TINY and g.max() <= HUGE):  # NaN fails both
         raise _refuse(f"its diagonal spans [{g.min():.3g}, {g.max():.3g}]")
 
 
