@@ -21,6 +21,10 @@ import numpy as np
 DEFAULT_TOL = 1e-9
 """Default tolerance of the dimensionless residuals of a certificate (docs/theory.md §8)."""
 
+FRICTION_TOL = 1e-8
+"""Default tolerance of a frictional contact problem's certificate: ABH's ‖F‖/‖q‖ among the
+others (docs/theory.md §15), the accuracy FCLib's benchmarks ask for."""
+
 UNIT_RANGE = (1e-100, 1e100)
 """Velocity scales (largest |u⁻ᵢ|) worked with as given; beyond them, scale-free answers are
 computed in order-one units and scaled back (docs/theory.md §8): norms and products of

@@ -1,13 +1,15 @@
-"""Every backend on the user's own impact: each one's time, its distance to the best certified
-answer, the certificate's verdict, and why a backend was refused (docs/theory.md §8, §9).
+"""Every backend on the user's own problem: each one's time, its distance to the best certified
+answer, the certificate's verdict, and why a backend was refused (docs/theory.md §8, §9, §15).
 
-:func:`compare_backends` solves one problem with one law through every backend of the
+:func:`compare_backends` solves one impact with one law through every backend of the
 registry that serves the law (the families with sub-solvers, ``"cvxpy"`` and ``"qpsolvers"``,
 once per solver impactqp names, installed or not), so a backend that is not installed appears
-with the extra that installs it. Nothing is trusted: a backend's answer counts only when
+with the extra that installs it; or a frictional contact problem (an FCLib or Siconos file's)
+through every friction method. Nothing is trusted: a backend's answer counts only when
 impactqp's recomputed certificate passes, and the reference is the certified answer with the
 smallest certificate residual relative to its tolerance among the exact backends' answers
-(active-set solutions), or among all of them when no exact backend answered.
+(active-set solutions), or among all of them when no exact backend answered (always, for a
+frictional contact problem).
 """
 
 from __future__ import annotations
@@ -15,10 +17,13 @@ from __future__ import annotations
 import math
 import statistics
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 
-from ..base.checks import DEFAULT_TOL, Certificate
+import numpy as np
+
+from ..base.checks import DEFAULT_TOL, FRICTION_TOL, Certificate
+from ..base.log import verbosity
 from ..errors import (
     BackendUnsuitableError,
     InputError,
@@ -26,15 +31,23 @@ from ..errors import (
     SolverError,
     UnknownBackendError,
 )
+from ..kernels.first_calls import compiling
 from ..laws.base import ImpactLaw
+from ..laws.friction import FRICTION_BACKENDS, solve_friction
 from ..laws.pipeline import solve
 from ..laws.planner import check_law, check_problem
-from ..laws.result import ImpactResult
+from ..laws.result import FrictionResult, ImpactResult
+from ..model.friction import FrictionContactProblem
 from ..model.problem import ImpactProblem
 from ..qp import backends as registry
 
 CERTIFIED, FAILED, REFUSED = "certified", "failed", "refused"
 """The verdicts of a backend on the compared impact."""
+
+WARM_UP = 2
+"""Untimed calls per backend before the timed ones: the first pays compilation and the
+solvers' caches, the second what a problem keeps from its first solve (a packed frictional
+problem is solved from its pack from the third call on)."""
 
 
 @dataclass(frozen=True)
@@ -58,12 +71,13 @@ class BackendRun:
     times : tuple of float
         Every timed call's wall time in seconds.
     error : float
-        ‖u⁺ − u⁺_best‖ / ‖u⁻‖ in the kinetic norm against the best certified answer (NaN
-        unless certified).
+        Distance to the best certified answer (NaN unless certified): ‖u⁺ − u⁺_best‖ / ‖u⁻‖
+        in the kinetic norm for an impact, ‖u − u_best‖ / ‖q‖ for a frictional contact
+        problem.
     margin : float
         The certificate's largest residual divided by its tolerance (≤ 1 when certified;
         NaN when there is no certificate).
-    result : ImpactResult or None
+    result : ImpactResult, FrictionResult or None
         The certified result of the first call.
     """
 
@@ -75,7 +89,7 @@ class BackendRun:
     times: tuple[float, ...] = ()
     error: float = math.nan
     margin: float = math.nan
-    result: ImpactResult | None = None
+    result: ImpactResult | FrictionResult | None = None
 
     @property
     def certified(self) -> bool:
@@ -88,22 +102,24 @@ class BackendComparison:
 
     Attributes
     ----------
-    problem : ImpactProblem
-    law : ImpactLaw
+    problem : ImpactProblem or FrictionContactProblem
+    law : ImpactLaw or None
+        The impact's law; None for a frictional contact problem (its μ is its law).
     runs : tuple of BackendRun
     best : str or None
         The backend whose certified answer is the reference of ``error``: an exact backend's
-        (registry ``exact``) with the smallest certificate margin, else any backend's with
-        the smallest margin; None when no backend was certified.
+        (registry ``exact``) with the smallest certificate margin, else (and for a
+        frictional contact problem) any backend's with the smallest margin; None when no
+        backend was certified.
     tol : float
         The certificate tolerance of every solve.
     repeats : int
-        Timed calls per certified backend (after one untimed call that pays compilation and
+        Timed calls per certified backend (after two untimed calls that pay compilation and
         caches).
     """
 
-    problem: ImpactProblem
-    law: ImpactLaw
+    problem: ImpactProblem | FrictionContactProblem
+    law: ImpactLaw | None
     runs: tuple[BackendRun, ...]
     best: str | None
     tol: float
@@ -132,11 +148,15 @@ class BackendComparison:
 
     def __str__(self) -> str:
         p = self.problem
-        head = (f"{self.law.title} on {_count(p.n_dof, 'velocity', 'velocities')} and "
-                f"{_count(p.n_contacts, 'contact')}: {len(self.certified)} of "
-                f"{len(self.runs)} backends certified (tol {self.tol:.0e}); error = "
-                f"‖u⁺ − u⁺_best‖/‖u⁻‖ against {self.best!r}; time = median of "
-                f"{_count(self.repeats, 'call')} after a first one")
+        if self.law is None:
+            what, error = (f"Coulomb friction (W, q, μ) on {_count(p.n_contacts, 'contact')} "
+                           f"in {p.contact_dim}-D", "‖u − u_best‖/‖q‖")
+        else:
+            what, error = (f"{self.law.title} on {_count(p.n_dof, 'velocity', 'velocities')} "
+                           f"and {_count(p.n_contacts, 'contact')}", "‖u⁺ − u⁺_best‖/‖u⁻‖")
+        head = (f"{what}: {len(self.certified)} of {len(self.runs)} backends certified "
+                f"(tol {self.tol:.0e}); error = {error} against {self.best!r}; time = median "
+                f"of {_count(self.repeats, 'call')} after {WARM_UP} untimed")
         rows = [("backend", "time", "error", "certificate", "why")]
         for r in self.runs:
             name = r.backend if r.used in ("", r.backend) else f"{r.backend} ({r.used})"
@@ -147,7 +167,7 @@ class BackendComparison:
         for row in rows:
             cells = [cell.ljust(w) for cell, w in zip(row, widths)]
             lines.append("  ".join([*cells, row[4]]).rstrip())
-        if self.law.frictional and self.certified:
+        if (self.law is None or self.law.frictional) and self.certified:
             lines += ["", "Coulomb's law can have several solutions (docs/theory.md §16): "
                           "certified answers may differ by more than the tolerance."]
         return "\n".join(lines)
@@ -190,18 +210,21 @@ def _margin(cert: Certificate) -> float:
     return max(ratios, default=0.0)
 
 
-def _run(problem: ImpactProblem, law: ImpactLaw, backend: str, tol: float, repeats: int,
-         verbose: bool | int) -> BackendRun:
-    """One backend: a first call (compilation, caches), then ``repeats`` timed calls."""
-    def call() -> ImpactResult:
-        return solve(problem, law, backend, tol=tol, verbose=verbose)
+def _run(call: Callable[[str], ImpactResult | FrictionResult], backend: str,
+         repeats: int) -> BackendRun:
+    """One backend: :data:`WARM_UP` untimed calls, then ``repeats`` timed ones. Every kernel
+    a call reaches compiles at once (:func:`~impactqp.kernels.first_calls.compiling`): run as
+    Python, as a fresh process's first small calls are, it would be timed so."""
     try:
-        result = call()
-        times = []
-        for _ in range(repeats):
-            start = time.perf_counter()
-            call()
-            times.append(time.perf_counter() - start)
+        with compiling():
+            result = call(backend)
+            for _ in range(WARM_UP - 1):
+                call(backend)
+            times = []
+            for _ in range(repeats):
+                start = time.perf_counter()
+                call(backend)
+                times.append(time.perf_counter() - start)
     except (UnknownBackendError, BackendUnsuitableError) as exc:
         return BackendRun(backend, REFUSED, _one_line(exc))
     except InputError:  # the caller's input, not the backend's fault
@@ -219,33 +242,46 @@ def _rank(run: BackendRun) -> tuple[bool, float]:
     return (entry is None or not entry.exact), run.margin
 
 
+def _margin_of(run: BackendRun) -> float:
+    """The smallest certificate margin first."""
+    return run.margin
+
+
 def _one_line(exc: Exception) -> str:
     return " ".join(str(exc).split())
 
 
-def compare_backends(problem: ImpactProblem, law: ImpactLaw,
-                     backends: Iterable[str] | None = None, *, repeats: int = 3,
-                     tol: float = DEFAULT_TOL, verbose: bool | int = False
+def compare_backends(problem: ImpactProblem | FrictionContactProblem,
+                     law: ImpactLaw | None = None, backends: Iterable[str] | None = None, *,
+                     repeats: int = 3, tol: float | None = None, verbose: bool | int = False
                      ) -> BackendComparison:
-    """Solve ``problem`` with ``law`` through each backend and compare them.
+    """Solve ``problem`` through each backend and compare them: an impact with ``law``
+    (:func:`impactqp.solve`), or a frictional contact problem, whose μ is its law
+    (:func:`impactqp.solve_friction`, e.g. ``iq.load_fclib(path)``).
 
     Parameters
     ----------
-    problem : ImpactProblem
-        Any impact (e.g. ``iq.load_problem(path).problem``).
-    law : ImpactLaw
-        ``iq.Moreau(0.5)``, ``iq.Newton(e)``, ``iq.Coulomb(mu)``, ...
+    problem : ImpactProblem or FrictionContactProblem
+        Any impact (e.g. ``iq.load_problem(path).problem``), or a frictional contact problem.
+    law : ImpactLaw, optional
+        ``iq.Moreau(0.5)``, ``iq.Newton(e)``, ``iq.Coulomb(mu)``, ...: required for an
+        impact, left out for a frictional contact problem.
     backends : iterable of str, optional
         The backends to compare, as :func:`impactqp.solve` takes them (``"auto"``,
-        ``"clarabel"``, ``"cvxpy:SCS"``, ``"qpsolvers:highs"``); default ``"auto"`` and
+        ``"clarabel"``, ``"cvxpy:SCS"``, ``"qpsolvers:highs"``) or, for a frictional
+        contact problem, as :func:`impactqp.solve_friction` does; default ``"auto"`` and
         every registered backend that serves the law, the families ``"cvxpy"`` and
         ``"qpsolvers"`` once per solver impactqp names, installed or not
-        (:func:`!impactqp.verification.bench.default_backends`).
+        (:func:`!impactqp.verification.bench.default_backends`), or every friction method.
     repeats : int
-        Timed calls per certified backend (≥ 1), after one untimed call that pays numba's
-        compilation and cvxpy's problem cache; the time reported is their median.
-    tol : float
-        Certificate tolerance of every solve.
+        Timed calls per certified backend (≥ 1), after two untimed calls that pay numba's
+        compilation (every kernel they reach is compiled, never run as Python), cvxpy's
+        problem cache and what a problem keeps from its first solve; the time reported is
+        their median.
+    tol : float, optional
+        Certificate tolerance of every solve; default that of :func:`impactqp.solve`
+        (1e-9), or of :func:`impactqp.solve_friction` (1e-8) for a frictional contact
+        problem.
     verbose : bool or {0, 1, 2}
         As for :func:`impactqp.solve`: 1 logs refusals and fallbacks; 2 also every attempt,
         and lets the third-party solvers print (they are silenced otherwise).
@@ -259,24 +295,51 @@ def compare_backends(problem: ImpactProblem, law: ImpactLaw,
     Raises
     ------
     InputError
-        Not a problem or a law, coefficients that do not fit, a bad ``tol``, ``repeats`` or
-        ``backends`` (a backend that is unknown or not installed is a refused row, not an
-        error).
+        Not a problem or a law, a law for a frictional contact problem or none for an
+        impact, coefficients that do not fit, a bad ``tol``, ``repeats`` or ``backends`` (a
+        backend that is unknown or not installed is a refused row, not an error).
     """
-    check_problem(problem)
-    check_law(law)
     if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
         raise InputError(f"repeats must be an integer ≥ 1, got {repeats!r}")
-    names = default_backends(law) if backends is None else _names(backends)
-    runs = [_run(problem, law, name, tol, repeats, verbose) for name in names]
+    if isinstance(problem, FrictionContactProblem):
+        if law is not None:
+            raise InputError("a FrictionContactProblem carries its law (Coulomb's, with its "
+                             f"μ): leave law out (got {law!r}), e.g. iq.compare_backends("
+                             "problem) or iq.compare_backends(problem, backends=['auto', "
+                             "'nsgs'])")
+        tol = FRICTION_TOL if tol is None else tol
+        defaults = FRICTION_BACKENDS
+
+        def call(name: str) -> FrictionResult:
+            with verbosity(verbose):
+                return solve_friction(problem, backend=name, tol=tol)
+
+        def distance(r: FrictionResult, best: FrictionResult) -> float:
+            return float(np.linalg.norm(r.u - best.u) / np.linalg.norm(problem.q))
+        rank = _margin_of  # no friction method gives an active-set answer
+    else:
+        check_problem(problem)
+        if law is None:
+            raise InputError("an impact needs its law: iq.compare_backends(problem, "
+                             "iq.Moreau(0.5)) (or iq.Newton(e), iq.Coulomb(mu), ...)")
+        check_law(law)
+        tol = DEFAULT_TOL if tol is None else tol
+        defaults = default_backends(law)
+
+        def call(name: str) -> ImpactResult:
+            return solve(problem, law, name, tol=tol, verbose=verbose)
+
+        def distance(r: ImpactResult, best: ImpactResult) -> float:
+            return problem.norm(r.u_plus - best.u_plus) / problem.velocity_scale
+        rank = _rank
+    names = defaults if backends is None else _names(backends)
+    runs = [_run(call, name, repeats) for name in names]
     certified = [r for r in runs if r.certified]
     if not certified:
         return BackendComparison(problem, law, tuple(runs), None, tol, repeats)
-    best = min(certified, key=_rank)
-    u_best = best.result.u_plus
-    scale = problem.velocity_scale
-    runs = [replace(r, error=problem.norm(r.result.u_plus - u_best) / scale) if r.certified
-            else r for r in runs]
+    best = min(certified, key=rank)
+    runs = [replace(r, error=distance(r.result, best.result)) if r.certified else r
+            for r in runs]
     return BackendComparison(problem, law, tuple(runs), best.backend, tol, repeats)
 
 
