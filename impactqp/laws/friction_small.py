@@ -10,12 +10,18 @@ verdict. A problem solved again is solved from the pack its second solve keeps o
 into Python objects at the call: the :class:`SmallFrictionResult` holds the array the call
 filled (r, u and the certificate's figures) and builds the certificate, the error and the
 attempts from it when they are read.
+
+A solve again of a 1-contact problem costs a few microseconds, about half of them Python
+around the compiled call; each step of the path is therefore counted: the result is one
+entry in a new object's dictionary (:class:`SmallFrictionResult`), what a pack's solves share
+is built once with the pack (:class:`_Packed`), and the route takes no frame it does not need.
 """
 
 from __future__ import annotations
 
-import time
 from functools import cached_property
+from time import perf_counter
+from typing import NamedTuple
 
 import numpy as np
 
@@ -45,61 +51,75 @@ whose first sweep :func:`solve_few` tries in one compiled call before the genera
 where it does not certify, the general route starts over, and it cost 2–3 % of that route's
 time on the FCLib problems of 52 to 60 contacts (65 µs of 2.4 ms on Confeti-ex03)."""
 
+_new = object.__new__
+
+
+class _Route(NamedTuple):
+    """What the results of one problem's calls share: the unknowns d·m (``size``), whether
+    the problem was posed in other units than given (``scaled``) and the method's name."""
+
+    size: int
+    scaled: bool
+    backend: str
+
 
 class SmallFrictionResult(FrictionResult):
-    """A :class:`~impactqp.friction.FrictionResult` of :func:`solve_few`: the same attributes, those
-    the verdict does not need read from the compiled call's array when first asked for.
+    """A :class:`~impactqp.friction.FrictionResult` of :func:`solve_few`: the same attributes,
+    each read from the compiled call when first asked for.
 
-    ``ok`` (hence ``success`` and ``status``) is the compiled call's verdict on the figures
-    it computed; ``certificate`` is the :class:`~impactqp.friction.FrictionCertificate` of the same
-    figures, whose ``ok`` is that verdict (the same comparisons, NaN failing both).
+    A new result holds one entry, ``_call``: (the array the call filled with r, u and the
+    certificate's figures, the tolerance, the iterations, the seconds, its :class:`_Route`);
+    a Python object's every further attribute costs about 25 ns to set and free, a tenth of
+    a solve again's Python. ``ok`` (hence ``success`` and ``status``) is the compiled call's
+    verdict on the figures it computed; ``certificate`` is the
+    :class:`~impactqp.friction.FrictionCertificate` of the same figures, whose ``ok`` is that
+    verdict (the same comparisons, NaN failing both).
     """
-
-    @classmethod
-    def of_call(cls, out: np.ndarray, size: int, tol: float, iterations: int,
-                seconds: float, scaled: bool, backend: str) -> SmallFrictionResult:
-        """The result of a certified call of ``backend``'s method: ``out`` holds r, u
-        (``size`` each) and the figures; ``scaled`` whether the problem was posed in other
-        units than given."""
-        result = cls.__new__(cls)
-        fields = result.__dict__  # item by item: cheaper than update(**fields) by ~0.15 µs
-        fields["_out"] = out
-        fields["_size"] = size
-        fields["_tol"] = tol
-        fields["_scaled"] = scaled
-        fields["iterations"] = iterations
-        fields["solve_time"] = seconds
-        fields["backend"] = backend
-        return result
 
     @property
     def ok(self) -> bool:
         """True: only a certified call makes this result (``certificate.ok`` says the same)."""
-        return "_out" in self.__dict__ or self.certificate.ok
+        return "_call" in self.__dict__ or self.certificate.ok
 
     @cached_property
     def r(self) -> np.ndarray:  # type: ignore[override]
-        return self._out[:self._size]
+        out, _, _, _, route = self._call
+        return out[:route.size]
 
     @cached_property
     def u(self) -> np.ndarray:  # type: ignore[override]
-        return self._out[self._size:2 * self._size]
+        out, _, _, _, route = self._call
+        return out[route.size:2 * route.size]
 
     @cached_property
     def certificate(self) -> FrictionCertificate:  # type: ignore[override]
-        return friction_certificate(self._out[2 * self._size:], self._tol)
+        out, tol, _, _, route = self._call
+        return friction_certificate(out[2 * route.size:], tol)
 
     @cached_property
     def error(self) -> float:  # type: ignore[override]
         return self.certificate.error
 
     @cached_property
+    def iterations(self) -> int:  # type: ignore[override]
+        return self._call[2]
+
+    @cached_property
+    def solve_time(self) -> float:  # type: ignore[override]
+        return self._call[3]
+
+    @cached_property
+    def backend(self) -> str:  # type: ignore[override]
+        return self._call[4].backend
+
+    @cached_property
     def attempts(self) -> list[str]:  # type: ignore[override]
-        note = ["solved in its contacts' units (2^0)"] if self._scaled else []
-        return [*note, f"{self.backend} (friction): certified"]
+        route = self._call[4]
+        note = ["solved in its contacts' units (2^0)"] if route.scaled else []
+        return [*note, f"{route.backend} (friction): certified"]
 
 
-def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
+def solve_few(problem: FrictionContactProblem, tol: float, start: float,
               sweeps: bool = True) -> SmallFrictionResult | None:
     """The certified answer of one compiled call
     (:func:`impactqp.kernels.friction_packed.solve_given`), ``start`` the
@@ -117,44 +137,66 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
     start from it (:func:`~impactqp.kernels.friction_packed.solve_packed`). The first solve
     packs nothing (a simulator poses a new problem at each step), and a problem that no
     longer :meth:`~impactqp.FrictionContactProblem.holds` the state it was packed in (q
-    rewritten, W or μ replaced) is solved from its arrays and packed again.
+    rewritten, W or μ replaced) is solved from its arrays and packed again. Every call fills
+    an array of its own: a result is never changed by a later solve.
     """
     m = problem.n_contacts
     small = m <= methods.SMALL_CONTACTS  # the "kernel" method's own limit
     if not (small or (sweeps and m <= SWEPT_CONTACTS)):
         return None
-    out = np.empty(2 * problem.q.size + _FIGURES)
     kept = problem.__dict__.get(_KEPT)
-    if kept is None or kept.small is not small or not problem.holds(kept.state):
-        problem.__dict__[_KEPT] = _Kept(problem.state(), small)
-        its, outcome, scaled = solve_given(*_given(problem), (tol, *_budgets(small)), out)
-    else:
+    if kept is not None and kept.small is small and problem.holds(kept.state):
         packed = kept.packed
         if packed is None:  # solved once: pack it
-            floats, ints = pack(*_given(problem), _budgets(small))
-            packed = kept.packed = (floats, ints, bool(ints[_SCALED]))  # one assignment
-        its, outcome = solve_packed(packed[0], packed[1], tol, out)
-        scaled = packed[2]
+            packed = kept.packed = _Packed.of(problem, small)  # one assignment
+        out = np.empty(packed.out_size)
+        its, outcome = solve_packed(packed.floats, packed.ints, tol, out)
+        route = packed.route
+    else:
+        problem.__dict__[_KEPT] = _Kept(problem.state(), small)
+        size = problem.q.size
+        out = np.empty(2 * size + _FIGURES)
+        W, rows, q, mu, d = _given(problem)
+        its, outcome, scaled = solve_given(W, rows, q, mu, d, (tol, *_budgets(small)), out)
+        route = _Route(size, scaled, "kernel" if small else "nsgs-short")
     if outcome != CERTIFIED:
         return None
-    return SmallFrictionResult.of_call(out, problem.q.size, tol, its,
-                                       time.perf_counter() - start, scaled,
-                                       "kernel" if small else "nsgs-short")
+    result = _new(SmallFrictionResult)
+    result.__dict__["_call"] = (out, tol, its, perf_counter() - start, route)
+    return result
+
+
+class _Packed(NamedTuple):
+    """A problem packed by :func:`~impactqp.kernels.friction_packed.pack` (``floats``,
+    ``ints``), the size of the array a solve of it fills, and the :class:`_Route` its
+    results share."""
+
+    floats: np.ndarray
+    ints: np.ndarray
+    out_size: int
+    route: _Route
+
+    @classmethod
+    def of(cls, problem: FrictionContactProblem, small: bool) -> _Packed:
+        """``problem`` packed for the ``"kernel"`` method (``small``) or the first sweep of
+        ``"nsgs-short"``."""
+        floats, ints = pack(*_given(problem), _budgets(small))
+        size = problem.q.size
+        return cls(floats, ints, 2 * size + _FIGURES,
+                   _Route(size, bool(ints[_SCALED]), "kernel" if small else "nsgs-short"))
 
 
 class _Kept:
     """What :func:`solve_few` keeps on a problem it has solved: the problem's
     :meth:`~impactqp.FrictionContactProblem.state` it solved, whether by the ``"kernel"``
-    method (``small``), and from its second solve on
-    ``packed``: the problem packed by :func:`~impactqp.kernels.friction_packed.pack`
-    (floats, ints) and whether its units are not all 1, set in one assignment (a thread
-    solving the same problem sees all of it or none)."""
+    method (``small``), and from its second solve on ``packed``, a :class:`_Packed` set in
+    one assignment (a thread solving the same problem sees all of it or none)."""
 
     __slots__ = ("state", "small", "packed")
 
     def __init__(self, state: tuple, small: bool) -> None:
         self.state, self.small = state, small
-        self.packed: tuple[np.ndarray, np.ndarray, bool] | None = None
+        self.packed: _Packed | None = None
 
 
 def _given(problem: FrictionContactProblem) -> tuple:
