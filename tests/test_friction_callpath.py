@@ -19,6 +19,7 @@ import scipy.sparse as sp
 import impactqp as iq
 from benchmarks import friction_data
 from impactqp.errors import InputError, NonFiniteError, UnknownBackendError
+from impactqp.kernels.friction_tiny import CERTIFIED
 from impactqp.laws import friction_small
 from impactqp.laws.friction_small import SmallFrictionResult
 from impactqp.model.friction import certify_friction
@@ -199,3 +200,27 @@ def test_the_thin_result_reads_pickles_and_compares(form: str) -> None:
     assert replaced.iterations == 7 and replaced.ok and replaced.backend == "kernel"
     assert "_call" not in replaced.__dict__
     assert res == dataclasses.replace(res)
+
+
+def test_solves_from_the_pack_call_the_machine_code_its_first_solve_found() -> None:
+    """The pack's later solves skip numba's dispatch where the first found machine code for
+    its argument types, and fall back to the dispatcher (or the plain function) where there
+    is none: the same answers either way."""
+    from impactqp.kernels.friction_packed import solve_packed
+
+    problem = friction_data.load("FC2D-00394").problem
+    results = [iq.solve_friction(problem, tol=TOL) for _ in range(3)]
+    pack = problem.__dict__[friction_small._KEPT].packed
+    if hasattr(solve_packed, "overloads"):  # numba on (not NUMBA_DISABLE_JIT)
+        assert pack.call is not solve_packed and callable(pack.call)
+    out = np.empty(pack.out_size)
+    assert pack.call(pack.floats, pack.ints, TOL, out) == (results[2].iterations, CERTIFIED)
+    np.testing.assert_array_equal(out, results[2]._call[0])
+    np.testing.assert_array_equal(results[1].r, results[2].r)
+    other_types = (pack.floats.astype(np.float32), pack.ints, TOL, out)
+    assert friction_small._compiled(solve_packed, *other_types) is solve_packed
+
+    def plain(*args):
+        return args
+
+    assert friction_small._compiled(plain, *other_types) is plain

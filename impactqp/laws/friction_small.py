@@ -19,10 +19,12 @@ is built once with the pack (:class:`_Packed`), and the route takes no frame it 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import cached_property
 from time import perf_counter
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
+import numba
 import numpy as np
 
 from ..kernels.friction import kernel_mu
@@ -52,15 +54,7 @@ where it does not certify, the general route starts over, and it cost 2–3 % of
 time on the FCLib problems of 52 to 60 contacts (65 µs of 2.4 ms on Confeti-ex03)."""
 
 _new = object.__new__
-
-
-class _Route(NamedTuple):
-    """What the results of one problem's calls share: the unknowns d·m (``size``), whether
-    the problem was posed in other units than given (``scaled``) and the method's name."""
-
-    size: int
-    scaled: bool
-    backend: str
+_empty = np.empty
 
 
 class SmallFrictionResult(FrictionResult):
@@ -68,9 +62,11 @@ class SmallFrictionResult(FrictionResult):
     each read from the compiled call when first asked for.
 
     A new result holds one entry, ``_call``: (the array the call filled with r, u and the
-    certificate's figures, the tolerance, the iterations, the seconds, its :class:`_Route`);
-    a Python object's every further attribute costs about 25 ns to set and free, a tenth of
-    a solve again's Python. ``ok`` (hence ``success`` and ``status``) is the compiled call's
+    certificate's figures, the tolerance, the iterations, the seconds, the route), the route
+    (d·m, whether the problem was posed in other units than given, the method's name) shared
+    by the results of one pack. A Python object's every further attribute costs about 25 ns
+    to set and free, a tenth of a solve again's Python; a plain tuple, not a named one
+    (about 0.3 µs to make). ``ok`` (hence ``success`` and ``status``) is the compiled call's
     verdict on the figures it computed; ``certificate`` is the
     :class:`~impactqp.friction.FrictionCertificate` of the same figures, whose ``ok`` is that
     verdict (the same comparisons, NaN failing both).
@@ -83,18 +79,18 @@ class SmallFrictionResult(FrictionResult):
 
     @cached_property
     def r(self) -> np.ndarray:  # type: ignore[override]
-        out, _, _, _, route = self._call
-        return out[:route.size]
+        out, _, _, _, (size, _, _) = self._call
+        return out[:size]
 
     @cached_property
     def u(self) -> np.ndarray:  # type: ignore[override]
-        out, _, _, _, route = self._call
-        return out[route.size:2 * route.size]
+        out, _, _, _, (size, _, _) = self._call
+        return out[size:2 * size]
 
     @cached_property
     def certificate(self) -> FrictionCertificate:  # type: ignore[override]
-        out, tol, _, _, route = self._call
-        return friction_certificate(out[2 * route.size:], tol)
+        out, tol, _, _, (size, _, _) = self._call
+        return friction_certificate(out[2 * size:], tol)
 
     @cached_property
     def error(self) -> float:  # type: ignore[override]
@@ -110,13 +106,13 @@ class SmallFrictionResult(FrictionResult):
 
     @cached_property
     def backend(self) -> str:  # type: ignore[override]
-        return self._call[4].backend
+        return self._call[4][2]
 
     @cached_property
     def attempts(self) -> list[str]:  # type: ignore[override]
-        route = self._call[4]
-        note = ["solved in its contacts' units (2^0)"] if route.scaled else []
-        return [*note, f"{route.backend} (friction): certified"]
+        _, scaled, backend = self._call[4]
+        note = ["solved in its contacts' units (2^0)"] if scaled else []
+        return [*note, f"{backend} (friction): certified"]
 
 
 def solve_few(problem: FrictionContactProblem, tol: float, start: float,
@@ -148,9 +144,11 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float,
     if kept is not None and kept.small is small and problem.holds(kept.state):
         packed = kept.packed
         if packed is None:  # solved once: pack it
-            packed = kept.packed = _Packed.of(problem, small)  # one assignment
-        out = np.empty(packed.out_size)
-        its, outcome = solve_packed(packed.floats, packed.ints, tol, out)
+            packed, out, its, outcome = _pack(problem, small, tol)
+            kept.packed = packed  # one assignment
+        else:
+            out = _empty(packed.out_size)
+            its, outcome = packed.call(packed.floats, packed.ints, tol, out)
         route = packed.route
     else:
         problem.__dict__[_KEPT] = _Kept(problem.state(), small)
@@ -158,7 +156,7 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float,
         out = np.empty(2 * size + _FIGURES)
         W, rows, q, mu, d = _given(problem)
         its, outcome, scaled = solve_given(W, rows, q, mu, d, (tol, *_budgets(small)), out)
-        route = _Route(size, scaled, "kernel" if small else "nsgs-short")
+        route = (size, scaled, "kernel" if small else "nsgs-short")
     if outcome != CERTIFIED:
         return None
     result = _new(SmallFrictionResult)
@@ -168,22 +166,46 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float,
 
 class _Packed(NamedTuple):
     """A problem packed by :func:`~impactqp.kernels.friction_packed.pack` (``floats``,
-    ``ints``), the size of the array a solve of it fills, and the :class:`_Route` its
-    results share."""
+    ``ints``), the size of the array a solve of it fills, the route its results share (see
+    :class:`SmallFrictionResult`) and what solves it (:func:`_compiled`)."""
 
     floats: np.ndarray
     ints: np.ndarray
     out_size: int
-    route: _Route
+    route: tuple[int, bool, str]
+    call: Callable[..., tuple[int, int]]
 
-    @classmethod
-    def of(cls, problem: FrictionContactProblem, small: bool) -> _Packed:
-        """``problem`` packed for the ``"kernel"`` method (``small``) or the first sweep of
-        ``"nsgs-short"``."""
-        floats, ints = pack(*_given(problem), _budgets(small))
-        size = problem.q.size
-        return cls(floats, ints, 2 * size + _FIGURES,
-                   _Route(size, bool(ints[_SCALED]), "kernel" if small else "nsgs-short"))
+
+def _pack(problem: FrictionContactProblem, small: bool,
+          tol: float) -> tuple[_Packed, np.ndarray, int, int]:
+    """``problem`` packed for the ``"kernel"`` method (``small``) or the first sweep of
+    ``"nsgs-short"``, and its solve at ``tol`` through numba's dispatch (which compiles,
+    loads or interprets :func:`~impactqp.kernels.friction_packed.solve_packed` as it must):
+    the :class:`_Packed`, whose later solves call the machine code that call found, the array
+    the solve filled, its iterations and its outcome."""
+    floats, ints = pack(*_given(problem), _budgets(small))
+    size = problem.q.size
+    out = np.empty(2 * size + _FIGURES)
+    its, outcome = solve_packed(floats, ints, tol, out)
+    route = (size, bool(ints[_SCALED]), "kernel" if small else "nsgs-short")
+    packed = _Packed(floats, ints, out.size, route,
+                     _compiled(solve_packed, floats, ints, tol, out))
+    return packed, out, its, outcome
+
+
+def _compiled(dispatcher: Any, *args: Any) -> Callable:
+    """The machine code numba has compiled of ``dispatcher`` for the types of ``args``, to be
+    called on arguments of exactly those types without numba's dispatch (typing each
+    argument and finding the code: ~0.15 µs of a ~3 µs solve again, measured on
+    :func:`~impactqp.kernels.friction_packed.solve_packed`); ``dispatcher`` itself where
+    there is none (not compiled in this process: run as Python, or ``NUMBA_DISABLE_JIT``).
+
+    The caller must keep to the types: the machine code does not check them."""
+    try:
+        key = tuple(numba.typeof(a) for a in args)
+        return dispatcher.overloads[key].entry_point
+    except (AttributeError, KeyError):
+        return dispatcher
 
 
 class _Kept:
