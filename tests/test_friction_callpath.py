@@ -217,10 +217,34 @@ def test_solves_from_the_pack_call_the_machine_code_its_first_solve_found() -> N
     assert pack.call(pack.floats, pack.ints, TOL, out) == (results[2].iterations, CERTIFIED)
     np.testing.assert_array_equal(out, results[2]._call[0])
     np.testing.assert_array_equal(results[1].r, results[2].r)
-    other_types = (pack.floats.astype(np.float32), pack.ints, TOL, out)
-    assert friction_small._compiled(solve_packed, *other_types) is solve_packed
 
-    def plain(*args):
-        return args
 
-    assert friction_small._compiled(plain, *other_types) is plain
+def test_machine_code_is_found_once_where_there_is_some(monkeypatch) -> None:
+    """_compiled: a dispatcher with nothing compiled and a plain function are called as they
+    are; once compiled, the machine code for the arguments' types, found once (typing the
+    arguments again would cost a pack ~40 µs)."""
+    import numba
+
+    def plain(x):
+        return x
+
+    assert friction_small._compiled(plain, 1.0) is plain
+
+    @numba.njit
+    def twice(x):
+        return 2.0 * x
+
+    assert friction_small._compiled(twice, 1.0) is twice  # nothing compiled yet
+    assert twice(1.5) == 3.0
+    if numba.config.DISABLE_JIT:  # a plain function: nothing more to find
+        assert friction_small._compiled(twice, 1.0) is twice
+        return
+    code = friction_small._compiled(twice, 1.0)
+    assert code is not twice and code(4.0) == 8.0
+
+    def untyped(value):
+        raise AssertionError("typed again")
+
+    monkeypatch.setattr(numba, "typeof", untyped)
+    assert friction_small._compiled(twice, 1.0) is code  # found once
+    monkeypatch.delitem(friction_small._MACHINE_CODE, twice)

@@ -200,12 +200,23 @@ def _compiled(dispatcher: Any, *args: Any) -> Callable:
     :func:`~impactqp.kernels.friction_packed.solve_packed`); ``dispatcher`` itself where
     there is none (not compiled in this process: run as Python, or ``NUMBA_DISABLE_JIT``).
 
-    The caller must keep to the types: the machine code does not check them."""
-    try:
-        key = tuple(numba.typeof(a) for a in args)
-        return dispatcher.overloads[key].entry_point
-    except (AttributeError, KeyError):
-        return dispatcher
+    Found once per process and dispatcher (typing the arguments in Python takes ~40 µs):
+    every call must pass arguments of the same types, which the machine code does not
+    check."""
+    found = _MACHINE_CODE.get(dispatcher)
+    if found is None:
+        if not getattr(dispatcher, "overloads", None):  # nothing compiled (yet)
+            return dispatcher
+        try:
+            key = tuple(numba.typeof(a) for a in args)
+            found = _MACHINE_CODE[dispatcher] = dispatcher.overloads[key].entry_point
+        except (AttributeError, KeyError):
+            return dispatcher
+    return found
+
+
+_MACHINE_CODE: dict[Any, Callable] = {}
+"""What :func:`_compiled` has found, by dispatcher."""
 
 
 class _Kept:
