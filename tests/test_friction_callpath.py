@@ -87,14 +87,21 @@ def test_q_rewritten_in_place_after_packing_is_solved_as_it_now_is(name: str,
         problem.q[:] = problem.q * rng.uniform(0.5, 1.5, problem.q.size)
 
 
+@pytest.mark.parametrize("form", ["as it is", "csr", "coo", "dense"])
 @pytest.mark.parametrize("name", ["CubeH8", "FC3D-1c", "FC2D-00031"])
-def test_w_replaced_after_packing_is_solved_as_it_now_is(name: str) -> None:
-    """A new W object (here W scaled by 3, so every answer r is a third of the old one) is
-    solved for, not answered from the pack of the old W."""
+def test_w_replaced_after_packing_is_solved_as_it_now_is(name: str, form: str) -> None:
+    """A new W object (here W scaled by 3, so every answer r is a third of the old one; in
+    a sparse format the problem does not make itself, or dense) is solved for, not answered
+    from the pack of the old W."""
     problem = friction_data.load(name).problem
     for _ in range(3):
         old = iq.solve_friction(problem, tol=TOL)
-    problem.W = problem.W * 3.0
+    W = problem.W * 3.0
+    if form == "dense":
+        W = W.toarray() if sp.issparse(W) else W
+    elif form != "as it is":
+        W = getattr(sp, f"{form}_matrix")(W)
+    problem.W = W
     new = iq.solve_friction(problem, tol=TOL)
     assert certify_friction(problem, new.r, new.u, tol=TOL).ok
     np.testing.assert_allclose(new.r, old.r / 3.0, rtol=1e-9, atol=1e-12 * np.abs(old.r).max())
@@ -174,13 +181,14 @@ def test_every_route_gives_the_same_answer_again(backend: str) -> None:
         assert certify_friction(problem, res.r, res.u, tol=TOL).ok
 
 
-@pytest.mark.parametrize("form", ["dense", "csr", "coo"])
+@pytest.mark.parametrize("form", ["dense", "csr", "csc", "coo"])
 def test_the_thin_result_reads_pickles_and_compares(form: str) -> None:
     """Every FrictionResult attribute of a result from the pack, after pickling, and after
     dataclasses.replace (which makes a result of fields, no compiled call)."""
-    W = np.array([[2.0, 0.1, 0.2], [0.1, 1.5, 0.0], [0.2, 0.0, 1.2]])
-    W = W if form == "dense" else getattr(sp, f"{form}_matrix")(W)
+    W = np.array([[2.0, 0.3, 0.2], [0.1, 1.5, 0.0], [0.2, 0.05, 1.2]])  # not symmetric
     problem = iq.FrictionContactProblem(W, np.array([-1.0, 2.0, -1.0]), 0.3)
+    if form != "dense":  # as a caller may set it (the problem makes CSC of a sparse W)
+        problem.W = getattr(sp, f"{form}_matrix")(W)
     for _ in range(3):
         res = iq.solve_friction(problem, tol=TOL)
     assert packed(problem) and type(res) is SmallFrictionResult

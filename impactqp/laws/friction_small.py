@@ -243,10 +243,11 @@ def _given(problem: FrictionContactProblem) -> tuple:
         W = np.ascontiguousarray(W)
         rows = _DENSE
     else:
-        if W.format not in ("csr", "csc"):
-            W = W.tocsr()
+        form = W.format  # a property: ~0.1 µs a read
+        if form not in ("csr", "csc"):
+            W, form = W.tocsr(), "csr"
         rows = (W.indptr.astype(np.int32, copy=False), W.indices.astype(np.int32, copy=False),
-                np.asarray(W.data, dtype=float), W.format == "csc")
+                np.asarray(W.data, dtype=float), form == "csc")
         W = _NO_W
     return W, rows, problem.q, kernel_mu(problem.mu), problem.contact_dim
 
