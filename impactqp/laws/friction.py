@@ -90,6 +90,15 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
         few = solve_few(problem, tol, start, backend == "auto")
         if few is not None:
             return few
+    return _solve_general(problem, backend, tol, start)
+
+
+def _solve_general(problem: FrictionContactProblem, backend: str, tol: float,
+                   start: float) -> FrictionResult:
+    """:func:`solve_friction` by the registry's plan, ``start`` the ``perf_counter()`` of
+    the solve's start. Apart from :func:`solve_friction` so that its closure over
+    ``problem`` and ``tol`` (cells, ~0.1 µs a call) is not made on the route of a few
+    contacts."""
     # units and the registry's plan, in one Route
     route = plan_friction(problem, backend, lambda units: _finisher(problem, units, tol))
     note = () if route.units is None else (f"solved in its contacts' units (2^{route.units.k})",)
