@@ -210,27 +210,45 @@ def test_the_thin_result_reads_pickles_and_compares(form: str) -> None:
     assert res == dataclasses.replace(res)
 
 
-def test_solves_from_the_pack_call_the_machine_code_its_first_solve_found() -> None:
-    """The pack's later solves skip numba's dispatch where the first found machine code for
-    its argument types, and fall back to the dispatcher (or the plain function) where there
-    is none: the same answers either way."""
+def test_solves_from_a_pack_call_the_machine_code_a_first_solve_found() -> None:
+    """Once a pack's first solve found solve_packed's machine code, solves from a pack call
+    it without numba's dispatch: the same answers as through the dispatcher."""
     from impactqp.kernels.friction_packed import solve_packed
 
     problem = friction_data.load("FC2D-00394").problem
     results = [iq.solve_friction(problem, tol=TOL) for _ in range(3)]
     pack = problem.__dict__[friction_small._KEPT].packed
+    code = friction_small._solve_from_pack
     if hasattr(solve_packed, "overloads"):  # numba on (not NUMBA_DISABLE_JIT)
-        assert pack.call is not solve_packed and callable(pack.call)
-    out = np.empty(pack.out_size)
-    assert pack.call(pack.floats, pack.ints, TOL, out) == (results[2].iterations, CERTIFIED)
+        assert code is not solve_packed and callable(code)
+    out, again = np.empty(pack.out_size), np.empty(pack.out_size)
+    assert code(pack.floats, pack.ints, TOL, out) == (results[2].iterations, CERTIFIED)
+    assert solve_packed(pack.floats, pack.ints, TOL, again) == (results[2].iterations,
+                                                                CERTIFIED)
     np.testing.assert_array_equal(out, results[2]._call[0])
+    np.testing.assert_array_equal(again, out)
     np.testing.assert_array_equal(results[1].r, results[2].r)
 
 
-def test_machine_code_is_found_once_where_there_is_some(monkeypatch) -> None:
-    """_compiled: a dispatcher with nothing compiled and a plain function are called as they
-    are; once compiled, the machine code for the arguments' types, found once (typing the
-    arguments again would cost a pack ~40 µs)."""
+@pytest.mark.parametrize("solves", [1, 2, 3])
+def test_a_solved_problem_pickles_and_solves_as_before(solves: int) -> None:
+    """What the route keeps on a problem (its state, its pack) pickles with it, and the copy
+    is solved as the problem is."""
+    problem = friction_data.load("Rover11211").problem
+    for _ in range(solves):
+        res = iq.solve_friction(problem, tol=TOL)
+    copy = pickle.loads(pickle.dumps(problem))
+    for _ in range(3):
+        again = iq.solve_friction(copy, tol=TOL)
+        np.testing.assert_array_equal(again.r, res.r)
+    copy.q[:] = 2.0 * copy.q  # the copy's own q: its pack is made again, the original's kept
+    np.testing.assert_allclose(iq.solve_friction(copy, tol=TOL).r, 2.0 * res.r, rtol=1e-12)
+    np.testing.assert_array_equal(iq.solve_friction(problem, tol=TOL).r, res.r)
+
+
+def test_machine_code_is_found_where_there_is_some() -> None:
+    """_compiled: a dispatcher with nothing compiled and a plain function are returned as
+    they are; once compiled, the machine code for the arguments' types."""
     import numba
 
     def plain(x):
@@ -244,15 +262,9 @@ def test_machine_code_is_found_once_where_there_is_some(monkeypatch) -> None:
 
     assert friction_small._compiled(twice, 1.0) is twice  # nothing compiled yet
     assert twice(1.5) == 3.0
-    if numba.config.DISABLE_JIT:  # a plain function: nothing more to find
-        assert friction_small._compiled(twice, 1.0) is twice
-        return
     code = friction_small._compiled(twice, 1.0)
-    assert code is not twice and code(4.0) == 8.0
-
-    def untyped(value):
-        raise AssertionError("typed again")
-
-    monkeypatch.setattr(numba, "typeof", untyped)
-    assert friction_small._compiled(twice, 1.0) is code  # found once
-    monkeypatch.delitem(friction_small._MACHINE_CODE, twice)
+    if numba.config.DISABLE_JIT:  # a plain function: nothing more to find
+        assert code is twice
+    else:
+        assert code is not twice and code(4.0) == 8.0
+        assert friction_small._compiled(twice, np.ones(2)) is twice  # no code for an array

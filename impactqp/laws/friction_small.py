@@ -15,8 +15,8 @@ A solve again of a 1-contact problem takes about 3 µs, of which the compiled ca
 1.4 µs and the Python around it (the checks, the problem's state, the result) the rest, so
 each step of the path is counted: the result is one entry in a new object's dictionary
 (:class:`SmallFrictionResult`), what a pack's solves share is built once with the pack
-(:class:`_Packed`), among it the machine code they call without numba's dispatch
-(:func:`_compiled`), and the route takes no frame it does not need.
+(:class:`_Packed`), the machine code they call is found once, to be called without numba's
+dispatch (:data:`_solve_from_pack`), and the route takes no frame it does not need.
 """
 
 from __future__ import annotations
@@ -150,7 +150,7 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float,
             kept.packed = packed  # one assignment
         else:
             out = _empty(packed.out_size)
-            its, outcome = packed.call(packed.floats, packed.ints, tol, out)
+            its, outcome = _solve_from_pack(packed.floats, packed.ints, tol, out)
         route = packed.route
     else:
         problem.__dict__[_KEPT] = _Kept(problem.state(), small)
@@ -168,57 +168,56 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float,
 
 class _Packed(NamedTuple):
     """A problem packed by :func:`~impactqp.kernels.friction_packed.pack` (``floats``,
-    ``ints``), the size of the array a solve of it fills, the route its results share (see
-    :class:`SmallFrictionResult`) and what solves it (:func:`_compiled`)."""
+    ``ints``), the size of the array a solve of it fills and the route its results share
+    (see :class:`SmallFrictionResult`)."""
 
     floats: np.ndarray
     ints: np.ndarray
     out_size: int
     route: tuple[int, bool, str]
-    call: Callable[..., tuple[int, int]]
 
 
 def _pack(problem: FrictionContactProblem, small: bool,
           tol: float) -> tuple[_Packed, np.ndarray, int, int]:
     """``problem`` packed for the ``"kernel"`` method (``small``) or the first sweep of
     ``"nsgs-short"``, and its solve at ``tol`` through numba's dispatch (which compiles,
-    loads or interprets :func:`~impactqp.kernels.friction_packed.solve_packed` as it must):
-    the :class:`_Packed`, whose later solves call the machine code that call found, the array
-    the solve filled, its iterations and its outcome."""
+    loads or interprets :func:`~impactqp.kernels.friction_packed.solve_packed` as it must,
+    and from which :data:`_solve_from_pack` takes the machine code): the :class:`_Packed`,
+    the array the solve filled, its iterations and its outcome."""
+    global _solve_from_pack
     floats, ints = pack(*_given(problem), _budgets(small))
     size = problem.q.size
     out = np.empty(2 * size + _FIGURES)
     its, outcome = solve_packed(floats, ints, tol, out)
+    if _solve_from_pack is solve_packed:
+        _solve_from_pack = _compiled(solve_packed, floats, ints, tol, out)
     route = (size, bool(ints[_SCALED]), "kernel" if small else "nsgs-short")
-    packed = _Packed(floats, ints, out.size, route,
-                     _compiled(solve_packed, floats, ints, tol, out))
-    return packed, out, its, outcome
+    return _Packed(floats, ints, out.size, route), out, its, outcome
 
 
 def _compiled(dispatcher: Any, *args: Any) -> Callable:
     """The machine code numba has compiled of ``dispatcher`` for the types of ``args``, to be
-    called on arguments of exactly those types without numba's dispatch (typing each
-    argument and finding the code: ~0.15 µs of a ~3 µs solve again, measured on
-    :func:`~impactqp.kernels.friction_packed.solve_packed`); ``dispatcher`` itself where
-    there is none (not compiled in this process: run as Python, or ``NUMBA_DISABLE_JIT``).
-
-    Found once per process and dispatcher (typing the arguments in Python takes ~40 µs):
-    every call must pass arguments of the same types, which the machine code does not
-    check."""
-    found = _MACHINE_CODE.get(dispatcher)
-    if found is None:
-        if not getattr(dispatcher, "overloads", None):  # nothing compiled (yet)
-            return dispatcher
-        try:
-            key = tuple(numba.typeof(a) for a in args)
-            found = _MACHINE_CODE[dispatcher] = dispatcher.overloads[key].entry_point
-        except (AttributeError, KeyError):
-            return dispatcher
-    return found
+    called on arguments of exactly those types, which it does not check, without numba's
+    dispatch; ``dispatcher`` itself where there is none (not compiled in this process:
+    run as Python, or ``NUMBA_DISABLE_JIT``). Typing the arguments in Python takes ~40 µs:
+    a caller keeps what it found."""
+    if not getattr(dispatcher, "overloads", None):  # nothing compiled (yet)
+        return dispatcher
+    try:
+        return dispatcher.overloads[tuple(numba.typeof(a) for a in args)].entry_point
+    except (AttributeError, KeyError):
+        return dispatcher
 
 
-_MACHINE_CODE: dict[Any, Callable] = {}
-"""What :func:`_compiled` has found, by dispatcher."""
+_solve_from_pack: Callable[..., tuple[int, int]] = solve_packed
+"""What solves a pack (:func:`solve_few`): :func:`~impactqp.kernels.friction_packed.solve_packed`
+through numba's dispatch until a pack's first solve (:func:`_pack`) finds its machine code
+(:func:`_compiled`), that code from then on, called without the dispatch (typing each
+argument and finding the code: ~0.15 µs of a ~3 µs solve again). Every argument of a solve
+from a pack is of the types that code was compiled for: the pack's two arrays
+(:func:`~impactqp.kernels.friction_packed.pack` makes them), the float ``tol``
+(:func:`~impactqp.base.arrays.check_tol`) and a new float array. Kept in the module, not on
+the problem: a problem with its pack still pickles."""
 
 
 class _Kept:
