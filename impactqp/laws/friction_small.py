@@ -44,8 +44,9 @@ _DENSE = (np.empty(0, dtype=np.int32), np.empty(0, dtype=np.int32), np.empty(0),
 _NO_W = np.empty((0, 0))
 """The ``W`` of :func:`~impactqp.kernels.friction_packed.solve_given` for a compressed W."""
 _FIGURES = len(FRICTION_FIGURES)
-_KEPT = "_packed_few"
-"""The attribute of a problem :func:`solve_few` has solved, a :class:`_Kept`."""
+_KEPT = "_kept"
+"""The attribute of a problem :func:`solve_few` has solved, a :class:`_Kept`
+(:attr:`FrictionContactProblem._kept <impactqp.model.friction.FrictionContactProblem._kept>`)."""
 _SCALED = 4
 """The entry of a packed problem's integer array that says whether its units are not all 1
 (:data:`~impactqp.kernels.friction_packed.PACKED_HEADER`)."""
@@ -142,7 +143,7 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float,
     small = m <= methods.SMALL_CONTACTS  # the "kernel" method's own limit
     if not (small or (sweeps and m <= SWEPT_CONTACTS)):
         return None
-    kept = problem.__dict__.get(_KEPT)
+    kept = problem._kept
     if kept is not None and kept.small is small and problem.holds(kept.state):
         packed = kept.packed
         if packed is None:  # solved once: pack it
@@ -153,7 +154,7 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float,
             its, outcome = _solve_from_pack(packed.floats, packed.ints, tol, out)
         route = packed.route
     else:
-        problem.__dict__[_KEPT] = _Kept(problem.state(), small)
+        problem._kept = _Kept(problem.state(), small)
         size = problem.q.size
         out = np.empty(2 * size + _FIGURES)
         W, rows, q, mu, d = _given(problem)
