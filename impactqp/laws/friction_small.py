@@ -11,8 +11,8 @@ into Python objects at the call: the :class:`SmallFrictionResult` holds the arra
 filled (r, u and the certificate's figures) and builds the certificate, the error and the
 attempts from it when they are read.
 
-A solve again of a 1-contact problem takes about 3 µs, of which the compiled call about
-1.4 µs and the Python around it (the checks, the problem's state, the result) the rest, so
+A solve again of a 1-contact problem takes about 2.5 µs, of which the compiled call about
+1.3 µs and the Python around it (the checks, the problem's state, the result) the rest, so
 each step of the path is counted: the result is one entry in a new object's dictionary
 (:class:`SmallFrictionResult`), what a pack's solves share is built once with the pack
 (:class:`_Packed`), the machine code they call is found once, to be called without numba's
