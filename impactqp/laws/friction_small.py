@@ -10,13 +10,23 @@ verdict. A problem solved again is solved from the pack its second solve keeps o
 into Python objects at the call: the :class:`SmallFrictionResult` holds the array the call
 filled (r, u and the certificate's figures) and builds the certificate, the error and the
 attempts from it when they are read.
+
+A solve again of a 1-contact problem takes about 2.5 µs, of which the compiled call about
+1.3 µs and the Python around it (the checks, the problem's state, the result) the rest, so
+each step of the path is counted: the result is one entry in a new object's dictionary
+(:class:`SmallFrictionResult`), what a pack's solves share is built once with the pack
+(:class:`_Packed`), the machine code they call is found once, to be called without numba's
+dispatch (:data:`_solve_from_pack`), and the route takes no frame it does not need.
 """
 
 from __future__ import annotations
 
-import time
+from collections.abc import Callable
 from functools import cached_property
+from time import perf_counter
+from typing import Any, NamedTuple
 
+import numba
 import numpy as np
 
 from ..kernels.friction import kernel_mu
@@ -34,8 +44,9 @@ _DENSE = (np.empty(0, dtype=np.int32), np.empty(0, dtype=np.int32), np.empty(0),
 _NO_W = np.empty((0, 0))
 """The ``W`` of :func:`~impactqp.kernels.friction_packed.solve_given` for a compressed W."""
 _FIGURES = len(FRICTION_FIGURES)
-_KEPT = "_packed_few"
-"""The attribute of a problem :func:`solve_few` has solved, a :class:`_Kept`."""
+_KEPT = "_kept"
+"""The attribute of a problem :func:`solve_few` has solved, a :class:`_Kept`
+(:attr:`FrictionContactProblem._kept <impactqp.model.friction.FrictionContactProblem._kept>`)."""
 _SCALED = 4
 """The entry of a packed problem's integer array that says whether its units are not all 1
 (:data:`~impactqp.kernels.friction_packed.PACKED_HEADER`)."""
@@ -45,61 +56,69 @@ whose first sweep :func:`solve_few` tries in one compiled call before the genera
 where it does not certify, the general route starts over, and it cost 2–3 % of that route's
 time on the FCLib problems of 52 to 60 contacts (65 µs of 2.4 ms on Confeti-ex03)."""
 
+_new = object.__new__
+_empty = np.empty
+
 
 class SmallFrictionResult(FrictionResult):
-    """A :class:`~impactqp.friction.FrictionResult` of :func:`solve_few`: the same attributes, those
-    the verdict does not need read from the compiled call's array when first asked for.
+    """A :class:`~impactqp.friction.FrictionResult` of :func:`solve_few`: the same attributes,
+    each read from the compiled call when first asked for.
 
-    ``ok`` (hence ``success`` and ``status``) is the compiled call's verdict on the figures
-    it computed; ``certificate`` is the :class:`~impactqp.friction.FrictionCertificate` of the same
-    figures, whose ``ok`` is that verdict (the same comparisons, NaN failing both).
+    A new result holds one entry, ``_call``: (the array the call filled with r, u and the
+    certificate's figures, the tolerance, the iterations, the seconds, the route), the route
+    (d·m, whether the problem was posed in other units than given, the method's name) shared
+    by the results of one pack. A Python object's every further attribute costs about 25 ns
+    to set and free, a tenth of a solve again's Python; a plain tuple, not a named one
+    (about 0.3 µs to make). ``ok`` (hence ``success`` and ``status``) is the compiled call's
+    verdict on the figures it computed; ``certificate`` is the
+    :class:`~impactqp.friction.FrictionCertificate` of the same figures, whose ``ok`` is that
+    verdict (the same comparisons, NaN failing both).
     """
-
-    @classmethod
-    def of_call(cls, out: np.ndarray, size: int, tol: float, iterations: int,
-                seconds: float, scaled: bool, backend: str) -> SmallFrictionResult:
-        """The result of a certified call of ``backend``'s method: ``out`` holds r, u
-        (``size`` each) and the figures; ``scaled`` whether the problem was posed in other
-        units than given."""
-        result = cls.__new__(cls)
-        fields = result.__dict__  # item by item: cheaper than update(**fields) by ~0.15 µs
-        fields["_out"] = out
-        fields["_size"] = size
-        fields["_tol"] = tol
-        fields["_scaled"] = scaled
-        fields["iterations"] = iterations
-        fields["solve_time"] = seconds
-        fields["backend"] = backend
-        return result
 
     @property
     def ok(self) -> bool:
         """True: only a certified call makes this result (``certificate.ok`` says the same)."""
-        return "_out" in self.__dict__ or self.certificate.ok
+        return "_call" in self.__dict__ or self.certificate.ok
 
     @cached_property
     def r(self) -> np.ndarray:  # type: ignore[override]
-        return self._out[:self._size]
+        out, _, _, _, (size, _, _) = self._call
+        return out[:size]
 
     @cached_property
     def u(self) -> np.ndarray:  # type: ignore[override]
-        return self._out[self._size:2 * self._size]
+        out, _, _, _, (size, _, _) = self._call
+        return out[size:2 * size]
 
     @cached_property
     def certificate(self) -> FrictionCertificate:  # type: ignore[override]
-        return friction_certificate(self._out[2 * self._size:], self._tol)
+        out, tol, _, _, (size, _, _) = self._call
+        return friction_certificate(out[2 * size:], tol)
 
     @cached_property
     def error(self) -> float:  # type: ignore[override]
         return self.certificate.error
 
     @cached_property
+    def iterations(self) -> int:  # type: ignore[override]
+        return self._call[2]
+
+    @cached_property
+    def solve_time(self) -> float:  # type: ignore[override]
+        return self._call[3]
+
+    @cached_property
+    def backend(self) -> str:  # type: ignore[override]
+        return self._call[4][2]
+
+    @cached_property
     def attempts(self) -> list[str]:  # type: ignore[override]
-        note = ["solved in its contacts' units (2^0)"] if self._scaled else []
-        return [*note, f"{self.backend} (friction): certified"]
+        _, scaled, backend = self._call[4]
+        note = ["solved in its contacts' units (2^0)"] if scaled else []
+        return [*note, f"{backend} (friction): certified"]
 
 
-def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
+def solve_few(problem: FrictionContactProblem, tol: float, start: float,
               sweeps: bool = True) -> SmallFrictionResult | None:
     """The certified answer of one compiled call
     (:func:`impactqp.kernels.friction_packed.solve_given`), ``start`` the
@@ -117,44 +136,102 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float, *,
     start from it (:func:`~impactqp.kernels.friction_packed.solve_packed`). The first solve
     packs nothing (a simulator poses a new problem at each step), and a problem that no
     longer :meth:`~impactqp.FrictionContactProblem.holds` the state it was packed in (q
-    rewritten, W or μ replaced) is solved from its arrays and packed again.
+    rewritten, W or μ replaced) is solved from its arrays and packed again. Every call fills
+    an array of its own: a result is never changed by a later solve.
     """
     m = problem.n_contacts
     small = m <= methods.SMALL_CONTACTS  # the "kernel" method's own limit
     if not (small or (sweeps and m <= SWEPT_CONTACTS)):
         return None
-    out = np.empty(2 * problem.q.size + _FIGURES)
-    kept = problem.__dict__.get(_KEPT)
-    if kept is None or kept.small is not small or not problem.holds(kept.state):
-        problem.__dict__[_KEPT] = _Kept(problem.state(), small)
-        its, outcome, scaled = solve_given(*_given(problem), (tol, *_budgets(small)), out)
-    else:
+    kept = problem._kept
+    if kept is not None and kept.small is small and problem.holds(kept.state):
         packed = kept.packed
         if packed is None:  # solved once: pack it
-            floats, ints = pack(*_given(problem), _budgets(small))
-            packed = kept.packed = (floats, ints, bool(ints[_SCALED]))  # one assignment
-        its, outcome = solve_packed(packed[0], packed[1], tol, out)
-        scaled = packed[2]
+            packed, out, its, outcome = _pack(problem, small, tol)
+            kept.packed = packed  # one assignment
+        else:
+            out = _empty(packed.out_size)
+            its, outcome = _solve_from_pack(packed.floats, packed.ints, tol, out)
+        route = packed.route
+    else:
+        problem._kept = _Kept(problem.state(), small)
+        size = problem.q.size
+        out = np.empty(2 * size + _FIGURES)
+        W, rows, q, mu, d = _given(problem)
+        its, outcome, scaled = solve_given(W, rows, q, mu, d, (tol, *_budgets(small)), out)
+        route = (size, scaled, "kernel" if small else "nsgs-short")
     if outcome != CERTIFIED:
         return None
-    return SmallFrictionResult.of_call(out, problem.q.size, tol, its,
-                                       time.perf_counter() - start, scaled,
-                                       "kernel" if small else "nsgs-short")
+    result = _new(SmallFrictionResult)
+    result.__dict__["_call"] = (out, tol, its, perf_counter() - start, route)
+    return result
+
+
+class _Packed(NamedTuple):
+    """A problem packed by :func:`~impactqp.kernels.friction_packed.pack` (``floats``,
+    ``ints``), the size of the array a solve of it fills and the route its results share
+    (see :class:`SmallFrictionResult`)."""
+
+    floats: np.ndarray
+    ints: np.ndarray
+    out_size: int
+    route: tuple[int, bool, str]
+
+
+def _pack(problem: FrictionContactProblem, small: bool,
+          tol: float) -> tuple[_Packed, np.ndarray, int, int]:
+    """``problem`` packed for the ``"kernel"`` method (``small``) or the first sweep of
+    ``"nsgs-short"``, and its solve at ``tol`` through numba's dispatch (which compiles,
+    loads or interprets :func:`~impactqp.kernels.friction_packed.solve_packed` as it must,
+    and from which :data:`_solve_from_pack` takes the machine code): the :class:`_Packed`,
+    the array the solve filled, its iterations and its outcome."""
+    global _solve_from_pack
+    floats, ints = pack(*_given(problem), _budgets(small))
+    size = problem.q.size
+    out = np.empty(2 * size + _FIGURES)
+    its, outcome = solve_packed(floats, ints, tol, out)
+    if _solve_from_pack is solve_packed:
+        _solve_from_pack = _compiled(solve_packed, floats, ints, tol, out)
+    route = (size, bool(ints[_SCALED]), "kernel" if small else "nsgs-short")
+    return _Packed(floats, ints, out.size, route), out, its, outcome
+
+
+def _compiled(dispatcher: Any, *args: Any) -> Callable:
+    """The machine code numba has compiled of ``dispatcher`` for the types of ``args``, to be
+    called on arguments of exactly those types, which it does not check, without numba's
+    dispatch; ``dispatcher`` itself where there is none (not compiled in this process:
+    run as Python, or ``NUMBA_DISABLE_JIT``). Typing the arguments in Python takes ~40 µs:
+    a caller keeps what it found."""
+    if not getattr(dispatcher, "overloads", None):  # nothing compiled (yet)
+        return dispatcher
+    try:
+        return dispatcher.overloads[tuple(numba.typeof(a) for a in args)].entry_point
+    except (AttributeError, KeyError):
+        return dispatcher
+
+
+_solve_from_pack: Callable[..., tuple[int, int]] = solve_packed
+"""What solves a pack (:func:`solve_few`): :func:`~impactqp.kernels.friction_packed.solve_packed`
+through numba's dispatch until a pack's first solve (:func:`_pack`) finds its machine code
+(:func:`_compiled`), that code from then on, called without the dispatch (typing each
+argument and finding the code: ~0.15 µs of a ~3 µs solve again). Every argument of a solve
+from a pack is of the types that code was compiled for: the pack's two arrays
+(:func:`~impactqp.kernels.friction_packed.pack` makes them), the float ``tol``
+(:func:`~impactqp.base.arrays.check_tol`) and a new float array. Kept in the module, not on
+the problem: a problem with its pack still pickles."""
 
 
 class _Kept:
     """What :func:`solve_few` keeps on a problem it has solved: the problem's
     :meth:`~impactqp.FrictionContactProblem.state` it solved, whether by the ``"kernel"``
-    method (``small``), and from its second solve on
-    ``packed``: the problem packed by :func:`~impactqp.kernels.friction_packed.pack`
-    (floats, ints) and whether its units are not all 1, set in one assignment (a thread
-    solving the same problem sees all of it or none)."""
+    method (``small``), and from its second solve on ``packed``, a :class:`_Packed` set in
+    one assignment (a thread solving the same problem sees all of it or none)."""
 
     __slots__ = ("state", "small", "packed")
 
     def __init__(self, state: tuple, small: bool) -> None:
         self.state, self.small = state, small
-        self.packed: tuple[np.ndarray, np.ndarray, bool] | None = None
+        self.packed: _Packed | None = None
 
 
 def _given(problem: FrictionContactProblem) -> tuple:
@@ -166,10 +243,11 @@ def _given(problem: FrictionContactProblem) -> tuple:
         W = np.ascontiguousarray(W)
         rows = _DENSE
     else:
-        if W.format not in ("csr", "csc"):
-            W = W.tocsr()
+        form = W.format  # a property: ~0.1 µs a read
+        if form not in ("csr", "csc"):
+            W, form = W.tocsr(), "csr"
         rows = (W.indptr.astype(np.int32, copy=False), W.indices.astype(np.int32, copy=False),
-                np.asarray(W.data, dtype=float), W.format == "csc")
+                np.asarray(W.data, dtype=float), form == "csc")
         W = _NO_W
     return W, rows, problem.q, kernel_mu(problem.mu), problem.contact_dim
 

@@ -33,7 +33,6 @@ QUANTITY_RANGE = (1e-100, 1e100)
 it, in units of a power of two near max|q̃ᵢ| (docs/theory.md §15)."""
 
 
-
 def friction_coefficients(value: Any, n_contacts: int, name: str = "mu") -> np.ndarray:
     """Friction coefficients as one per contact: a number spread over the contacts or an
     (m,) array, each finite and ≥ 0.
@@ -84,6 +83,10 @@ class FrictionContactProblem:
     solve (:meth:`holds`). W edited in place is not seen: give a new W a new problem.
     """
 
+    _kept: Any = None
+    """What a route keeps with the :meth:`state` it was made for (the few-contact route's pack,
+    laws/friction_small.py); a class default: reading it builds no ``__dict__``."""
+
     def __init__(self, W, q, mu, *, contact_dim: int = 3) -> None:
         d = as_count("contact_dim", contact_dim)
         if d not in (2, 3):
@@ -98,11 +101,8 @@ class FrictionContactProblem:
             raise ShapeError(f"W must have shape ({n}, {n}) to match q, got {W.shape}")
         m = n // d
         mu = friction_coefficients(mu, m)
-        self.W = W
-        self.q = q
-        self.mu = mu
-        self.contact_dim = d
-        self.n_contacts = m
+        self.W, self.q, self.mu = W, q, mu
+        self.contact_dim, self.n_contacts = d, m
         self._units: ContactUnits | None = None
         self._units_state: tuple | None = None
 
