@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from .base.arrays import as_count, check_tol
+from .base.checks import FRICTION_TOL
 from .errors import InputError
 from .io.collection import (
     STATUSES,
@@ -85,7 +86,7 @@ class CollectionRun:
 
 def run_collection(folder: str | Path, output: str | Path, *,
                    methods: str | Sequence[str] = ("auto",), time_limit: float | None = None,
-                   tol: float = 1e-8, n_jobs: int = 1, scheduler: str | None = None,
+                   tol: float = FRICTION_TOL, n_jobs: int = 1, scheduler: str | None = None,
                    client: Any = None,
                    on_record: Callable[[Record], None] | None = None) -> CollectionRun:
     """Solve every problem file of ``folder`` with each of ``methods``, recording each outcome

@@ -20,6 +20,7 @@ from time import perf_counter
 import numpy as np
 
 from ..base.arrays import check_tol
+from ..base.checks import FRICTION_TOL
 from ..errors import CertificateError, InputError, OutOfRangeError
 from ..model.friction import (
     ContactUnits,
@@ -42,7 +43,7 @@ FRICTION_BACKENDS = ("auto", *backends.serving(backends.FRICTION))
 
 
 def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
-                   tol: float = 1e-8) -> FrictionResult:
+                   tol: float = FRICTION_TOL) -> FrictionResult:
     """Solve u = W r + q, r_c ∈ K_μc ⟂ u_c + μ_c‖u_T,c‖e_n ∈ K*_μc with a certificate
     (docs/theory.md §15), in the problem's contacts' units
     (:meth:`~impactqp.FrictionContactProblem.in_contact_units`): r and u are scaled back and

@@ -18,7 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..base.arrays import as_array, as_count, as_matrix, check_tol
-from ..base.checks import Certificate
+from ..base.checks import FRICTION_TOL, Certificate
 from ..errors import InputError, OutOfRangeError, ShapeError
 from ..kernels.coulomb_certificate import FRICTION_FIGURES, friction_figures
 from ..kernels.friction import kernel_mu, natural_map
@@ -295,7 +295,7 @@ def _candidate(name: str, value, n: int) -> np.ndarray:
 
 
 def certify_friction(problem: FrictionContactProblem, r, u=None, *,
-                     tol: float = 1e-8) -> Certificate:
+                     tol: float = FRICTION_TOL) -> Certificate:
     """Recompute the certificate of a candidate reaction ``r`` (and velocity ``u``) in the
     problem's contacts' units (docs/theory.md §15): r̂, û and q̂ of
     :meth:`FrictionContactProblem.in_contact_units`, û = W̃ r̂ + q̂ recomputed.

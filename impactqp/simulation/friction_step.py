@@ -20,7 +20,7 @@ from functools import cached_property, partial
 import numpy as np
 import scipy.sparse as sp
 
-from ..base.checks import Certificate
+from ..base.checks import FRICTION_TOL, Certificate
 from ..errors import CertificateError, InputError, ShapeError
 from ..kernels.friction import project_cones
 from ..kernels.step import gather_local, step_q
@@ -185,7 +185,7 @@ class FrictionSolver:
     """
 
     def __init__(self, system: LinearSystem, free, law: Coulomb, *, backend: str = "auto",
-                 tol: float = 1e-8) -> None:
+                 tol: float = FRICTION_TOL) -> None:
         self.system, self.free = system, free
         self.mu, self.e = coulomb_coefficients(law, system)
         self.backend, self.tol = check_friction_backend(step_backend(law, backend)), tol

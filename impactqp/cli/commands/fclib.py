@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from ...base.checks import FRICTION_TOL
 from ...io.fclib import load_fclib
 from ...laws.friction import FRICTION_BACKENDS, FrictionResult, solve_friction
 from ...model.friction import FrictionContactProblem
@@ -66,7 +67,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                                 "file (.dat, .dat.gz)")
     p.add_argument("--backend", default="auto", choices=FRICTION_BACKENDS,
                    help="method of solve_friction (default auto)")
-    p.add_argument("--tol", type=float, default=1e-8,
-                   help="tolerance of the certificate, ‖F‖/‖q‖ among others (default 1e-8)")
+    p.add_argument("--tol", type=float, default=FRICTION_TOL,
+                   help="tolerance of the certificate, ‖F‖/‖q‖ among others (default "
+                        f"{FRICTION_TOL:g})")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=run)
