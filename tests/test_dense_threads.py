@@ -5,9 +5,9 @@ round-off.
 OpenBLAS runs LAPACK's ``trtrs`` on its thread pool at every size: on a loaded machine the
 caller then waits milliseconds for a worker to be scheduled, and the worker spinning after
 the job slows the caller's next BLAS calls. The structure solves with BLAS's ``trsm``, which
-OpenBLAS keeps in the calling thread below 1024 entries of the right-hand side. The test
-below watches the thread pools themselves: a worker that took a job went to sleep again
-afterwards (a voluntary context switch in /proc).
+OpenBLAS keeps in the calling thread below 1024 entries of the right-hand side, in blocks of
+columns that size for a small problem. The last test watches the thread pools themselves: a
+worker that took a job went to sleep again afterwards (a voluntary context switch in /proc).
 """
 
 import os
@@ -20,6 +20,7 @@ import pytest
 from scipy.linalg import lapack
 
 import impactqp as iq
+from impactqp.base.cholesky import SMALL, cholesky_solve
 
 EPS = np.finfo(float).eps
 
@@ -32,7 +33,8 @@ def _spd(rng, n, cond):
 
 
 @pytest.mark.parametrize("cond", [1.0, 1e6, 1e12])
-@pytest.mark.parametrize("n, m", [(2, 1), (3, 2), (20, 10), (30, 34), (40, 30), (12, 90)])
+@pytest.mark.parametrize("n, m", [(2, 1), (3, 2), (20, 10), (30, 34), (40, 30), (64, 64),
+                                  (12, 90), (70, 40)])
 def test_operators_of_the_cholesky_factor(n, m, cond):
     """B = L⁻¹W, M⁻¹W and G against their definitions (backward errors, independent of the
     order of the arithmetic) and against LAPACK's trtrs/potrs to round-off, W given in either
@@ -57,6 +59,24 @@ def test_operators_of_the_cholesky_factor(n, m, cond):
         forward = 8 * n * EPS * np.sqrt(cond)  # cond(L) = √cond(M)
         assert np.abs(B - B_ref).max() <= forward * np.abs(B_ref).max()
         assert np.abs(X - X_ref).max() <= forward * np.sqrt(cond) * np.abs(X_ref).max()
+
+
+@pytest.mark.parametrize("n", [1, 7, 33, SMALL, SMALL + 1])
+def test_cholesky_solve_every_width(n):
+    """L⁻¹X and L⁻ᵀX for every column count up to SMALL + 1 (each way the columns split
+    into blocks, a last block of one column included) against LAPACK's trtrs, to
+    round-off; X is left as it was."""
+    rng = np.random.default_rng(n)
+    M = _spd(rng, n, 1e4)
+    L = lapack.dpotrf(M, lower=1, clean=1)[0]
+    for m in range(1, SMALL + 2):
+        X = rng.standard_normal((n, m))
+        kept = X.copy()
+        for transpose in (False, True):
+            Y = cholesky_solve(L, X, transpose)
+            ref = lapack.dtrtrs(L, X, lower=1, trans=int(transpose))[0]
+            assert np.abs(Y - ref).max() <= 1e-12 * np.abs(ref).max(), (m, transpose)
+        assert np.array_equal(X, kept)
 
 
 def test_solve_with_the_structure_matches_a_dense_kkt_solve():
@@ -134,8 +154,9 @@ def _woken(call, *args, watched=None, times=1) -> set[int]:
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/task")
 def test_small_dense_problems_stay_in_the_calling_thread():
-    """Building a 20 × 10 (and a 30 × 30) dense problem and its first Moreau, Newton and
-    Frémond solves and derivative wake no BLAS worker, neither scipy's pool nor numpy's."""
+    """Building a dense problem of up to SMALL = 64 degrees of freedom and columns of W and
+    its first Moreau, Newton and Frémond solves and derivative wake no BLAS worker, neither
+    scipy's pool nor numpy's (40 × 30 and 64 × 64 solve W in blocks)."""
     rng = np.random.default_rng(0)
     L = np.linalg.cholesky(_spd(rng, 8, 10.0))
     W = rng.standard_normal((8, 4))
@@ -147,7 +168,7 @@ def test_small_dense_problems_stay_in_the_calling_thread():
         pytest.skip("no BLAS thread pool to watch (one thread, or a BLAS that runs these "
                     "calls in the caller)")
     problems = []
-    for n, m in ((20, 10), (30, 30)):
+    for n, m in ((20, 10), (40, 30), (SMALL, SMALL)):
         p = iq.random_impact(n, m, seed=3)
         problems.append((np.array(p.structure.M), np.array(p.structure.W), p.u_minus.copy()))
     flows = {

@@ -15,9 +15,10 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from scipy.linalg import blas, lapack
+from scipy.linalg import lapack
 
 from ..base.arrays import Matrix, as_dense, as_matrix
+from ..base.cholesky import cholesky_solve
 from ..base.definite import symmetric_ldl
 from ..base.rowwise import row_max, row_sum
 from ..errors import MassMatrixError, ShapeError
@@ -259,14 +260,8 @@ class ImpactStructure:
 
     @cached_property
     def scaled_W(self) -> np.ndarray:
-        """B = L⁻¹W, so that G = BᵀB (dense problems): the basis of the NNLS paths.
-
-        BLAS's ``trsm`` rather than LAPACK's ``trtrs``, the same arithmetic to the bit:
-        OpenBLAS runs its ``trtrs`` on its thread pool at every size (a loaded machine then
-        keeps the caller waiting milliseconds for a worker to be scheduled), its ``trsm``
-        only from 1024 entries of W on, where the threads pay. A successful Cholesky factor
-        has no zero pivot, the one failure ``trtrs`` would report."""
-        return blas.dtrsm(1.0, self.cholesky_factor, self.W, lower=1)
+        """B = L⁻¹W, so that G = BᵀB (dense problems): the basis of the NNLS paths."""
+        return cholesky_solve(self.cholesky_factor, self.W)
 
     @cached_property
     def Minv_W(self) -> Matrix:
@@ -274,7 +269,7 @@ class ImpactStructure:
         if self.sparse and self.diagonal_mass:
             return sp.csc_matrix(sp.diags(1.0 / self._diag) @ self.W)
         if not self.sparse and self._diag is None:  # L⁻ᵀB: the second half of solve_mass
-            return blas.dtrsm(1.0, self.cholesky_factor, self.scaled_W, lower=1, trans_a=1)
+            return cholesky_solve(self.cholesky_factor, self.scaled_W, transpose=True)
         return self.solve_mass(as_dense(self.W))
 
     @cached_property
