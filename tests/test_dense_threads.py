@@ -53,6 +53,9 @@ def test_operators_of_the_cholesky_factor(n, m, cond):
         # G = BᵀB = WᵀM⁻¹W, the second from X
         assert np.abs(G - W.T @ X).max() <= 1e-10 * cond * np.abs(G).max()
         assert np.array_equal(st.delassus_diagonal, np.einsum("ij,ij->j", B, B))
+        # solve_mass on W's columns is the same two solves; on one column, LAPACK's potrs
+        assert np.array_equal(st.solve_mass(W), X)
+        assert np.abs(st.solve_mass(W[:, 0]) - X[:, 0]).max() <= 1e-12 * np.abs(X).max()
         # LAPACK's triangular solves (what the structure called before): round-off apart
         B_ref = lapack.dtrtrs(L, W, lower=1)[0]
         X_ref = lapack.dpotrs(L, W, lower=1)[0]

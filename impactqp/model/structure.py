@@ -161,6 +161,8 @@ class ImpactStructure:
             return x / self._diag[:, None] if x.ndim == 2 else x / self._diag
         if self.sparse:
             return self._lu.solve(np.asarray(x, dtype=float))
+        if np.ndim(x) == 2:  # potrs' two triangular solves, a small one in the calling thread
+            return cholesky_solve(self._chol, cholesky_solve(self._chol, x), transpose=True)
         return lapack.dpotrs(self._chol, x, lower=1)[0]  # info ≠ 0 only for bad shapes
 
     @cached_property
