@@ -18,6 +18,7 @@ import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
 from ..base.arrays import Matrix, as_dense, as_matrix
+from ..base.cholesky import cholesky_solve
 from ..base.definite import symmetric_ldl
 from ..base.rowwise import row_max, row_sum
 from ..errors import MassMatrixError, ShapeError
@@ -160,6 +161,8 @@ class ImpactStructure:
             return x / self._diag[:, None] if x.ndim == 2 else x / self._diag
         if self.sparse:
             return self._lu.solve(np.asarray(x, dtype=float))
+        if np.ndim(x) == 2:  # potrs' two triangular solves, a small one in the calling thread
+            return cholesky_solve(self._chol, cholesky_solve(self._chol, x), transpose=True)
         return lapack.dpotrs(self._chol, x, lower=1)[0]  # info ≠ 0 only for bad shapes
 
     @cached_property
@@ -260,14 +263,15 @@ class ImpactStructure:
     @cached_property
     def scaled_W(self) -> np.ndarray:
         """B = L⁻¹W, so that G = BᵀB (dense problems): the basis of the NNLS paths."""
-        # info ≠ 0 would mean a zero pivot, which a successful Cholesky factor does not have
-        return lapack.dtrtrs(self.cholesky_factor, self.W, lower=1)[0]
+        return cholesky_solve(self.cholesky_factor, self.W)
 
     @cached_property
     def Minv_W(self) -> Matrix:
         """M⁻¹W (sparse when M is diagonal and W sparse, dense otherwise)."""
         if self.sparse and self.diagonal_mass:
             return sp.csc_matrix(sp.diags(1.0 / self._diag) @ self.W)
+        if not self.sparse and self._diag is None:  # L⁻ᵀB: the second half of solve_mass
+            return cholesky_solve(self.cholesky_factor, self.scaled_W, transpose=True)
         return self.solve_mass(as_dense(self.W))
 
     @cached_property
