@@ -20,11 +20,11 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..base.arrays import as_dense
 from ..base.checks import DEFAULT_TOL
+from ..base.cholesky import cholesky_solve
 from ..errors import InputError
 from ..kernels.friction import project_cones
 from ..kernels.units import contact_units
@@ -63,7 +63,7 @@ def _metric_factor(structure: Any) -> tuple[np.ndarray, np.ndarray]:
     if not structure.sparse:
         return structure.scaled_W, structure.cholesky_factor.T
     L = np.linalg.cholesky(as_dense(structure.M))
-    return sla.solve_triangular(L, as_dense(structure.W), lower=True), L.T
+    return cholesky_solve(L, np.asarray(as_dense(structure.W), dtype=float)), L.T
 
 
 def cone_least_squares(B: np.ndarray, b: np.ndarray, mu: np.ndarray, d: int) -> np.ndarray:
