@@ -90,7 +90,7 @@ def _certified(W, q, r, mu, d, tol):
             and (cone == 0.0 or np.sqrt(cone) <= tol * rn))
 
 
-@kernel
+@kernel(internal=True)
 def _local(k, vf, gk, closed, contacts, friction, tol, events, vn, lam):
     """Step 3 on the closed contacts: the local problem solved and certified, v_{k+1} and
     the impulses written into ``vn`` and ``lam``, the step recorded; False hands the step

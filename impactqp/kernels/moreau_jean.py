@@ -98,7 +98,7 @@ def worst_step(n: int, m: int) -> np.ndarray:
     return np.array([n, n + m, CHECKED * n + 3 * n + m], dtype=np.int64)
 
 
-@kernel
+@kernel(internal=True)
 def _work(n, m, chain):
     """Scratch of a run: the clusters' buffers, the dense or chain solves' scratch."""
     dense = 0 if chain else n
@@ -173,7 +173,7 @@ def _solve_dense(cl, contacts, law, tol, dense_work, res, work):
     return True
 
 
-@kernel
+@kernel(internal=True)
 def _solve_chain(cl, units, chain, left, right, tol, chain_work, res):
     """One run ``cl`` of a chain (balls D, contacts C) with one restitution e, as the
     isotonic path solves it (docs/theory.md §14): z = prox_{T_C}(u⁻ + e v_k) by
@@ -208,7 +208,7 @@ def _solve_chain(cl, units, chain, left, right, tol, chain_work, res):
     return True
 
 
-@kernel
+@kernel(internal=True)
 def _record(events, k, D, C, res, um, up, vp, lam):
     """Record a solved cluster (dofs D, contacts C) of step k."""
     nc, mc = D.size, C.size
