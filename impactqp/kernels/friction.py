@@ -18,9 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction_blocks import exact_contact, local_steps, nonzero_rows
+from .friction_blocks import exact_contact, local_steps, nonzero_rows, sticking
 from .friction_planar import planar_contact
 from .friction_rows import contact_rows, off_diagonal, velocity_into
+from .friction_slip import sliding_3d
 from .jit import inline_kernel, kernel
 
 CHECK_GAP = 8
@@ -209,13 +210,14 @@ def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
     """:func:`nsgs_contacts` by :func:`sweep_once` on W's compressed ``rows`` (scipy's CSR
     arrays) and ``blocks`` = (W_cc, ρ_c) (:func:`~impactqp.kernels.friction_blocks.local_steps`),
     which a caller solving W again keeps: a few sweeps of a few contacts, where gathering W
-    by contacts at each call costs more than it saves (LMGC-00046: 2 µs a call)."""
+    by contacts at each call costs more than it saves (LMGC-00046: 2 µs a call), each
+    3-D contact sliding solved by its slip angle (``slip`` of :func:`sweep_once`)."""
     indptr, indices, data = rows
     n = r.size
     u, F, scratch = np.empty(n), np.empty(n), np.empty(3 * d)
     err, last_err, last_at, check_at = np.inf, np.inf, 0, 1
     for sweep in range(max_sweeps):
-        sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch)
+        sweep_once(rows, blocks, q, mu, d, r, local_iters, True, scratch)
         done = sweep + 1
         if done < check_at and done < max_sweeps:
             continue
@@ -293,14 +295,17 @@ def nsgs_contacts(rows, rhos, q, mu, d, r, tol, max_sweeps, local_iters):
 
 
 @inline_kernel
-def sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch):
+def sweep_once(rows, blocks, q, mu, d, r, local_iters, slip, scratch):
     """One sweep over the contacts on W's compressed ``rows`` and ``blocks`` (as
     :func:`nsgs_blocks` takes them), updating ``r`` in place (``scratch``: ≥ 3·d floats).
     A contact is apart (r_c = 0) where its normal row gives b_n ≥ 0, before its tangential
     rows are summed (41 of NESpheres-30's 44 contacts in its one sweep); a planar contact is
     solved by its cases in scalars (:func:`~impactqp.kernels.friction_planar.planar_contact`)
-    in the loop itself (in an inlined helper numba compiled them ten times slower), any other
-    by :func:`contact_steps`."""
+    in the loop itself (in an inlined helper numba compiled them ten times slower); with
+    ``slip``, a 3-D contact that neither separates nor sticks is solved sliding by its slip
+    angle (:func:`~impactqp.kernels.friction_slip.sliding_3d`), so that every local problem
+    with a solution is solved exactly (docs/theory.md §15); any other contact by
+    :func:`contact_steps`."""
     indptr, indices, data = rows
     Wcc, rhos = blocks
     for c in range(mu.size):
@@ -324,6 +329,11 @@ def sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch):
             if exact:
                 r[k], r[k + 1] = rn, rt
                 continue
+        elif slip and (sticking(Wcc[c], scratch[2 * d:], mu[c], d, scratch)
+                       or sliding_3d(Wcc[c], scratch[2 * d:], mu[c], scratch)):
+            for i in range(d):
+                r[k + i] = scratch[i]
+            continue
         contact_steps(Wcc, rhos, mu, c, d, r, local_iters, scratch)
 
 

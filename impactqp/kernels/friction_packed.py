@@ -13,9 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from .friction import sweep_once
-from .friction_blocks import densified, diagonal_blocks, exact_contact, local_steps
+from .friction_blocks import densified, diagonal_blocks, local_steps
 from .friction_newton import ROUND_OFF, scales, solve_small, sweeps_on
-from .friction_slip import sliding_3d
 from .friction_tiny import (
     CERTIFIED,
     NEEDS_SCALING,
@@ -172,11 +171,7 @@ def solve_packed(floats, ints, tol, out):
     newton_steps, sweeps, local_iters, whole = budgets
     size = qu.size
     ru = np.zeros(size)
-    if whole and mu.size == 1:  # one contact: its cases in closed form, or its slip angle
-        if not exact_contact(blocks[0][0], qu, mu[0], d, ru) and d == 3:
-            sliding_3d(blocks[0][0], qu, mu[0], ru)
-    else:
-        sweep_once(rows, blocks, qu, mu, d, ru, local_iters, np.empty(5 * d))
+    sweep_once(rows, blocks, qu, mu, d, ru, local_iters, whole, np.empty(3 * d))
     done = 1
     # the certificate of this answer; its natural map is the sweeps' measure from here
     outcome = _finish(ru, s, rows, qu, mu, d, tol, out)
