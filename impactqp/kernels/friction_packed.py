@@ -131,12 +131,12 @@ def _finish(ru, s, rows, qu, mu, d, tol, out):
 @kernel(interpretable=True)
 def solve_packed(floats, ints, tol, out):
     """Solve and certify a problem of a few contacts packed by :func:`pack`, in one call
-    (docs/theory.md §15). A problem of one contact is solved by its cases in closed form
-    (:func:`~impactqp.kernels.friction_blocks.exact_contact`: apart, sticking, a planar
-    contact sliding) or, a 3-D contact sliding, by its slip angle
-    (:func:`~impactqp.kernels.friction_slip.sliding_3d`); a problem of more by one sweep of
-    the projected Gauss–Seidel from r = 0 on W̃
-    (:func:`~impactqp.kernels.friction.sweep_once`). That answer is certified at once
+    (docs/theory.md §15): one sweep of the projected Gauss–Seidel from r = 0 on W̃
+    (:func:`~impactqp.kernels.friction.sweep_once`), with ``whole`` each contact's local
+    problem solved exactly where it has a solution (apart, sticking, a planar contact by its
+    cases, a 3-D contact sliding by its slip angle,
+    :func:`~impactqp.kernels.friction_slip.sliding_3d`), which solves a problem of one
+    contact. That answer is certified at once
     (:func:`_finish`: scaled back, r = r̂/s, and recomputed from r as given, r̂ = s∘r,
     û = W̃r̂ + q̂, the velocity given u = s∘û) and kept where it passes with ‖F‖/‖q̂‖ within
     :data:`~impactqp.kernels.friction_newton.ROUND_OFF` (tol/2 without ``whole``): one
