@@ -12,7 +12,7 @@ import scipy.linalg
 
 import impactqp as iq
 from impactqp.kernels.friction_blocks import sticking
-from impactqp.kernels.friction_slip import _slip_at, _slip_terms, sliding_3d
+from impactqp.kernels.friction_slip import _slip_at, _slip_terms, sliding_3d, sliding_from
 from impactqp.laws import friction_small
 from impactqp.laws.friction_small import SmallFrictionResult
 from impactqp.model.friction import certify_friction
@@ -74,6 +74,33 @@ def test_the_slip_root_is_a_root_of_the_definition(seed: int) -> None:
     u = Wc @ r + base
     assert abs(u[0]) <= 1e-12 * np.abs(base).max()
     assert u[1] * r[1] + u[2] * r[2] < 0.0
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_newton_from_the_last_slip_angle_finds_the_same_answer(seed: int) -> None:
+    """sliding_from, started from an angle near the slip (as a sweep's last r_t is) or from
+    any angle, answers the contact's one sliding solution (W_cc definite) or nothing: never
+    another r."""
+    rng = np.random.default_rng(seed)
+    exact = np.empty(3)
+    Wc, base, mu = sliding_contact(rng)
+    while sticking(Wc, base, mu, 3, exact):
+        Wc, base, mu = sliding_contact(rng)
+    assert sliding_3d(Wc, base, mu, exact)
+    near = np.empty(3)
+    turn = rng.uniform(-0.05, 0.05)
+    t1 = exact[1] * math.cos(turn) - exact[2] * math.sin(turn)
+    t2 = exact[1] * math.sin(turn) + exact[2] * math.cos(turn)
+    assert sliding_from(Wc, base, mu, t1, t2, near)
+    np.testing.assert_allclose(near, exact, rtol=1e-12, atol=1e-14 * np.abs(exact).max())
+    for angle in np.linspace(0.0, 2.0 * math.pi, 9)[:-1]:
+        far = np.full(3, np.nan)
+        if sliding_from(Wc, base, mu, math.cos(angle), math.sin(angle), far):
+            np.testing.assert_allclose(far, exact, rtol=1e-10,
+                                       atol=1e-12 * np.abs(exact).max())
+        else:
+            assert np.isnan(far).all()  # untouched
+    assert not sliding_from(Wc, base, mu, 0.0, 0.0, near)  # no last angle
 
 
 def decoupled_problem(m: int, seed: int) -> iq.FrictionContactProblem:

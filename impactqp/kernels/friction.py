@@ -21,7 +21,7 @@ import numpy as np
 from .friction_blocks import exact_contact, local_steps, nonzero_rows, sticking
 from .friction_planar import planar_contact
 from .friction_rows import contact_rows, off_diagonal, velocity_into
-from .friction_slip import sliding_3d
+from .friction_slip import sliding_3d, sliding_from
 from .jit import inline_kernel, kernel
 
 CHECK_GAP = 8
@@ -303,7 +303,8 @@ def sweep_once(rows, blocks, q, mu, d, r, local_iters, slip, scratch):
     solved by its cases in scalars (:func:`~impactqp.kernels.friction_planar.planar_contact`)
     in the loop itself (in an inlined helper numba compiled them ten times slower); with
     ``slip``, a 3-D contact that neither separates nor sticks is solved sliding by its slip
-    angle (:func:`~impactqp.kernels.friction_slip.sliding_3d`), so that every local problem
+    angle (by Newton from its last one, :func:`~impactqp.kernels.friction_slip.sliding_from`,
+    else :func:`~impactqp.kernels.friction_slip.sliding_3d`), so that every local problem
     with a solution is solved exactly (docs/theory.md §15); any other contact by
     :func:`contact_steps`."""
     indptr, indices, data = rows
@@ -330,6 +331,8 @@ def sweep_once(rows, blocks, q, mu, d, r, local_iters, slip, scratch):
                 r[k], r[k + 1] = rn, rt
                 continue
         elif slip and (sticking(Wcc[c], scratch[2 * d:], mu[c], d, scratch)
+                       or sliding_from(Wcc[c], scratch[2 * d:], mu[c], r[k + 1], r[k + 2],
+                                       scratch)
                        or sliding_3d(Wcc[c], scratch[2 * d:], mu[c], scratch)):
             for i in range(d):
                 r[k + i] = scratch[i]
