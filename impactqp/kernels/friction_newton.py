@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction import alart_curnier, natural_map, nsgs_blocks, nsgs_rows, project_cones
+from .friction import alart_curnier, natural_map, nsgs_rows, project_cones
 from .friction_blocks import densified, nonzero_rows
+from .friction_sweep import nsgs_blocks
 from .jit import inline_kernel, kernel
 
 
@@ -310,7 +311,7 @@ fixed point, TwoRods1-condensed was within tol/2 after 2 sweeps, 5e-12 after 4, 
 @inline_kernel(interpretable=True)
 def sweeps_on(rows, blocks, q, mu, d, r, tol, local_iters, done, err):
     """The projected Gauss–Seidel on W's nonzero ``rows`` (indptr, indices, data) and its
-    diagonal ``blocks`` with their steps (:func:`~impactqp.kernels.friction.nsgs_blocks`,
+    diagonal ``blocks`` with their steps (:func:`~impactqp.kernels.friction_sweep.nsgs_blocks`,
     every local problem with a closed form or a slip angle solved exactly) from the answer
     in ``r`` of ``done`` sweeps, at ‖F‖/‖q‖ = ``err`` (docs/theory.md §15): one more, then
     more while their rate says they reach :data:`ROUND_OFF` within :data:`FIRST_SWEEPS`,

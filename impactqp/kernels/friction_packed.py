@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction import sweep_once
 from .friction_blocks import densified, diagonal_blocks, local_steps
 from .friction_newton import ROUND_OFF, scales, solve_small, sweeps_on
+from .friction_sweep import sweep_once
 from .friction_tiny import (
     CERTIFIED,
     NEEDS_SCALING,
@@ -132,7 +132,7 @@ def _finish(ru, s, rows, qu, mu, d, tol, out):
 def solve_packed(floats, ints, tol, out):
     """Solve and certify a problem of a few contacts packed by :func:`pack`, in one call
     (docs/theory.md §15): one sweep of the projected Gauss–Seidel from r = 0 on W̃
-    (:func:`~impactqp.kernels.friction.sweep_once`), with ``whole`` each contact's local
+    (:func:`~impactqp.kernels.friction_sweep.sweep_once`), with ``whole`` each contact's local
     problem solved exactly where it has a solution (apart, sticking, a planar contact by its
     cases, a 3-D contact sliding by its slip angle,
     :func:`~impactqp.kernels.friction_slip.sliding_3d`), which solves a problem of one

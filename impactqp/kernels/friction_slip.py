@@ -1,7 +1,7 @@
 """One 3-D contact's local problem solved sliding, by the root of its slip function
 (docs/theory.md §15): the case the closed forms of
 :func:`impactqp.kernels.friction_blocks.exact_contact` leave open, solved to round-off in the
-sweeps of a problem of a few contacts (:func:`impactqp.kernels.friction.sweep_once`).
+sweeps of a problem of a few contacts (:func:`impactqp.kernels.friction_sweep.sweep_once`).
 """
 
 from __future__ import annotations
