@@ -204,33 +204,6 @@ def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
                          local_iters)
 
 
-@kernel
-def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
-    """:func:`nsgs_contacts` by :func:`sweep_once` on W's compressed ``rows`` (scipy's CSR
-    arrays) and ``blocks`` = (W_cc, ρ_c) (:func:`~impactqp.kernels.friction_blocks.local_steps`),
-    which a caller solving W again keeps: a few sweeps of a few contacts, where gathering W
-    by contacts at each call costs more than it saves (LMGC-00046: 2 µs a call)."""
-    indptr, indices, data = rows
-    n = r.size
-    u, F, scratch = np.empty(n), np.empty(n), np.empty(3 * d)
-    err, last_err, last_at, check_at = np.inf, np.inf, 0, 1
-    for sweep in range(max_sweeps):
-        sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch)
-        done = sweep + 1
-        if done < check_at and done < max_sweeps:
-            continue
-        for i in range(n):
-            v = q[i]
-            for p in range(indptr[i], indptr[i + 1]):
-                v += data[p] * r[indices[p]]
-            u[i] = v
-        err = relative_error(r, u, q, mu, d, F)
-        if err <= tol:
-            return done, err
-        last_err, last_at, check_at = err, done, next_check(done, err, tol, last_err, last_at)
-    return max_sweeps, err
-
-
 @inline_kernel
 def relative_error(r, u, q, mu, d, F):
     """‖F‖/‖q‖ (‖F‖ for q = 0) at (r, u), F = r − P_{K_μ}(r − ũ) written into ``F``."""
@@ -257,9 +230,10 @@ def nsgs_contacts(rows, rhos, q, mu, d, r, tol, max_sweeps, local_iters):
     on W by contacts ``rows`` (:class:`~impactqp.kernels.friction_rows.ContactRows`, so that
     a sweep costs W's blocks) with the steps ``rhos`` of the contacts' fixed points
     (:func:`~impactqp.kernels.friction_blocks.local_steps`). Each contact's local problem
-    (the others held) is solved as in :func:`sweep_once`; the sweeps stop when
-    ‖F‖ ≤ tol·‖q‖. ‖F‖ (a product by W, as dear as a sweep) is evaluated after the first
-    sweep, then after the sweeps :func:`next_check` says, and after the last. Returns
+    (the others held) is solved as in :func:`~impactqp.kernels.friction_sweep.sweep_once`
+    without ``slip``; the sweeps stop when ‖F‖ ≤ tol·‖q‖. ‖F‖ (a product by W, as dear as
+    a sweep) is evaluated after the first sweep, then after the sweeps :func:`next_check`
+    says, and after the last. Returns
     (sweeps done, ‖F‖/‖q‖ at the end)."""
     start, other, block, Wcc = rows
     u, F, work = np.empty(r.size), np.empty(r.size), np.empty(3 * d)
@@ -290,41 +264,6 @@ def nsgs_contacts(rows, rhos, q, mu, d, r, tol, max_sweeps, local_iters):
             return done, err
         last_err, last_at, check_at = err, done, next_check(done, err, tol, last_err, last_at)
     return max_sweeps, err
-
-
-@inline_kernel
-def sweep_once(rows, blocks, q, mu, d, r, local_iters, scratch):
-    """One sweep over the contacts on W's compressed ``rows`` and ``blocks`` (as
-    :func:`nsgs_blocks` takes them), updating ``r`` in place (``scratch``: ≥ 3·d floats).
-    A contact is apart (r_c = 0) where its normal row gives b_n ≥ 0, before its tangential
-    rows are summed (41 of NESpheres-30's 44 contacts in its one sweep); a planar contact is
-    solved by its cases in scalars (:func:`~impactqp.kernels.friction_planar.planar_contact`)
-    in the loop itself (in an inlined helper numba compiled them ten times slower), any other
-    by :func:`contact_steps`."""
-    indptr, indices, data = rows
-    Wcc, rhos = blocks
-    for c in range(mu.size):
-        k = c * d
-        for i in range(d):
-            v = q[k + i]
-            for p in range(indptr[k + i], indptr[k + i + 1]):
-                v += data[p] * r[indices[p]]
-            for j in range(d):
-                v -= Wcc[c, i, j] * r[k + j]
-            scratch[2 * d + i] = v
-            if i == 0 and v >= 0.0:
-                break
-        if scratch[2 * d] >= 0.0:  # apart
-            for i in range(d):
-                r[k + i] = 0.0
-            continue
-        if d == 2:
-            exact, rn, rt = planar_contact(Wcc[c, 0, 0], Wcc[c, 0, 1], Wcc[c, 1, 0],
-                                           Wcc[c, 1, 1], scratch[4], scratch[5], mu[c])
-            if exact:
-                r[k], r[k + 1] = rn, rt
-                continue
-        contact_steps(Wcc, rhos, mu, c, d, r, local_iters, scratch)
 
 
 @kernel(internal=True, refcounted=False)

@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction import alart_curnier, natural_map, nsgs_blocks, nsgs_rows, project_cones
+from .friction import alart_curnier, natural_map, nsgs_rows, project_cones
 from .friction_blocks import densified, nonzero_rows
+from .friction_sweep import nsgs_blocks
 from .jit import inline_kernel, kernel
 
 
@@ -291,44 +292,35 @@ FIRST_SWEEPS = 12
 """Most sweeps :func:`sweeps_on` tries before the ``"kernel"`` method whole: while their
 rate says they reach :data:`ROUND_OFF` within this many
 (a sweep of a few contacts costs less than a microsecond, the dense Newton steps the method
-takes a few microseconds: CubeH8 and FC3D-1c, one contact, reach round-off in 5–7 sweeps)."""
+takes a few microseconds: Rover4396, two contacts sliding, reaches round-off in six sweeps,
+about 2.5e-3 of ‖F‖ kept a sweep)."""
 FAST_RATE = 0.1
 """Most ‖F‖ a sweep may keep of the last one's for :func:`sweeps_on` to sweep on, one sweep
 at a time, where the rate of the last ones does not promise round-off within
 :data:`FIRST_SWEEPS`: the sweeps of LMGC-00046 (9 contacts) speed up, 2e-1, 1.6e-2, 9e-5,
 2e-12, 7e-15 (a rate of 0.08, then 0.006), those of the problems Newton solves sooner keep
-0.12 (sliding single contacts) to 0.95 of ‖F‖ from the second sweep on."""
-SWEEP_GATE = 1e-6
-"""‖F‖/‖q‖ within which the first sweep is followed by a second whatever Newton's cost: the
-first sweep ends at 2e-10…2.1e-7 on the FCLib problems of a few contacts whose sweeps reach
-tol/2 soon (CubeH8, FC3D-1c, FC3D-Example1, Confeti-ex13-4c, TwoRods1-condensed), at
-1e-2…2e-1 on the rest. Beyond it the second is taken only where a dense Newton step costs
-:data:`FIRST_SWEEPS` sweeps or more (:func:`sweep_budget`: LMGC-00046, 9 dense 3-D contacts,
-about 17; the Rover problems of 2–5 contacts, which Newton solves, 2–8)."""
+0.3 to 0.95 of ‖F‖ from the second sweep on (Rover1039 to Rover9770, NESpheres-10, the
+slider-crank)."""
 POLISH_SWEEPS = 2
 """Most sweeps :func:`sweeps_on` predicts to round-off that it takes once within tol/2;
-beyond them it takes one Newton step on the dense W̃ (TwoRods1-condensed, 3 contacts: within
-tol/2 after 2 sweeps, 5e-12 after 4, then 0.65 of ‖F‖ a sweep)."""
+beyond them it takes one Newton step on the dense W̃ (with the local problems solved by the
+fixed point, TwoRods1-condensed was within tol/2 after 2 sweeps, 5e-12 after 4, then kept
+0.65 of ‖F‖ a sweep)."""
 
 
 @inline_kernel(interpretable=True)
 def sweeps_on(rows, blocks, q, mu, d, r, tol, local_iters, done, err):
     """The projected Gauss–Seidel on W's nonzero ``rows`` (indptr, indices, data) and its
-    diagonal ``blocks`` with their steps (:func:`~impactqp.kernels.friction.nsgs_blocks`)
-    from the answer in ``r`` of ``done`` sweeps, at ‖F‖/‖q‖ = ``err`` (docs/theory.md §15): none
-    where ``err`` is beyond :data:`SWEEP_GATE` and Newton costs less than
-    :data:`FIRST_SWEEPS` sweeps; otherwise more while their rate says they reach
-    :data:`ROUND_OFF` within :data:`FIRST_SWEEPS`, or, one at a time, while each keeps at
-    most :data:`FAST_RATE` of the last one's ‖F‖; once within tol/2, only while at most
-    :data:`POLISH_SWEEPS` are left, and then one Newton step on the dense W
-    (:func:`to_round_off`). Returns (sweeps and steps done, ‖F‖/‖q‖ of the sweeps, at most
-    tol/2 where ``r`` is within it)."""
-    indices = rows[1]
+    diagonal ``blocks`` with their steps (:func:`~impactqp.kernels.friction_sweep.nsgs_blocks`,
+    every local problem with a closed form or a slip angle solved exactly) from the answer
+    in ``r`` of ``done`` sweeps, at ‖F‖/‖q‖ = ``err`` (docs/theory.md §15): one more, then
+    more while their rate says they reach :data:`ROUND_OFF` within :data:`FIRST_SWEEPS`,
+    or, one at a time, while each keeps at most :data:`FAST_RATE` of the last one's ‖F‖;
+    once within tol/2, only while at most :data:`POLISH_SWEEPS` are left, and then one
+    Newton step on the dense W (:func:`to_round_off`). Returns (sweeps and steps done,
+    ‖F‖/‖q‖ of the sweeps, at most tol/2 where ``r`` is within it)."""
     ask = np.int64(1)  # an int64, not a literal 1: one compiled sweep
     last, last_done = np.inf, 0
-    if err > SWEEP_GATE and sweep_budget(q.size, mu.size, indices.size, FIRST_SWEEPS,
-                                         local_iters) < FIRST_SWEEPS:
-        return done, err  # a second sweep costs more than the Newton steps it may spare
     while ROUND_OFF < err < last and done < FIRST_SWEEPS:
         if last < np.inf:  # the sweeps left to round-off at the rate of the last ones
             rate = (err / last) ** (1.0 / (done - last_done))  # per sweep

@@ -12,10 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction import sweep_once
-from .friction_blocks import densified, diagonal_blocks, exact_contact, local_steps
+from .friction_blocks import densified, diagonal_blocks, local_steps
 from .friction_newton import ROUND_OFF, scales, solve_small, sweeps_on
-from .friction_slip import sliding_3d
+from .friction_sweep import sweep_once
 from .friction_tiny import (
     CERTIFIED,
     NEEDS_SCALING,
@@ -132,12 +131,12 @@ def _finish(ru, s, rows, qu, mu, d, tol, out):
 @kernel(interpretable=True)
 def solve_packed(floats, ints, tol, out):
     """Solve and certify a problem of a few contacts packed by :func:`pack`, in one call
-    (docs/theory.md §15). A problem of one contact is solved by its cases in closed form
-    (:func:`~impactqp.kernels.friction_blocks.exact_contact`: apart, sticking, a planar
-    contact sliding) or, a 3-D contact sliding, by its slip angle
-    (:func:`~impactqp.kernels.friction_slip.sliding_3d`); a problem of more by one sweep of
-    the projected Gauss–Seidel from r = 0 on W̃
-    (:func:`~impactqp.kernels.friction.sweep_once`). That answer is certified at once
+    (docs/theory.md §15): one sweep of the projected Gauss–Seidel from r = 0 on W̃
+    (:func:`~impactqp.kernels.friction_sweep.sweep_once`), with ``whole`` each contact's local
+    problem solved exactly where it has a solution (apart, sticking, a planar contact by its
+    cases, a 3-D contact sliding by its slip angle,
+    :func:`~impactqp.kernels.friction_slip.sliding_3d`), which solves a problem of one
+    contact. That answer is certified at once
     (:func:`_finish`: scaled back, r = r̂/s, and recomputed from r as given, r̂ = s∘r,
     û = W̃r̂ + q̂, the velocity given u = s∘û) and kept where it passes with ‖F‖/‖q̂‖ within
     :data:`~impactqp.kernels.friction_newton.ROUND_OFF` (tol/2 without ``whole``): one
@@ -172,11 +171,7 @@ def solve_packed(floats, ints, tol, out):
     newton_steps, sweeps, local_iters, whole = budgets
     size = qu.size
     ru = np.zeros(size)
-    if whole and mu.size == 1:  # one contact: its cases in closed form, or its slip angle
-        if not exact_contact(blocks[0][0], qu, mu[0], d, ru) and d == 3:
-            sliding_3d(blocks[0][0], qu, mu[0], ru)
-    else:
-        sweep_once(rows, blocks, qu, mu, d, ru, local_iters, np.empty(5 * d))
+    sweep_once(rows, blocks, qu, mu, d, ru, local_iters, whole, np.empty(3 * d))
     done = 1
     # the certificate of this answer; its natural map is the sweeps' measure from here
     outcome = _finish(ru, s, rows, qu, mu, d, tol, out)
