@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from .jit import inline_kernel
+from .jit import inline_kernel, kernel
 
 SLIP_SAMPLES = 16
 """Slip angles at which :func:`sliding_3d` looks for a sign change of its function (it has at
@@ -90,7 +90,7 @@ def _valid_at(Wc, mu, terms, c, s):
     return slope, c * (p0 + p1 * c + p2 * s) + s * (q0 + q1 * c + q2 * s)
 
 
-@inline_kernel
+@kernel
 def sliding_3d(Wc, base, mu, out):
     """A 3-D contact's local problem u = W_cc r + b solved sliding, where it slides
     (docs/theory.md §15): r = r_n(1, −μ cos θ, −μ sin θ) with u_n = 0, so
