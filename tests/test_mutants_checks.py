@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import impactqp as iq
-from impactqp.base.checks import DEFAULT_TOL, UNIT_RANGE, NamedChecks
+from impactqp.base.checks import DEFAULT_TOL, FRICTION_TOL, UNIT_RANGE, NamedChecks
 
 TOL = 1e-9
 
@@ -64,6 +64,14 @@ def test_default_tolerance_rejects_a_visible_error_and_accepts_rounding() -> Non
     assert NamedChecks({"r": 1e-6}, DEFAULT_TOL).ok is False
     assert NamedChecks({"r": 50 * np.finfo(float).eps}, DEFAULT_TOL).ok is True
     assert iq.moreau(iq.newtons_cradle(3), 1.0).certificate.tol == DEFAULT_TOL
+
+
+def test_friction_default_tolerance_is_the_accuracy_fclib_asks_for() -> None:
+    # ABH ≤ 1e-8: an answer off by 1.5e-8 fails the default, one off by 0.5e-8 passes
+    assert NamedChecks({"natural_map": 1.5e-8}, FRICTION_TOL).ok is False
+    assert NamedChecks({"natural_map": 0.5e-8}, FRICTION_TOL).ok is True
+    problem = iq.FrictionContactProblem(np.eye(3), np.array([-1.0, 0.5, 0.0]), 0.3)
+    assert iq.solve_friction(problem).certificate.tol == FRICTION_TOL
 
 
 @pytest.mark.parametrize("scale", [1e-90, 1.0, 1e90])
