@@ -20,6 +20,7 @@ import impactqp as iq
 from benchmarks import friction_data
 from impactqp.errors import InputError, NonFiniteError, UnknownBackendError
 from impactqp.kernels.friction_tiny import CERTIFIED
+from impactqp.kernels.jit import machine_code
 from impactqp.laws import friction_small
 from impactqp.laws.friction_small import SmallFrictionResult
 from impactqp.model.friction import certify_friction
@@ -212,11 +213,15 @@ def test_the_thin_result_reads_pickles_and_compares(form: str) -> None:
 
 def test_solves_from_a_pack_call_the_machine_code_a_first_solve_found() -> None:
     """Once a pack's first solve found solve_packed's machine code, solves from a pack call
-    it without numba's dispatch: the same answers as through the dispatcher."""
+    it without numba's dispatch: the same answers as through the dispatcher. The solves
+    compile what they call: with an empty cache a process's first small calls run as Python
+    (kernels/first_calls.py), and there is no machine code to find."""
+    from impactqp.kernels.first_calls import compiling
     from impactqp.kernels.friction_packed import solve_packed
 
     problem = friction_data.load("FC2D-00394").problem
-    results = [iq.solve_friction(problem, tol=TOL) for _ in range(3)]
+    with compiling():
+        results = [iq.solve_friction(problem, tol=TOL) for _ in range(3)]
     pack = problem.__dict__[friction_small._KEPT].packed
     code = friction_small._solve_from_pack
     if hasattr(solve_packed, "overloads"):  # numba on (not NUMBA_DISABLE_JIT)
@@ -247,24 +252,24 @@ def test_a_solved_problem_pickles_and_solves_as_before(solves: int) -> None:
 
 
 def test_machine_code_is_found_where_there_is_some() -> None:
-    """_compiled: a dispatcher with nothing compiled and a plain function are returned as
+    """machine_code: a dispatcher with nothing compiled and a plain function are returned as
     they are; once compiled, the machine code for the arguments' types."""
     import numba
 
     def plain(x):
         return x
 
-    assert friction_small._compiled(plain, 1.0) is plain
+    assert machine_code(plain, 1.0) is plain
 
     @numba.njit
     def twice(x):
         return 2.0 * x
 
-    assert friction_small._compiled(twice, 1.0) is twice  # nothing compiled yet
+    assert machine_code(twice, 1.0) is twice  # nothing compiled yet
     assert twice(1.5) == 3.0
-    code = friction_small._compiled(twice, 1.0)
+    code = machine_code(twice, 1.0)
     if numba.config.DISABLE_JIT:  # a plain function: nothing more to find
         assert code is twice
     else:
         assert code is not twice and code(4.0) == 8.0
-        assert friction_small._compiled(twice, np.ones(2)) is twice  # no code for an array
+        assert machine_code(twice, np.ones(2)) is twice  # no code for an array

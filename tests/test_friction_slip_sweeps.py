@@ -40,6 +40,16 @@ def sliding_contact(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, f
     return Wc, base, float(rng.uniform(0.05, 1.5))
 
 
+def slides(rng: np.random.Generator, r: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """A drawn contact that neither separates nor sticks (redrawn while it sticks), its
+    sliding answer by sliding_3d in ``r``."""
+    Wc, base, mu = sliding_contact(rng)
+    while sticking(Wc, base, mu, 3, r):
+        Wc, base, mu = sliding_contact(rng)
+    assert sliding_3d(Wc, base, mu, r)
+    return Wc, base, mu
+
+
 @pytest.mark.parametrize("seed", range(10))
 def test_the_slip_coefficients_give_the_slip_function_and_its_derivative(seed: int) -> None:
     """G and G′ from the five coefficients equal G by its definition, and its central
@@ -62,12 +72,8 @@ def test_the_slip_root_is_a_root_of_the_definition(seed: int) -> None:
     """A contact that neither separates nor sticks slides (W_cc definite: its local problem
     has one solution): sliding_3d answers, the angle of its r_t is a root of G by its
     definition, to round-off, with u_n = 0 and u_t along the slip (u_t · r_t < 0)."""
-    rng = np.random.default_rng(seed)
     r = np.empty(3)
-    Wc, base, mu = sliding_contact(rng)
-    while sticking(Wc, base, mu, 3, r):
-        Wc, base, mu = sliding_contact(rng)
-    assert sliding_3d(Wc, base, mu, r)
+    Wc, base, mu = slides(np.random.default_rng(seed), r)
     theta = math.atan2(-r[2], -r[1])
     scale = np.abs(Wc).max() * np.abs(base).max() * (1.0 + mu)
     assert abs(slip_by_definition(Wc, base, mu, theta)) <= 1e-13 * scale
@@ -83,10 +89,7 @@ def test_newton_from_the_last_slip_angle_finds_the_same_answer(seed: int) -> Non
     another r."""
     rng = np.random.default_rng(seed)
     exact = np.empty(3)
-    Wc, base, mu = sliding_contact(rng)
-    while sticking(Wc, base, mu, 3, exact):
-        Wc, base, mu = sliding_contact(rng)
-    assert sliding_3d(Wc, base, mu, exact)
+    Wc, base, mu = slides(rng, exact)
     near = np.empty(3)
     turn = rng.uniform(-0.05, 0.05)
     t1 = exact[1] * math.cos(turn) - exact[2] * math.sin(turn)

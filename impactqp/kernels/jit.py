@@ -170,6 +170,20 @@ def inline_kernel(function: F | None = None, *, interpretable: bool = False) -> 
     return kernel(function, interpretable=interpretable, inline=True)
 
 
+def machine_code(dispatcher: Any, *args: Any) -> Callable:
+    """The machine code numba has compiled of the kernel ``dispatcher`` for the types of
+    ``args``, to be called without numba's dispatch on arguments of exactly those types,
+    which it does not check; ``dispatcher`` itself where there is none (not compiled in this
+    process: run as Python, or ``NUMBA_DISABLE_JIT``). Typing the arguments in Python takes
+    ~40 µs: a caller keeps what it found (laws/friction_small.py, a solve again from a pack)."""
+    if not getattr(dispatcher, "overloads", None):  # nothing compiled (yet)
+        return dispatcher
+    try:
+        return dispatcher.overloads[tuple(numba.typeof(a) for a in args)].entry_point
+    except (AttributeError, KeyError):
+        return dispatcher
+
+
 def read_only(a: Any) -> Any:
     """A read-only view of the array ``a`` (no copy): a kernel's callers pass arrays with
     one set of flags, since each other set compiles the kernel (and every kernel it calls

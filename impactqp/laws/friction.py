@@ -85,8 +85,7 @@ def solve_friction(problem: FrictionContactProblem, *, backend: str = "auto",
         raise InputError(f"problem must be a FrictionContactProblem, got "
                          f"{type(problem).__name__}")
     start = perf_counter()
-    if type(tol) is not float or not 0.0 < tol < 1.0:  # check_tol's first test, without a call
-        tol = check_tol(tol)
+    tol = check_tol(tol)
     if backend == "auto" or backend == "kernel":
         few = solve_few(problem, tol, start, backend == "auto")
         if few is not None:

@@ -24,14 +24,14 @@ from __future__ import annotations
 from collections.abc import Callable
 from functools import cached_property
 from time import perf_counter
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
-import numba
 import numpy as np
 
 from ..kernels.friction import kernel_mu
 from ..kernels.friction_packed import pack, solve_given, solve_packed
 from ..kernels.friction_tiny import CERTIFIED, FRICTION_FIGURES
+from ..kernels.jit import machine_code
 from ..model.friction import FrictionCertificate, FrictionContactProblem, friction_certificate
 from ..qp.friction import methods
 from ..qp.friction.newton import NEWTON_STEPS
@@ -191,34 +191,20 @@ def _pack(problem: FrictionContactProblem, small: bool,
     out = np.empty(2 * size + _FIGURES)
     its, outcome = solve_packed(floats, ints, tol, out)
     if _solve_from_pack is solve_packed:
-        _solve_from_pack = _compiled(solve_packed, floats, ints, tol, out)
+        _solve_from_pack = machine_code(solve_packed, floats, ints, tol, out)
     route = (size, bool(ints[_SCALED]), "kernel" if small else "nsgs-short")
     return _Packed(floats, ints, out.size, route), out, its, outcome
-
-
-def _compiled(dispatcher: Any, *args: Any) -> Callable:
-    """The machine code numba has compiled of ``dispatcher`` for the types of ``args``, to be
-    called on arguments of exactly those types, which it does not check, without numba's
-    dispatch; ``dispatcher`` itself where there is none (not compiled in this process:
-    run as Python, or ``NUMBA_DISABLE_JIT``). Typing the arguments in Python takes ~40 µs:
-    a caller keeps what it found."""
-    if not getattr(dispatcher, "overloads", None):  # nothing compiled (yet)
-        return dispatcher
-    try:
-        return dispatcher.overloads[tuple(numba.typeof(a) for a in args)].entry_point
-    except (AttributeError, KeyError):
-        return dispatcher
 
 
 _solve_from_pack: Callable[..., tuple[int, int]] = solve_packed
 """What solves a pack (:func:`solve_few`): :func:`~impactqp.kernels.friction_packed.solve_packed`
 through numba's dispatch until a pack's first solve (:func:`_pack`) finds its machine code
-(:func:`_compiled`), that code from then on, called without the dispatch (typing each
-argument and finding the code: ~0.15 µs of a ~3 µs solve again). Every argument of a solve
-from a pack is of the types that code was compiled for: the pack's two arrays
-(:func:`~impactqp.kernels.friction_packed.pack` makes them), the float ``tol``
-(:func:`~impactqp.base.arrays.check_tol`) and a new float array. Kept in the module, not on
-the problem: a problem with its pack still pickles."""
+(:func:`~impactqp.kernels.jit.machine_code`), that code from then on, called without the
+dispatch (typing each argument and finding the code: ~0.15 µs of a ~3 µs solve again).
+Every argument of a solve from a pack is of the types that code was compiled for: the
+pack's two arrays (:func:`~impactqp.kernels.friction_packed.pack` makes them), the float
+``tol`` (:func:`~impactqp.base.arrays.check_tol`) and a new float array. Kept in the module,
+not on the problem: a problem with its pack still pickles."""
 
 
 class _Kept:

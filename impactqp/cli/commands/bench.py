@@ -50,7 +50,7 @@ def _impact(args: argparse.Namespace, names: list[str] | None) -> tuple[str,
     law = law_named(name, coefficients)
     with progress(f"comparing backends with law {name} (n = {content.problem.n_dof})"):
         return name, compare_backends(content.problem, law, names, repeats=args.repeats,
-                                      tol=DEFAULT_TOL if args.tol is None else args.tol)
+                                      tol=args.tol)
 
 
 def _friction(args: argparse.Namespace, names: list[str] | None) -> BackendComparison:
@@ -63,8 +63,7 @@ def _friction(args: argparse.Namespace, names: list[str] | None) -> BackendCompa
                          "μ; drop the flag")
     problem = load_fclib(args.file)
     with progress(f"comparing friction methods ({problem.n_contacts} contacts)"):
-        return compare_backends(problem, backends=names, repeats=args.repeats,
-                                tol=FRICTION_TOL if args.tol is None else args.tol)
+        return compare_backends(problem, backends=names, repeats=args.repeats, tol=args.tol)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
