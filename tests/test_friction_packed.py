@@ -13,7 +13,13 @@ import scipy.sparse as sp
 import impactqp as iq
 from benchmarks import friction_data
 from benchmarks.friction_tiny import ONE_SWEEP, TINY
-from impactqp.kernels.friction_packed import PACKED_HEADER, pack, solve_packed
+from impactqp.kernels.friction_packed import (
+    PACKED_HEADER,
+    answer_size,
+    iterations_at,
+    pack,
+    solve_packed,
+)
 from impactqp.kernels.friction_tiny import CERTIFIED, NEEDS_SCALING
 from impactqp.laws import friction_small
 from impactqp.laws.friction_small import SmallFrictionResult
@@ -103,8 +109,9 @@ def test_a_packed_problem_beyond_the_floats_is_not_solved() -> None:
     problem = iq.FrictionContactProblem(W, np.array([-1.0, 0.4, 0.2]) * 1e150, 0.3)
     floats, ints = pack(*friction_small._given(problem), friction_small._budgets(True))
     assert ints[5] == 0
-    out = np.empty(2 * 3 + 7)
-    assert solve_packed(floats, ints, TOL, out) == (0, NEEDS_SCALING)
+    out = np.empty(answer_size(3))
+    assert solve_packed(floats, ints, TOL, out) == NEEDS_SCALING
+    assert out[iterations_at(3)] == 0
     for _ in range(3):
         res = iq.solve_friction(problem, tol=TOL)
         assert res.ok and type(res) is not SmallFrictionResult
@@ -122,9 +129,9 @@ def test_one_contact_in_each_of_its_cases() -> None:
         d = len(q)
         problem = iq.FrictionContactProblem(W, np.array(q), 0.3, contact_dim=d)
         floats, ints = pack(*friction_small._given(problem), friction_small._budgets(True))
-        out = np.empty(2 * d + 7)
-        its, outcome = solve_packed(floats, ints, TOL, out)
-        assert outcome == CERTIFIED and its == 1
+        out = np.empty(answer_size(d))
+        outcome = solve_packed(floats, ints, TOL, out)
+        assert outcome == CERTIFIED and out[iterations_at(d)] == 1
         cert = certify_friction(problem, out[:d], out[d:2 * d], tol=1e-13)
         assert cert.ok
         general = iq.solve_friction(problem, tol=1e-12, backend="newton")

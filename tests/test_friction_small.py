@@ -18,7 +18,7 @@ from benchmarks import friction_data
 from benchmarks.friction_tiny import ONE_SWEEP, TINY
 from impactqp.errors import BackendUnsuitableError, CertificateError
 from impactqp.friction import FrictionResult
-from impactqp.kernels.friction_packed import solve_given
+from impactqp.kernels.friction_packed import answer_size, solve_given
 from impactqp.kernels.friction_tiny import CERTIFIED, NOT_CERTIFIED
 from impactqp.laws import friction_small
 from impactqp.laws.friction_small import SmallFrictionResult
@@ -158,13 +158,13 @@ def test_the_first_sweep_alone_is_not_certified_where_it_does_not_reach_tol() ->
     and the general route then solves it (and a tolerance no sweep reaches either)."""
     problem = random_problem(4, 3, 3)
     n = problem.q.size
-    out = np.empty(2 * n + 7)
+    out = np.empty(answer_size(n))
     rows = (np.empty(0, np.int32), np.empty(0, np.int32), np.empty(0), False)
-    _, outcome, _ = solve_given(problem.W, rows, problem.q, problem.mu, 3,
-                                (TOL, 50, 100, 3, False), out)
+    outcome, _ = solve_given(problem.W, rows, problem.q, problem.mu, 3,
+                             (TOL, 50, 100, 3, False), out)
     assert outcome == NOT_CERTIFIED
-    _, outcome, _ = solve_given(problem.W, rows, problem.q, problem.mu, 3,
-                                (TOL, 50, 100, 10, True), out)
+    outcome, _ = solve_given(problem.W, rows, problem.q, problem.mu, 3,
+                             (TOL, 50, 100, 10, True), out)
     assert outcome == CERTIFIED
     assert certify_friction(problem, out[:n], out[n:2 * n], tol=TOL).ok
 

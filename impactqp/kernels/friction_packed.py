@@ -17,6 +17,7 @@ from .friction_newton import ROUND_OFF, scales, solve_small, sweeps_on
 from .friction_sweep import sweep_once
 from .friction_tiny import (
     CERTIFIED,
+    FRICTION_FIGURES,
     NEEDS_SCALING,
     NOT_CERTIFIED,
     judged,
@@ -25,6 +26,8 @@ from .friction_tiny import (
 )
 from .jit import inline_kernel, kernel
 
+FIGURE_COUNT = len(FRICTION_FIGURES)
+"""The certificate's figures in the array a solve fills, after r and u."""
 PACKED_HEADER = 9
 """Leading entries of the integer array of :func:`pack`: d·m, d, m, the entries of W̃ kept,
 whether some contact's unit is not 1, whether the problem is posed, then the budgets
@@ -110,22 +113,54 @@ def _unpacked(floats, ints):
             ints[5] != 0, budgets)
 
 
+def answer_size(size: int) -> int:
+    """The floats of the array ``out`` that :func:`solve_packed` and :func:`solve_given` fill
+    for a problem of ``size`` = d·m entries: r, u, the certificate's figures, the
+    iterations done (at :func:`iterations_at`), then the call's own work (r̂, û, F of d·m
+    floats each, and 3·d ≤ 9 for a contact's local problem), taken from the one new array
+    a call is given rather than allocated in it (each array numba allocates costs ~25 ns,
+    a tenth of a 1-contact certificate)."""
+    return 5 * size + FIGURE_COUNT + 10
+
+
+@inline_kernel(interpretable=True)
+def iterations_at(size):
+    """Where in ``out`` (:func:`answer_size`) a solve of ``size`` = d·m entries writes the
+    iterations it did: after r, u and the figures. Returned in ``out``, so that the call
+    returns one integer (numba boxes a returned tuple for ~40 ns)."""
+    return 2 * size + FIGURE_COUNT
+
+
+@inline_kernel(interpretable=True)
+def _work(out, size, d):
+    """The work views of ``out`` (:func:`answer_size`): (r̂ set to 0, û, F, scratch)."""
+    at = iterations_at(size) + 1
+    ru = out[at:at + size]
+    for i in range(size):
+        ru[i] = 0.0
+    return (ru, out[at + size:at + 2 * size], out[at + 2 * size:at + 3 * size],
+            out[at + 3 * size:at + 3 * size + 3 * d])
+
+
 @kernel(internal=True)
 def _finish(ru, s, rows, qu, mu, d, tol, out):
     """The answer r̂ in ``ru`` scaled back into ``out`` (r = r̂/s) and certified from r as
     given (r̂ = s∘r, û = W̃r̂ + q̂ recomputed from W̃'s ``rows``, the velocity given
-    u = s∘û: W r + q), its figures after r and u in ``out``. Returns the verdict of
+    u = s∘û: W r + q), its figures after r and u in ``out``, û and F in its work
+    (:func:`answer_size`). Returns the verdict of
     :func:`~impactqp.kernels.friction_tiny.judged`."""
     size = qu.size
-    r, u, figures = out[:size], out[size:2 * size], out[2 * size:]
+    r, u, figures = out[:size], out[size:2 * size], out[2 * size:2 * size + FIGURE_COUNT]
+    at = iterations_at(size) + 1 + size
+    uw, F = out[at:at + size], out[at + size:at + 2 * size]
     for i in range(size):  # the answer as given, r = r̂/s, and r̂ = s∘r from it
         r[i] = ru[i] / s[i]
         ru[i] = r[i] * s[i]
-    uw = np.empty(size)  # û = W̃r̂ + q̂ of the certificate; u = s∘û (W r + q as given)
+    # û = W̃r̂ + q̂ of the certificate; u = s∘û (W r + q as given)
     row_products(rows[0], rows[1], rows[2], ru, qu, uw)
     for i in range(size):
         u[i] = uw[i] * s[i]
-    return judged(ru, uw, u, s, qu, mu, d, tol, figures)
+    return judged(ru, uw, u, s, qu, mu, d, tol, figures, F)
 
 
 @kernel(interpretable=True)
@@ -155,38 +190,43 @@ def solve_packed(floats, ints, tol, out):
         The problem as :func:`pack` returns it.
     tol : float
         Tolerance of the certificate.
-    out : (2·d·m + 7,) float array
-        Receives r, u and the figures of the certificate, in that order.
+    out : (:func:`answer_size`,) float array
+        Receives r, u, the figures of the certificate and the iterations done (sweeps and
+        Newton steps, at :func:`iterations_at`), in that order, then the call's work.
 
     Returns
     -------
-    (iterations, outcome)
-        ``outcome`` as for :func:`~impactqp.kernels.friction_tiny.solve_tiny`;
-        :data:`NOT_CERTIFIED` without ``whole`` where the first sweep did not reach tol/2
-        (``out`` then unspecified).
+    outcome : int
+        As for :func:`~impactqp.kernels.friction_tiny.solve_tiny`; :data:`NOT_CERTIFIED`
+        without ``whole`` where the first sweep did not reach tol/2 (``out`` then
+        unspecified but for the iterations).
     """
     s, qu, mu, rows, blocks, d, _, posed, budgets = _unpacked(floats, ints)
-    if not posed:
-        return 0, NEEDS_SCALING
-    newton_steps, sweeps, local_iters, whole = budgets
     size = qu.size
-    ru = np.zeros(size)
-    sweep_once(rows, blocks, qu, mu, d, ru, local_iters, whole, np.empty(3 * d))
-    done = 1
+    done = iterations_at(size)
+    out[done] = 0.0
+    if not posed:
+        return NEEDS_SCALING
+    newton_steps, sweeps, local_iters, whole = budgets
+    ru, _, _, scratch = _work(out, size, d)
+    sweep_once(rows, blocks, qu, mu, d, ru, local_iters, whole, scratch)
+    out[done] = 1.0
     # the certificate of this answer; its natural map is the sweeps' measure from here
     outcome = _finish(ru, s, rows, qu, mu, d, tol, out)
     err = out[2 * size]
     if outcome == CERTIFIED and err <= (ROUND_OFF if whole else 0.5 * tol):
-        return done, outcome
+        return outcome
     if not whole:
-        return done, NOT_CERTIFIED
-    done, err = sweeps_on(rows, blocks, qu, mu, d, ru, tol, local_iters, done, err)
+        return NOT_CERTIFIED
+    swept, err = sweeps_on(rows, blocks, qu, mu, d, ru, tol, local_iters, 1, err)
+    out[done] = swept
     if err <= 0.5 * tol:  # within tol and taken to round-off
-        return done, _finish(ru, s, rows, qu, mu, d, tol, out)
+        return _finish(ru, s, rows, qu, mu, d, tol, out)
     dense, diagonal = densified(rows, size)  # W̃ dense, for the method whole
     its, _ = solve_small(dense, qu, mu, scales(diagonal, d), d, tol, ru, newton_steps, sweeps,
                          local_iters)
-    return done + its, _finish(ru, s, rows, qu, mu, d, tol, out)
+    out[done] = swept + its
+    return _finish(ru, s, rows, qu, mu, d, tol, out)
 
 
 @kernel(interpretable=True)
@@ -211,21 +251,22 @@ def solve_given(W, rows, q, mu, d, limits, out):
         ns), and ``whole``: False to end after the first sweep (then kept where it is
         within tol/2, the first sweep of the ``"nsgs-short"`` method, with ``local_iters``
         of that method).
-    out : (2·d·m + 7,) float array
-        Receives r, u and the figures of the certificate, in that order.
+    out : (:func:`answer_size`,) float array
+        Filled as by :func:`solve_packed`.
 
     Returns
     -------
-    (iterations, outcome, scaled), as :func:`~impactqp.kernels.friction_tiny.solve_tiny`;
+    (outcome, scaled), as :func:`~impactqp.kernels.friction_tiny.solve_tiny`'s;
     :data:`NOT_CERTIFIED` without ``whole`` where the first sweep did not reach tol/2
-    (``out`` then unspecified).
+    (``out`` then unspecified but for the iterations).
     """
     tol, newton_steps, sweeps, local_iters, whole = limits
     floats, ints = pack(W, rows, q, mu, d, (newton_steps, sweeps, local_iters, whole))
     if ints[5] == 0:
-        return 0, NEEDS_SCALING, True
-    its, outcome = solve_packed(floats, ints, tol, out)
-    return its, outcome, ints[4] != 0
+        out[iterations_at(q.size)] = 0.0
+        return NEEDS_SCALING, True
+    return solve_packed(floats, ints, tol, out), ints[4] != 0
 
 
-__all__ = ["PACKED_HEADER", "pack", "solve_given", "solve_packed"]
+__all__ = ["FIGURE_COUNT", "PACKED_HEADER", "answer_size", "iterations_at", "pack",
+           "solve_given", "solve_packed"]

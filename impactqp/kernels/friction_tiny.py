@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .coulomb_certificate import FRICTION_FIGURES, friction_figures
-from .friction import natural_map
+from .friction import natural_map_into
 from .friction_newton import scales, solve_small
 from .jit import inline_kernel, kernel
 from .units import contact_units
@@ -73,17 +73,18 @@ def _units(diagonal, q, d):
 
 
 @inline_kernel(interpretable=True)
-def judged(rw, uw, u, s, qu, mu, d, tol, figures):
+def judged(rw, uw, u, s, qu, mu, d, tol, figures, F):
     """The certificate of an answer (r, u) as given, from r̂ = s∘r in ``rw`` and
     û = W̃r̂ + q̂ in ``uw`` recomputed by the caller from W̃ and q̂: the figures of
     :func:`~impactqp.kernels.coulomb_certificate.friction_figures` into ``figures``, with
-    ‖F(r̂, û)‖ and ‖u/s − û‖. Returns :data:`CERTIFIED` when each residual is within
-    ``tol`` (a NaN fails), else :data:`NOT_CERTIFIED`."""
+    ‖F(r̂, û)‖ (F written into ``F``, d·m floats) and ‖u/s − û‖. Returns
+    :data:`CERTIFIED` when each residual is within ``tol`` (a NaN fails), else
+    :data:`NOT_CERTIFIED`."""
     mismatch = 0.0
     for i in range(u.size):
         gap = u[i] / s[i] - uw[i]
         mismatch += gap * gap
-    F = natural_map(rw, uw, mu, d)
+    natural_map_into(rw, uw, mu, d, F)
     f_norm = 0.0
     for i in range(u.size):
         f_norm += F[i] * F[i]
@@ -155,7 +156,7 @@ def solve_tiny(W, q, mu, d, limits, r, u, figures):
         for j in range(size):
             total += Wu[i, j] * ru[j]
         uw[i] = total
-    return its, judged(ru, uw, u, s, qu, mu, d, limits.tol, figures), scaled
+    return its, judged(ru, uw, u, s, qu, mu, d, limits.tol, figures, np.empty(size)), scaled
 
 
 @inline_kernel(interpretable=True)

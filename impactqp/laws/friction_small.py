@@ -29,7 +29,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..kernels.friction import kernel_mu
-from ..kernels.friction_packed import pack, solve_given, solve_packed
+from ..kernels.friction_packed import answer_size, pack, solve_given, solve_packed
 from ..kernels.friction_tiny import CERTIFIED, FRICTION_FIGURES
 from ..kernels.jit import machine_code
 from ..model.friction import FrictionCertificate, FrictionContactProblem, friction_certificate
@@ -64,8 +64,10 @@ class SmallFrictionResult(FrictionResult):
     """A :class:`~impactqp.friction.FrictionResult` of :func:`solve_few`: the same attributes,
     each read from the compiled call when first asked for.
 
-    A new result holds one entry, ``_call``: (the array the call filled with r, u and the
-    certificate's figures, the tolerance, the iterations, the seconds, the route), the route
+    A new result holds one entry, ``_call``: (the array the call filled with r, u, the
+    certificate's figures and the iterations, then its work
+    (:func:`~impactqp.kernels.friction_packed.answer_size`), the tolerance, the seconds, the
+    route), the route
     (d·m, whether the problem was posed in other units than given, the method's name) shared
     by the results of one pack. A Python object's every further attribute costs about 25 ns
     to set and free, a tenth of a solve again's Python; a plain tuple, not a named one
@@ -82,18 +84,18 @@ class SmallFrictionResult(FrictionResult):
 
     @cached_property
     def r(self) -> np.ndarray:  # type: ignore[override]
-        out, _, _, _, (size, _, _) = self._call
+        out, _, _, (size, _, _) = self._call
         return out[:size]
 
     @cached_property
     def u(self) -> np.ndarray:  # type: ignore[override]
-        out, _, _, _, (size, _, _) = self._call
+        out, _, _, (size, _, _) = self._call
         return out[size:2 * size]
 
     @cached_property
     def certificate(self) -> FrictionCertificate:  # type: ignore[override]
-        out, tol, _, _, (size, _, _) = self._call
-        return friction_certificate(out[2 * size:], tol)
+        out, tol, _, (size, _, _) = self._call
+        return friction_certificate(out[2 * size:2 * size + _FIGURES], tol)
 
     @cached_property
     def error(self) -> float:  # type: ignore[override]
@@ -101,19 +103,20 @@ class SmallFrictionResult(FrictionResult):
 
     @cached_property
     def iterations(self) -> int:  # type: ignore[override]
-        return self._call[2]
+        out, _, _, (size, _, _) = self._call
+        return int(out[2 * size + _FIGURES])  # where the call wrote them (iterations_at)
 
     @cached_property
     def solve_time(self) -> float:  # type: ignore[override]
-        return self._call[3]
+        return self._call[2]
 
     @cached_property
     def backend(self) -> str:  # type: ignore[override]
-        return self._call[4][2]
+        return self._call[3][2]
 
     @cached_property
     def attempts(self) -> list[str]:  # type: ignore[override]
-        _, scaled, backend = self._call[4]
+        _, scaled, backend = self._call[3]
         note = ["solved in its contacts' units (2^0)"] if scaled else []
         return [*note, f"{backend} (friction): certified"]
 
@@ -139,31 +142,37 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float,
     rewritten, W or μ replaced) is solved from its arrays and packed again. Every call fills
     an array of its own: a result is never changed by a later solve.
     """
+    kept = problem._kept
+    if kept is not None:  # solved before: from its pack while it holds the state packed
+        packed = kept.packed
+        if (packed is not None and (sweeps or kept.small)
+                and problem.holds(kept.state)):  # the same d·m, so the same route
+            out = _empty(packed.out_size)
+            if _solve_from_pack(packed.floats, packed.ints, tol, out) != CERTIFIED:
+                return None
+            result = _new(SmallFrictionResult)
+            result.__dict__["_call"] = (out, tol, perf_counter() - start, packed.route)
+            return result
     m = problem.n_contacts
     small = m <= methods.SMALL_CONTACTS  # the "kernel" method's own limit
     if not (small or (sweeps and m <= SWEPT_CONTACTS)):
         return None
-    kept = problem._kept
-    if kept is not None and kept.small is small and problem.holds(kept.state):
-        packed = kept.packed
-        if packed is None:  # solved once: pack it
-            packed, out, its, outcome = _pack(problem, small, tol)
-            kept.packed = packed  # one assignment
-        else:
-            out = _empty(packed.out_size)
-            its, outcome = _solve_from_pack(packed.floats, packed.ints, tol, out)
+    if (kept is not None and kept.packed is None and kept.small is small
+            and problem.holds(kept.state)):  # solved once: pack it
+        packed, out, outcome = _pack(problem, small, tol)
+        kept.packed = packed  # one assignment
         route = packed.route
     else:
         problem._kept = _Kept(problem.state(), small)
         size = problem.q.size
-        out = np.empty(2 * size + _FIGURES)
+        out = np.empty(answer_size(size))
         W, rows, q, mu, d = _given(problem)
-        its, outcome, scaled = solve_given(W, rows, q, mu, d, (tol, *_budgets(small)), out)
+        outcome, scaled = solve_given(W, rows, q, mu, d, (tol, *_budgets(small)), out)
         route = (size, scaled, "kernel" if small else "nsgs-short")
     if outcome != CERTIFIED:
         return None
     result = _new(SmallFrictionResult)
-    result.__dict__["_call"] = (out, tol, its, perf_counter() - start, route)
+    result.__dict__["_call"] = (out, tol, perf_counter() - start, route)
     return result
 
 
@@ -179,24 +188,24 @@ class _Packed(NamedTuple):
 
 
 def _pack(problem: FrictionContactProblem, small: bool,
-          tol: float) -> tuple[_Packed, np.ndarray, int, int]:
+          tol: float) -> tuple[_Packed, np.ndarray, int]:
     """``problem`` packed for the ``"kernel"`` method (``small``) or the first sweep of
     ``"nsgs-short"``, and its solve at ``tol`` through numba's dispatch (which compiles,
     loads or interprets :func:`~impactqp.kernels.friction_packed.solve_packed` as it must,
     and from which :data:`_solve_from_pack` takes the machine code): the :class:`_Packed`,
-    the array the solve filled, its iterations and its outcome."""
+    the array the solve filled and its outcome."""
     global _solve_from_pack
     floats, ints = pack(*_given(problem), _budgets(small))
     size = problem.q.size
-    out = np.empty(2 * size + _FIGURES)
-    its, outcome = solve_packed(floats, ints, tol, out)
+    out = np.empty(answer_size(size))
+    outcome = solve_packed(floats, ints, tol, out)
     if _solve_from_pack is solve_packed:
         _solve_from_pack = machine_code(solve_packed, floats, ints, tol, out)
     route = (size, bool(ints[_SCALED]), "kernel" if small else "nsgs-short")
-    return _Packed(floats, ints, out.size, route), out, its, outcome
+    return _Packed(floats, ints, out.size, route), out, outcome
 
 
-_solve_from_pack: Callable[..., tuple[int, int]] = solve_packed
+_solve_from_pack: Callable[..., int] = solve_packed
 """What solves a pack (:func:`solve_few`): :func:`~impactqp.kernels.friction_packed.solve_packed`
 through numba's dispatch until a pack's first solve (:func:`_pack`) finds its machine code
 (:func:`~impactqp.kernels.jit.machine_code`), that code from then on, called without the
