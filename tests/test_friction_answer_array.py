@@ -18,7 +18,7 @@ from impactqp.kernels.friction_packed import (
     FIGURE_COUNT,
     answer_size,
     iterations_at,
-    solve_given,
+    pack,
     solve_packed,
 )
 from impactqp.kernels.friction_tiny import CERTIFIED
@@ -73,7 +73,7 @@ def test_what_the_array_held_before_does_not_change_the_answer(name: str) -> Non
 def test_the_result_reads_its_answer_not_the_work(name: str) -> None:
     """Each field a result reads from its array: r and u the problem's (u = W r + q
     recomputed here), the certificate the one recomputed apart, the iterations those the
-    first solve (through solve_given) wrote; the work after them is not r, u or the
+    first solve (through pack and solve_packed) wrote; the work after them is not r, u or the
     figures."""
     problem = friction_data.load(name).problem
     results = [iq.solve_friction(problem, tol=TOL) for _ in range(3)]
@@ -93,8 +93,8 @@ def test_the_result_reads_its_answer_not_the_work(name: str) -> None:
 
 @pytest.mark.parametrize("name", ["FC2D-00394", "LMGC-00046", "Rover4144"])
 def test_the_first_solve_writes_its_iterations(name: str) -> None:
-    """solve_given (the first solve) writes the iterations where the result reads them: one
-    where the first sweep alone ends the problem, more where it does not (judged apart by
+    """A first solve (pack, then solve_packed) writes the iterations where the result reads
+    them: one where the first sweep alone ends the problem, more where it does not (judged apart by
     the first sweep alone, ``whole`` False, exact on these 2-D and sticking or coupled 3-D
     contacts where one sweep is); the sweeps' count where they end it (LMGC-00046), with
     the Newton steps where those do (Rover4144)."""
@@ -103,10 +103,11 @@ def test_the_first_solve_writes_its_iterations(name: str) -> None:
     W, rows, q, mu, d = friction_small._given(problem)
     steps, sweeps, local, _ = friction_small._budgets(True)
     alone = np.full(answer_size(size), np.nan)
-    outcome, _ = solve_given(W, rows, q, mu, d, (TOL, steps, sweeps, local, False), alone)
+    outcome = solve_packed(*pack(W, rows, q, mu, d, (steps, sweeps, local, False)), TOL, alone)
     assert alone[iterations_at(size)] == 1
     out = np.full(answer_size(size), np.nan)
-    assert solve_given(W, rows, q, mu, d, (TOL, steps, sweeps, local, True), out)[0] == CERTIFIED
+    assert solve_packed(*pack(W, rows, q, mu, d, (steps, sweeps, local, True)), TOL,
+                        out) == CERTIFIED
     its = out[iterations_at(size)]
     assert its == int(its) and (its == 1) == (outcome == CERTIFIED)
     assert certify_friction(problem, out[:size], out[size:2 * size], tol=TOL).ok

@@ -1,7 +1,7 @@
-"""The route of a few contacts in one compiled call (impactqp/laws/friction_small.py,
-impactqp/kernels/friction_tiny.py's solve_given) against the general route: on every problem
-of benchmarks/data/fclib with at most 64 contacts and on random ones, dense and compressed,
-the same verdict, velocities within the certificate's tolerance, and a thin result whose
+"""The route of a few contacts in one compiled solve (impactqp/laws/friction_small.py,
+impactqp/kernels/friction_packed.py's pack and solve_packed) against the general route: on
+every problem of benchmarks/data/fclib with at most 64 contacts and on random ones, dense and
+compressed, the same verdict, velocities within the certificate's tolerance, and a thin result whose
 certificate is the one certify_friction recomputes from its r and u."""
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from benchmarks import friction_data
 from benchmarks.friction_tiny import ONE_SWEEP, TINY
 from impactqp.errors import BackendUnsuitableError, CertificateError
 from impactqp.friction import FrictionResult
-from impactqp.kernels.friction_packed import answer_size, solve_given
+from impactqp.kernels.friction_packed import answer_size, pack, solve_packed
 from impactqp.kernels.friction_tiny import CERTIFIED, NOT_CERTIFIED
 from impactqp.laws import friction_small
 from impactqp.laws.friction_small import SmallFrictionResult
@@ -160,11 +160,11 @@ def test_the_first_sweep_alone_is_not_certified_where_it_does_not_reach_tol() ->
     n = problem.q.size
     out = np.empty(answer_size(n))
     rows = (np.empty(0, np.int32), np.empty(0, np.int32), np.empty(0), False)
-    outcome, _ = solve_given(problem.W, rows, problem.q, problem.mu, 3,
-                             (TOL, 50, 100, 3, False), out)
+    outcome = solve_packed(*pack(problem.W, rows, problem.q, problem.mu, 3, (50, 100, 3, False)),
+                           TOL, out)
     assert outcome == NOT_CERTIFIED
-    outcome, _ = solve_given(problem.W, rows, problem.q, problem.mu, 3,
-                             (TOL, 50, 100, 10, True), out)
+    outcome = solve_packed(*pack(problem.W, rows, problem.q, problem.mu, 3, (50, 100, 10, True)),
+                           TOL, out)
     assert outcome == CERTIFIED
     assert certify_friction(problem, out[:n], out[n:2 * n], tol=TOL).ok
 

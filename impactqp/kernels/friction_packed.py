@@ -1,10 +1,13 @@
 """A local frictional problem of a few contacts packed once and solved in one compiled call
 (docs/theory.md §15).
 
-:func:`solve_given` poses a problem as given (W dense or compressed) in its contacts' units
-(:func:`impactqp.kernels.friction_tiny.posed_rows`), packs it with what its sweeps read
-(:func:`pack`) and solves and certifies it (:func:`solve_packed`); a caller solving the same
-problem again keeps the pack and calls :func:`solve_packed` alone. The certificate is
+:func:`pack` poses a problem as given (W dense or compressed) in its contacts' units
+(:func:`impactqp.kernels.friction_tiny.posed_rows`) and packs it with what its sweeps read;
+:func:`solve_packed` solves and certifies it, and a caller solving the same problem again
+keeps the pack and calls :func:`solve_packed` alone. They are two calls from Python, not
+one kernel calling both: numba links the code of every kernel a kernel calls into the
+caller and optimises it again there, and a kernel over :func:`solve_packed` cost 6–10 s of
+CPU of ``impactqp compile`` for the ~1 µs of a call it saved on a first solve. The certificate is
 recomputed from r as given by :func:`impactqp.kernels.friction_tiny.judged`.
 """
 
@@ -45,10 +48,19 @@ def pack(W, rows, q, mu, d, budgets):
 
     Parameters
     ----------
-    W, rows, q, mu, d
-        As for :func:`solve_given`.
+    W : (d·m, d·m) float array
+        W when it is dense; ignored (any 2-D float array) when ``rows`` hold it.
+    rows : (indptr, indices, data, by_columns)
+        W compressed as scipy keeps it (CSR rows, or CSC columns when ``by_columns``; int32
+        indices), duplicates summed; empty arrays (``indptr`` of size 0) when W is dense.
+    q, mu, d
+        As for :func:`~impactqp.kernels.friction_tiny.solve_tiny`.
     budgets : (newton_steps, sweeps, local_iters, whole)
-        The integer fields of ``limits`` of :func:`solve_given`.
+        The integer fields of :class:`~impactqp.kernels.friction_tiny.TinyLimits` as a plain
+        tuple (numba types a NamedTuple at each call in about 2 µs, a plain tuple in a few
+        hundred ns), and ``whole``: False to end after the first sweep (then kept where it
+        is within tol/2, the first sweep of the ``"nsgs-short"`` method, with
+        ``local_iters`` of that method).
 
     Returns
     -------
@@ -114,7 +126,7 @@ def _unpacked(floats, ints):
 
 
 def answer_size(size: int) -> int:
-    """The floats of the array ``out`` that :func:`solve_packed` and :func:`solve_given` fill
+    """The floats of the array ``out`` that :func:`solve_packed` fills
     for a problem of ``size`` = d·m entries: r, u, the certificate's figures, the
     iterations done (at :func:`iterations_at`), then the call's own work (r̂, û, F of d·m
     floats each, and 3·d ≤ 9 for a contact's local problem), taken from the one new array
@@ -229,44 +241,5 @@ def solve_packed(floats, ints, tol, out):
     return _finish(ru, s, rows, qu, mu, d, tol, out)
 
 
-@kernel(interpretable=True)
-def solve_given(W, rows, q, mu, d, limits, out):
-    """Solve and certify a problem of a few contacts, W as the problem holds it (dense or
-    compressed), in one call (docs/theory.md §15): posed in its contacts' units by its
-    nonzero entries and packed (:func:`pack`), then solved and certified by
-    :func:`solve_packed`.
-
-    Parameters
-    ----------
-    W : (d·m, d·m) float array
-        W when it is dense; ignored (any 2-D float array) when ``rows`` hold it.
-    rows : (indptr, indices, data, by_columns)
-        W compressed as scipy keeps it (CSR rows, or CSC columns when ``by_columns``; int32
-        indices), duplicates summed; empty arrays (``indptr`` of size 0) when W is dense.
-    q, mu, d
-        As for :func:`~impactqp.kernels.friction_tiny.solve_tiny`.
-    limits : (tol, newton_steps, sweeps, local_iters, whole)
-        The fields of :class:`~impactqp.kernels.friction_tiny.TinyLimits` as a plain tuple
-        (numba types a NamedTuple at each call in about 2 µs, a plain tuple in a few hundred
-        ns), and ``whole``: False to end after the first sweep (then kept where it is
-        within tol/2, the first sweep of the ``"nsgs-short"`` method, with ``local_iters``
-        of that method).
-    out : (:func:`answer_size`,) float array
-        Filled as by :func:`solve_packed`.
-
-    Returns
-    -------
-    (outcome, scaled), as :func:`~impactqp.kernels.friction_tiny.solve_tiny`'s;
-    :data:`NOT_CERTIFIED` without ``whole`` where the first sweep did not reach tol/2
-    (``out`` then unspecified but for the iterations).
-    """
-    tol, newton_steps, sweeps, local_iters, whole = limits
-    floats, ints = pack(W, rows, q, mu, d, (newton_steps, sweeps, local_iters, whole))
-    if ints[5] == 0:
-        out[iterations_at(q.size)] = 0.0
-        return NEEDS_SCALING, True
-    return solve_packed(floats, ints, tol, out), ints[4] != 0
-
-
 __all__ = ["FIGURE_COUNT", "PACKED_HEADER", "answer_size", "iterations_at", "pack",
-           "solve_given", "solve_packed"]
+           "solve_packed"]

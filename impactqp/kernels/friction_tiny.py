@@ -173,7 +173,7 @@ def row_products(indptr, indices, data, x, q, out):
 def posed_rows(W, rows, q, d):
     """The problem in its contacts' units, W̃ = DWD by its nonzero compressed rows and
     q̂ = Dq (D = diag(1/s), s of :func:`_units`), from W dense or compressed (as
-    :func:`~impactqp.kernels.friction_packed.solve_given` takes it): one pass over W's entries.
+    :func:`~impactqp.kernels.friction_packed.pack` takes it): one pass over W's entries.
 
     Returns
     -------

@@ -2,14 +2,14 @@
 (docs/theory.md §15).
 
 :func:`solve_few` hands W (dense, or compressed as scipy holds it), q and μ to
-:func:`impactqp.kernels.friction_packed.solve_given`, which poses the problem in its contacts'
-units, solves it by the ``"kernel"`` method (or, for a few dozen contacts, sweeps it once),
-scales the answer back and recomputes its certificate from W and q as given, and returns the
-verdict. A problem solved again is solved from the pack its second solve keeps on it
-(:func:`impactqp.kernels.friction_packed.solve_packed`). Nothing but the verdict is turned
-into Python objects at the call: the :class:`SmallFrictionResult` holds the array the call
-filled (r, u, the certificate's figures and the iterations) and builds the certificate, the
-error and the attempts from it when they are read.
+:func:`impactqp.kernels.friction_packed.pack`, which poses the problem in its contacts'
+units, and the pack to :func:`impactqp.kernels.friction_packed.solve_packed`, which solves
+it by the ``"kernel"`` method (or, for a few dozen contacts, sweeps it once), scales the
+answer back and recomputes its certificate from W and q as given, and returns the verdict.
+The pack is kept on the problem: a problem solved again is solved from it. Nothing but the
+verdict is turned into Python objects at the call: the :class:`SmallFrictionResult` holds
+the array the call filled (r, u, the certificate's figures and the iterations) and builds
+the certificate, the error and the attempts from it when they are read.
 
 A solve again of a 1-contact problem takes about 2.4 µs of thread CPU (quiet machine): the
 compiled work about 1.0 µs (unpacking the pack ~0.2, the sweep ~0.4 with a sliding
@@ -35,7 +35,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..kernels.friction import kernel_mu
-from ..kernels.friction_packed import answer_size, pack, solve_given, solve_packed
+from ..kernels.friction_packed import answer_size, pack, solve_packed
 from ..kernels.friction_tiny import CERTIFIED, FRICTION_FIGURES
 from ..kernels.jit import machine_code
 from ..model.friction import FrictionCertificate, FrictionContactProblem, friction_certificate
@@ -46,9 +46,9 @@ from .result import FrictionResult
 __all__ = ["SmallFrictionResult", "solve_few"]
 
 _DENSE = (np.empty(0, dtype=np.int32), np.empty(0, dtype=np.int32), np.empty(0), False)
-"""The ``rows`` of :func:`~impactqp.kernels.friction_packed.solve_given` for a dense W."""
+"""The ``rows`` of :func:`~impactqp.kernels.friction_packed.pack` for a dense W."""
 _NO_W = np.empty((0, 0))
-"""The ``W`` of :func:`~impactqp.kernels.friction_packed.solve_given` for a compressed W."""
+"""The ``W`` of :func:`~impactqp.kernels.friction_packed.pack` for a compressed W."""
 _FIGURES = len(FRICTION_FIGURES)
 _KEPT = "_kept"
 """The attribute of a problem :func:`solve_few` has solved, a :class:`_Kept`
@@ -129,8 +129,8 @@ class SmallFrictionResult(FrictionResult):
 
 def solve_few(problem: FrictionContactProblem, tol: float, start: float,
               sweeps: bool = True) -> SmallFrictionResult | None:
-    """The certified answer of one compiled call
-    (:func:`impactqp.kernels.friction_packed.solve_given`), ``start`` the
+    """The certified answer of one compiled solve
+    (:func:`impactqp.kernels.friction_packed.solve_packed`), ``start`` the
     ``time.perf_counter()`` of the solve's start: for at most
     :data:`~impactqp.qp.friction.methods.SMALL_CONTACTS` contacts the ``"kernel"``
     method's; with ``sweeps``, for at most :data:`SWEPT_CONTACTS`, that of one sweep of the
@@ -139,46 +139,37 @@ def solve_few(problem: FrictionContactProblem, tol: float, start: float,
     answer fails its certificate: the general route then runs (and tries the method again
     among the others).
 
-    A problem solved a second time is kept packed (:func:`~impactqp.kernels.friction_packed.pack`:
+    A problem solved is kept packed (:func:`~impactqp.kernels.friction_packed.pack`:
     posed in its contacts' units, with its diagonal blocks and their steps) on the problem, as
     :meth:`~impactqp.FrictionContactProblem.in_contact_units` keeps its units: later solves
-    start from it (:func:`~impactqp.kernels.friction_packed.solve_packed`). The first solve
-    packs nothing (a simulator poses a new problem at each step), and a problem that no
+    start from it. The pack is made by a call of its own, not inside the solve (which would
+    cost ``impactqp compile`` 6–10 s of CPU, see
+    :mod:`~impactqp.kernels.friction_packed`), so the first solve keeps it for the cost
+    of one assignment; a problem that no
     longer :meth:`~impactqp.FrictionContactProblem.holds` the state it was packed in (q
     rewritten, W or μ replaced) is solved from its arrays and packed again. Every call fills
     an array of its own: a result is never changed by a later solve.
     """
     kept = problem._kept
-    if kept is not None:  # solved before: from its pack while it holds the state packed
-        packed = kept.packed
-        if (packed is not None and (sweeps or kept.small)
-                and problem.holds(kept.state)):  # the same d·m, so the same route
-            out = _empty(packed.out_size)
-            if _solve_from_pack(packed.floats, packed.ints, tol, out) != CERTIFIED:
-                return None
-            result = _new(SmallFrictionResult)
-            result.__dict__["_call"] = (out, tol, perf_counter() - start, packed.route)
-            return result
+    if kept is not None and (sweeps or kept.small) and problem.holds(kept.state):
+        packed = kept.packed  # solved before, in the state packed: the same d·m and route
+        out = _empty(packed.out_size)
+        if _solve_from_pack(packed.floats, packed.ints, tol, out) != CERTIFIED:
+            return None
+        result = _new(SmallFrictionResult)
+        result.__dict__["_call"] = (out, tol, perf_counter() - start, packed.route)
+        return result
     m = problem.n_contacts
     small = m <= methods.SMALL_CONTACTS  # the "kernel" method's own limit
     if not (small or (sweeps and m <= SWEPT_CONTACTS)):
         return None
-    if (kept is not None and kept.packed is None and kept.small is small
-            and problem.holds(kept.state)):  # solved once: pack it
-        packed, out, outcome = _pack(problem, small, tol)
-        kept.packed = packed  # one assignment
-        route = packed.route
-    else:
-        problem._kept = _Kept(problem.state(), small)
-        size = problem.q.size
-        out = np.empty(answer_size(size))
-        W, rows, q, mu, d = _given(problem)
-        outcome, scaled = solve_given(W, rows, q, mu, d, (tol, *_budgets(small)), out)
-        route = (size, scaled, "kernel" if small else "nsgs-short")
+    state = problem.state()
+    packed, out, outcome = _pack(problem, small, tol)
+    problem._kept = _Kept(state, small, packed)  # one assignment
     if outcome != CERTIFIED:
         return None
     result = _new(SmallFrictionResult)
-    result.__dict__["_call"] = (out, tol, perf_counter() - start, route)
+    result.__dict__["_call"] = (out, tol, perf_counter() - start, packed.route)
     return result
 
 
@@ -204,7 +195,7 @@ def _pack(problem: FrictionContactProblem, small: bool,
     floats, ints = pack(*_given(problem), _budgets(small))
     size = problem.q.size
     out = np.empty(answer_size(size))
-    outcome = solve_packed(floats, ints, tol, out)
+    outcome = _solve_from_pack(floats, ints, tol, out)
     if _solve_from_pack is solve_packed:
         _solve_from_pack = machine_code(solve_packed, floats, ints, tol, out)
     route = (size, bool(ints[_SCALED]), "kernel" if small else "nsgs-short")
@@ -225,18 +216,17 @@ not on the problem: a problem with its pack still pickles."""
 class _Kept:
     """What :func:`solve_few` keeps on a problem it has solved: the problem's
     :meth:`~impactqp.FrictionContactProblem.state` it solved, whether by the ``"kernel"``
-    method (``small``), and from its second solve on ``packed``, a :class:`_Packed` set in
-    one assignment (a thread solving the same problem sees all of it or none)."""
+    method (``small``), and the :class:`_Packed` problem, made at once and set in one
+    assignment (a thread solving the same problem sees all of it or none)."""
 
     __slots__ = ("state", "small", "packed")
 
-    def __init__(self, state: tuple, small: bool) -> None:
-        self.state, self.small = state, small
-        self.packed: _Packed | None = None
+    def __init__(self, state: tuple, small: bool, packed: _Packed) -> None:
+        self.state, self.small, self.packed = state, small, packed
 
 
 def _given(problem: FrictionContactProblem) -> tuple:
-    """(W, rows, q, μ, d) of :func:`~impactqp.kernels.friction_packed.solve_given` for
+    """(W, rows, q, μ, d) of :func:`~impactqp.kernels.friction_packed.pack` for
     ``problem``: W dense, or its compressed arrays (CSC kept as columns, other formats as
     CSR rows)."""
     W = problem.W
