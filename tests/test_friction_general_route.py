@@ -14,8 +14,17 @@ import impactqp as iq
 from benchmarks.friction_data import load
 from impactqp.kernels.friction import nsgs_contacts, project_cones, relax_contact, relaxation
 from impactqp.model.friction import certify_friction
+from impactqp.qp.friction import methods as friction_methods
 from impactqp.qp.friction.data import FrictionData, ProblemArrays
-from impactqp.qp.friction.methods import RELAX_PLANAR, nsgs_route
+from impactqp.qp.friction.methods import (
+    NEWTON_STALL,
+    QUICK_PROBE,
+    RELAX_PLANAR,
+    SOCP_WARM,
+    STALL_NEAR,
+    nsgs_route,
+)
+from impactqp.qp.friction.newton import NEWTON_STEPS, _slow, newton
 
 TOL = 1e-8
 
@@ -201,3 +210,85 @@ def test_relaxation_cuts_the_sweeps_of_the_granular_flow() -> None:
     res = iq.solve_friction(case.problem, tol=TOL)
     assert res.backend == "nsgs-short" and res.iterations == counts[1]
     assert certify_friction(case.problem, res.r, res.u, tol=TOL).ok
+
+
+def test_slow_windows() -> None:
+    """Newton's probe asks once, after its first k steps; its stall after every step from
+    the k-th, over the last k."""
+    errors = [1.0, 0.9, 0.85, 0.1, 0.09, 0.085]
+    assert not _slow(errors[:2], (2, 1.25), only_first=True)  # one step: not asked yet
+    assert _slow(errors[:3], (2, 1.25), only_first=True)  # 1 → 0.85 in two steps
+    assert not _slow(errors[:4], (2, 1.25), only_first=True)  # asked only after step 2
+    assert not _slow(errors[:4], (2, 1.25), only_first=False)  # 0.9 → 0.1
+    assert _slow(errors, (2, 1.25), only_first=False)  # 0.1 → 0.085
+    assert not _slow(errors, (3, 1.25), only_first=False)  # 0.85 → 0.085
+    assert not _slow(errors, None, only_first=False)
+
+
+@pytest.fixture(scope="module")
+def capsules_404() -> FrictionData:
+    return FrictionData(load("Capsules-404").problem.in_contact_units().problem)
+
+
+def test_newton_ends_where_it_stalls_near_the_answer(capsules_404: FrictionData) -> None:
+    """Capsules-404: Newton from r = 0 sits at ‖F‖/‖q‖ ≈ 3e-6 from its 10th step on; with the
+    stall it ends there, well before its 50 steps, at the error it would have crawled from."""
+    data = capsules_404
+    r, steps, ok = newton(data, np.zeros(data.n), TOL, stall=NEWTON_STALL)
+    assert not ok and NEWTON_STALL[0] <= steps < 25
+    assert data.error(r) <= STALL_NEAR
+    r_full, steps_full, _ = newton(data, np.zeros(data.n), TOL, max_steps=steps + 5)
+    assert steps_full == steps + 5
+    assert data.error(r_full) > 0.5 * data.error(r)  # five more steps gain less than 2×
+
+
+def test_newton_goes_on_where_it_converges_or_is_far() -> None:
+    """Capsules: Newton certifies in 21 steps, with or without the stall; far from the
+    answer (spheres-in-a-box, ‖F‖/‖q‖ > 1e-4 throughout) it takes its 50 steps."""
+    data = FrictionData(load("Capsules").problem.in_contact_units().problem)
+    r, steps, ok = newton(data, np.zeros(data.n), TOL, stall=NEWTON_STALL)
+    assert ok and steps == 21
+    assert certify_friction(data.program, r, tol=TOL).ok
+    far = FrictionData(load("spheres-in-a-box").problem.in_contact_units().problem)
+    r, steps, ok = newton(far, np.zeros(far.n), TOL, stall=NEWTON_STALL)
+    assert not ok and steps == NEWTON_STEPS and far.error(r) > STALL_NEAR
+
+
+def test_socp_route_starts_from_zero_near_but_not_at_the_answer(
+        capsules_404: FrictionData, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The SOCP route's start: r = 0 from a start between SOCP_WARM·tol and STALL_NEAR, the
+    start itself within SOCP_WARM·tol or beyond STALL_NEAR."""
+    data = capsules_404
+    starts = []
+
+    def spy(data_, r0, tol):
+        starts.append(r0.copy())
+        return r0, 0, False
+
+    monkeypatch.setattr(friction_methods, "socp_route", spy)
+    r_near, _, _ = newton(data, np.zeros(data.n), TOL, stall=NEWTON_STALL)  # ~3e-6
+    r_far = np.zeros(data.n)
+    r_far[0::3] = 1.0  # far from the answer
+    assert data.error(r_far) > STALL_NEAR
+    for start, expect_zero in ((r_near, True), (r_far, False), (None, True)):
+        friction_methods.socp(data, start, TOL)
+        if expect_zero:
+            assert not starts[-1].any()
+        else:
+            np.testing.assert_array_equal(starts[-1], start)
+    r_close = newton(data, np.zeros(data.n), 0.5 * SOCP_WARM * TOL, max_steps=60)[0]
+    if data.error(r_close) <= SOCP_WARM * TOL:
+        friction_methods.socp(data, r_close, TOL)
+        np.testing.assert_array_equal(starts[-1], r_close)
+
+
+def test_capsules_404_takes_the_socp_route_after_a_short_newton() -> None:
+    case = load("Capsules-404")
+    res = iq.solve_friction(case.problem, tol=TOL)
+    assert res.backend == "clarabel"
+    assert certify_friction(case.problem, res.r, res.u, tol=TOL).ok
+    newton_attempt = [a for a in res.attempts if a.startswith("newton (")]
+    steps = int(newton_attempt[0].split(" after ")[1].split(" iterations")[0])
+    assert steps < 25
+    nsgs_attempt = [a for a in res.attempts if a.startswith("nsgs-short (")]
+    assert int(nsgs_attempt[0].split(" after ")[1].split(" iterations")[0]) <= 100 + QUICK_PROBE

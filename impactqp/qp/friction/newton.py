@@ -76,8 +76,8 @@ def newton_step(J: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
 
 
 def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
-            max_steps: int = NEWTON_STEPS,
-            probe: tuple[int, float] | None = None) -> tuple[np.ndarray, int, bool]:
+            max_steps: int = NEWTON_STEPS, probe: tuple[int, float] | None = None,
+            stall: tuple[int, float, float] | None = None) -> tuple[np.ndarray, int, bool]:
     """Semismooth Newton on Alart–Curnier's function Φ (docs/theory.md §15) from r: steps
     (J + λI)Δ = −Φ with J = A + B W (A, B block-diagonal, from
     :func:`impactqp.kernels.friction.alart_curnier`) and λ = κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²) (J is
@@ -88,8 +88,11 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
 
     Stops when the projected r is within tol/2 in ‖F‖/‖q‖ (projecting moves r by up to ‖F‖,
     hence u by up to ‖W‖‖F‖), after ``max_steps`` steps (a rejected step counts), when
-    the line search fails at the largest shift, or, with ``probe`` = (k, g), after k steps
-    that have not divided ‖F‖ by g (Newton still far from its fast convergence). Returns r
+    the line search fails at the largest shift, with ``probe`` = (k, g), after k steps
+    that have not divided ‖F‖ by g (Newton still far from its fast convergence), or, with
+    ``stall`` = (k, g, e), at the first k steps in a row that have not divided ‖F‖ by g
+    ending within ‖F‖/‖q‖ ≤ e (Newton stalled near the answer, docs/theory.md §15).
+    Returns r
     projected onto the cones, the steps done, and whether that r is within tol/2 (the
     certificate's figure)."""
     q, mu, d, rho = data.q, data.mu, data.d, data.rho
@@ -102,15 +105,16 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
     f = norm(phi)
     steps = 0
     boost = 1.0
-    first = -1.0
+    errors: list[float] = []  # ‖F‖ at r and after each step
     while True:
         f_nat = norm(natural_map(r, u, mu, d))
         rp = data.finished(r, f_nat, tol)
         if rp is not None:
             return rp, steps, True
-        first = f_nat if first < 0.0 else first
-        if steps == max_steps or (probe is not None and steps == probe[0]
-                                  and not f_nat * probe[1] <= first):
+        errors.append(f_nat)
+        if (steps == max_steps or _slow(errors, probe, only_first=True)
+                or (stall is not None and f_nat <= stall[2] * data.qn
+                    and _slow(errors, stall[:2], only_first=False))):
             break
         steps += 1
         shift = boost * kappa * min(f / (scale or 1.0), 1e-2)
@@ -132,6 +136,20 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
         phi = alart_curnier(r, u, mu, rho, d, True, A, B)
         f = norm(phi)
     return project_cones(r, mu, d), steps, False
+
+
+def _slow(errors: list[float], window: tuple[int, float] | None, only_first: bool) -> bool:
+    """Whether the last k = ``window[0]`` steps of Newton (``errors``: ‖F‖ at its start and
+    after each step) have not divided ‖F‖ by g = ``window[1]``: asked after the first k steps
+    only when ``only_first`` (:func:`newton`'s probe), else after every step from the k-th
+    (its stall)."""
+    if window is None:
+        return False
+    k, gain = window
+    steps = len(errors) - 1
+    if steps < k or (only_first and steps > k):
+        return False
+    return not errors[-1] * gain <= errors[-1 - k]
 
 
 def lstsq_newton(data: FrictionData, r: np.ndarray, tol: float) -> tuple[np.ndarray, int, bool]:
