@@ -1,5 +1,5 @@
 """Newton's Jacobian J = A + λI + B W assembled from W's contact blocks
-(:class:`impactqp.qp.friction.newton.ContactBlocks`, docs/theory.md §15) against the same
+(:class:`impactqp.qp.friction.data.ContactBlocks`, docs/theory.md §15) against the same
 matrix formed densely, block by block."""
 
 import numpy as np
@@ -7,7 +7,7 @@ import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from impactqp.qp.friction.newton import ContactBlocks
+from impactqp.qp.friction.data import ContactBlocks
 
 
 @pytest.mark.parametrize("d", [1, 2, 3])

@@ -13,9 +13,9 @@ import scipy.sparse.linalg as spla
 import impactqp as iq
 from benchmarks.friction_data import load
 from impactqp.qp.friction import newton as newton_module
+from impactqp.qp.friction.data import ContactBlocks
 from impactqp.qp.friction.newton import (
     STEP_RESIDUAL,
-    ContactBlocks,
     FrictionData,
     newton,
     newton_step,

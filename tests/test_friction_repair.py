@@ -44,9 +44,15 @@ def test_newton_stalls_where_the_repair_certifies() -> None:
     with pytest.raises(iq.CertificateError) as stalled:
         iq.solve_friction(p, backend="newton")
     assert stalled.value.best.error > 1e-6
-    res = iq.solve_friction(p)
+    res = iq.solve_friction(p, backend="newton-repair")
     assert res.backend == "newton-repair" and res.status == "solved"
-    assert "newton (friction, tol 1e-08): certificate failed" in " ".join(res.attempts)
+    # auto: Newton fails, then the SOCP route from r = 0 (its start rule, STALL_NEAR)
+    # certifies before the repairs are reached
+    auto = iq.solve_friction(p)
+    assert auto.backend == "clarabel" and auto.status == "solved"
+    assert "newton (friction, tol 1e-08): certificate failed" in " ".join(auto.attempts)
+    assert certify_friction(p, auto.r, tol=1e-8).ok
+    np.testing.assert_allclose(auto.r, res.r, atol=1e-6 * np.abs(res.r).max())
     # the independent certificate, recomputed from r alone
     again = certify_friction(p, res.r, tol=1e-8)
     assert again.ok and again.error == pytest.approx(res.error, rel=1e-9)

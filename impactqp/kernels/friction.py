@@ -25,6 +25,9 @@ from .jit import inline_kernel, kernel
 
 CHECK_GAP = 8
 """Most sweeps of :func:`nsgs_rows` between two evaluations of ‖F‖."""
+RELAX_FROM = 8
+"""First sweep after which :func:`nsgs_contacts` may measure the plain sweeps' rate to
+over-relax by (the first sweeps' rates are faster than the sweeps' asymptotic one)."""
 
 
 @inline_kernel
@@ -201,7 +204,7 @@ def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
     contacts at each call (:func:`~impactqp.kernels.friction_rows.contact_rows`)."""
     rows = contact_rows(indptr, indices, data, mu.size, d)
     return nsgs_contacts(rows, local_steps(rows.diagonal), q, mu, d, r, tol, max_sweeps,
-                         local_iters)
+                         local_iters, 1.0)
 
 
 @inline_kernel
@@ -224,8 +227,29 @@ def next_check(done, err, tol, last_err, last_at):
     return done + gap
 
 
+@inline_kernel
+def relax_contact(r, k, d, mu, omega, o0, o1, o2):
+    """Over-relaxation of one contact's sweep: ``r[k:k+d]`` ← P_{K_μ}((1 − ω)·r_old + ω·r_new),
+    r_old = (o0, o1, o2) the contact's reaction before the sweep solved its local problem
+    (o2 unused for d = 2), r_new what it wrote (docs/theory.md §15)."""
+    r[k] = (1.0 - omega) * o0 + omega * r[k]
+    r[k + 1] = (1.0 - omega) * o1 + omega * r[k + 1]
+    if d == 3:
+        r[k + 2] = (1.0 - omega) * o2 + omega * r[k + 2]
+    project_contact(r, mu, k, d, r)  # in place: each entry is read before written
+
+
+@inline_kernel
+def relaxation(rate, relax):
+    """The over-relaxation factor of the sweeps at the measured rate of plain sweeps (‖F‖
+    divided by ``rate`` < 1 a sweep): 2/(1 + √(1 − rate)), the best factor of successive
+    over-relaxation of a linear system whose Gauss–Seidel contracts at that rate (Young's
+    formula, docs/theory.md §15), at most ``relax``."""
+    return min(2.0 / (1.0 + np.sqrt(1.0 - rate)), relax)
+
+
 @kernel
-def nsgs_contacts(rows, rhos, q, mu, d, r, tol, max_sweeps, local_iters):
+def nsgs_contacts(rows, rhos, q, mu, d, r, tol, max_sweeps, local_iters, relax):
     """Projected Gauss–Seidel over the contacts (docs/theory.md §15), updating ``r`` in place,
     on W by contacts ``rows`` (:class:`~impactqp.kernels.friction_rows.ContactRows`, so that
     a sweep costs W's blocks) with the steps ``rhos`` of the contacts' fixed points
@@ -233,28 +257,42 @@ def nsgs_contacts(rows, rhos, q, mu, d, r, tol, max_sweeps, local_iters):
     (the others held) is solved as in :func:`~impactqp.kernels.friction_sweep.sweep_once`
     without ``slip``; the sweeps stop when ‖F‖ ≤ tol·‖q‖. ‖F‖ (a product by W, as dear as
     a sweep) is evaluated after the first sweep, then after the sweeps :func:`next_check`
-    says, and after the last. Returns
-    (sweeps done, ‖F‖/‖q‖ at the end)."""
+    says, and after the last.
+
+    With ``relax`` > 1 the sweeps over-relax (:func:`relax_contact`) once the plain sweeps'
+    rate is measured between two evaluations from sweep :data:`RELAX_FROM` on, by the factor
+    :func:`relaxation` gives at that rate (at most ``relax``); they sweep plainly again for
+    good as soon as ‖F‖ falls no faster than it did by plain sweeps. Returns (sweeps done,
+    ‖F‖/‖q‖ at the end)."""
     start, other, block, Wcc = rows
     u, F, work = np.empty(r.size), np.empty(r.size), np.empty(3 * d)
     err, last_err, last_at, check_at = np.inf, np.inf, 0, 1
+    omega, plain = 1.0, 1.0
+    o0, o1, o2 = 0.0, 0.0, 0.0
     for sweep in range(max_sweeps):
         for c in range(mu.size):  # as sweep_once, b_c by blocks
             k = c * d
+            if omega != 1.0:
+                o0, o1 = r[k], r[k + 1]
+                o2 = r[k + 2] if d == 3 else 0.0
             b0, b1, b2 = off_diagonal(start, other, block, q, r, c, d)
+            solved = False
             if d == 2:
                 exact, rn, rt = planar_contact(Wcc[c, 0, 0], Wcc[c, 0, 1], Wcc[c, 1, 0],
                                                Wcc[c, 1, 1], b0, b1, mu[c])
                 if exact:
                     r[k], r[k + 1] = rn, rt
-                    continue
+                    solved = True
             elif b0 >= 0.0:  # apart
                 r[k], r[k + 1], r[k + 2] = 0.0, 0.0, 0.0
-                continue
-            work[2 * d], work[2 * d + 1] = b0, b1
-            if d == 3:
-                work[8] = b2
-            contact_steps(Wcc, rhos, mu, c, d, r, local_iters, work)
+                solved = True
+            if not solved:
+                work[2 * d], work[2 * d + 1] = b0, b1
+                if d == 3:
+                    work[8] = b2
+                contact_steps(Wcc, rhos, mu, c, d, r, local_iters, work)
+            if omega != 1.0:
+                relax_contact(r, k, d, mu[c], omega, o0, o1, o2)
         done = sweep + 1
         if done < check_at and done < max_sweeps:
             continue
@@ -262,6 +300,14 @@ def nsgs_contacts(rows, rhos, q, mu, d, r, tol, max_sweeps, local_iters):
         err = relative_error(r, u, q, mu, d, F)
         if err <= tol:
             return done, err
+        if relax > 1.0 and err < last_err:
+            rate = (err / last_err) ** (1.0 / (done - last_at))
+            if omega != 1.0 and not rate < plain:  # over-relaxing does not pay here
+                omega, relax = 1.0, 1.0
+            elif omega == 1.0 and done >= RELAX_FROM:
+                omega, plain = relaxation(rate, relax), rate
+        elif omega != 1.0:  # ‖F‖ rose
+            omega, relax = 1.0, 1.0
         last_err, last_at, check_at = err, done, next_check(done, err, tol, last_err, last_at)
     return max_sweeps, err
 

@@ -78,9 +78,9 @@ class FrictionContactProblem:
     Notes
     -----
     W, q and μ are the problem's own copies (μ read-only). q may be rewritten in place
-    between solves: what impactqp keeps for a problem (its contact units, the pack of a
-    few-contact problem) is checked against q, and against the W and μ objects, at each
-    solve (:meth:`holds`). W edited in place is not seen: give a new W a new problem.
+    between solves: what impactqp keeps for a problem (its units, a few-contact pack, the
+    arrays of qp/friction/data.py) is checked against q and the W and μ objects at each solve
+    (:meth:`holds`). W edited in place is not seen: give a new W a new problem.
     """
 
     _kept: Any = None

@@ -15,7 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...errors import SolverError
-from ...kernels.friction import modified_velocity, nsgs_rows, project_cones
+from ...kernels.friction import modified_velocity, nsgs_contacts, project_cones
 from ...kernels.friction_newton import scales, solve_small
 from ..cone_solve import solve_cone
 from ..cones import ConeProgram, friction_cone_rows
@@ -26,7 +26,8 @@ SOCP_ROUNDS = 30
 """Most SOCPs of the fixed point on s = μ‖u_T‖."""
 POLISH_STEPS = 20
 """Most Newton steps after NSGS (where they converge they take fewer than 10; where NSGS
-failed, Newton from there tends to fail too, and r = 0 is tried next)."""
+failed, Newton from there tends to fail too, and r = 0 is tried next: on Capsules-404, whose
+sweeps stall at 1.2e-5, 20 steps ended at 3.9e-6, 36 ms, its first two gaining 1.1×)."""
 NEWTON_SHIFT = {"newton": 1.0, "newton-damped": 10.0}
 """The factor κ of the shift κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²)·I added to Newton's Jacobian by each
 variant: the damped one converges on some problems where the other stalls, and takes more
@@ -38,8 +39,29 @@ Newton (on BoxesStack1 rounds gain 10–40 down to 1e-8, at 15 ms each, while Ne
 SOCP_STALL = 3
 """Rounds in a row without progress after which the SOCP route hands its best r on (to
 Newton's polish): on spheres-in-a-box the fixed point stalls at 1.6e-6 for 26 rounds."""
+STALL_NEAR = 1e-4
+"""‖F‖/‖q‖ at or below which Newton from r = 0 ends where it stalls (:data:`NEWTON_STALL`) and
+the SOCP route does not start from the best answer so far unless that is within
+:data:`SOCP_WARM` times the tolerance (docs/theory.md §15). Measured on the 3-D FCLib problems
+whose sweeps and Newton fail: Newton stalls near the answer on Capsules-404 (3e-6 from its
+10th step to its 42nd) and Capsules-1617 (4e-6, then 1e-7), and the SOCP route from such a
+point, or from the sweeps' answer (5e-7 to 4e-6), took 2–6 times longer than from r = 0
+(Capsules-404 54 vs 27 ms, Capsules-1617 301–398 vs 71), or ended uncertified (Capsules);
+from farther points it did not lose (spheres-in-a-box from Newton's 2e-4: 89 ms, from r = 0
+252 ms; BoxesStack1 from 3e-5 or r = 0: 22–33 ms)."""
+SOCP_WARM = 10.0
+"""Within this many times the tolerance the SOCP route starts from the best answer so far
+(Newton's answer that just missed it: Capsules-404 from 2.6e-8 certifies after one round
+and four Newton steps)."""
 NEWTON_FROM = 1e-3
 """Error ‖F‖/‖q‖ below which the SOCP route tries Newton (from farther it tends to stall)."""
+NEWTON_STALL = (8, 1.5, STALL_NEAR)
+"""(k, g, e): Newton from r = 0 (``"newton"``, ``"newton-damped"``) stops at the first k steps
+in a row that have not divided ‖F‖ by g once ‖F‖/‖q‖ ≤ e (:func:`~.newton.newton`'s
+``stall``): stuck there, it crawls through the rest of its 50 steps, and the SOCP route that
+follows starts from r = 0 (:data:`STALL_NEAR`). Stopped after 14 steps on Capsules-404 and 23
+on Capsules-1617; where Newton converges, on Capsules in 21 steps, its slowest 8 steps in a
+row divide ‖F‖ by 2.2."""
 NSGS_SWEEPS = 20000
 """Most sweeps of the projected Gauss–Seidel."""
 NSGS_SHORT = 100
@@ -61,6 +83,13 @@ QUICK_GAIN = 1.25
 """Least factor in ‖F‖ the :data:`QUICK_PROBE` steps gain for the quick polish to go on
 (measured after two steps: KaplasTower 1/0.99, Capsules 1/0.96; PerioBox 1/0.52, FC2D-00727
 1/0.26, FC2D-00237 1/0.001)."""
+RELAX_PLANAR = 1.5
+"""Largest over-relaxation factor of the sweeps on planar problems (d = 2;
+:func:`impactqp.kernels.friction.nsgs_contacts` takes the factor the plain sweeps' rate
+gives, up to this, and sweeps plainly again where it does not pay). Sweeps to 5·10⁻⁹ from
+r = 0, plain against over-relaxed: Granular2D-667 40 → 26, FC2D-00071 65 → 39, FC2D-00727
+704 → 690, FC2D-00237 359 → 343. 3-D problems sweep plainly: over-relaxed, PerioBox took
+958 → 1656 sweeps."""
 NSGS_LOCAL = 3
 """Most projected fixed-point steps on one contact's local problem per sweep (more are
 wasted while the other contacts still move: on the FCLib problems 10 took as many sweeps as
@@ -146,56 +175,58 @@ def _lag(data: FrictionData, r: np.ndarray) -> np.ndarray:
 
 
 def nsgs_route(data: FrictionData, r0: np.ndarray, tol: float,
-                sweeps: int) -> tuple[np.ndarray, int, float]:
+               sweeps: int) -> tuple[np.ndarray, int, float, float]:
     """The compiled projected Gauss–Seidel from r0 to the tolerance (or ``sweeps``), in two
-    halves. Returns r, the sweeps done and the sweeps its rate over the second half predicts
-    are still needed (0 when done, infinity when the error did not fall)."""
+    halves, on W by contacts (kept between solves, :attr:`FrictionData.contacts`),
+    over-relaxed on planar problems (:data:`RELAX_PLANAR`). Returns
+    r, the sweeps done, the sweeps its rate over the second half predicts are still needed
+    (0 when done, infinity when the error did not fall) and ‖F(r)‖/‖q‖."""
     r = np.array(r0, dtype=float)
-    W = data.W
+    rows, steps = data.contacts, data.steps
+    relax = RELAX_PLANAR if data.d == 2 else 1.0
     first = sweeps // 2
-    done, err = nsgs_rows(W.indptr, W.indices, W.data, data.q, data.mu, data.d, r, 0.5 * tol,
-                          first, NSGS_LOCAL)
+    done, err = nsgs_contacts(rows, steps, data.q, data.mu, data.d, r, 0.5 * tol, first,
+                              NSGS_LOCAL, relax)
     if err <= 0.5 * tol or done == sweeps:
-        return r, int(done), 0.0 if err <= 0.5 * tol else math.inf
-    more, err_more = nsgs_rows(W.indptr, W.indices, W.data, data.q, data.mu, data.d, r,
-                               0.5 * tol, sweeps - first, NSGS_LOCAL)
+        return r, int(done), 0.0 if err <= 0.5 * tol else math.inf, err
+    more, err_more = nsgs_contacts(rows, steps, data.q, data.mu, data.d, r, 0.5 * tol,
+                                   sweeps - first, NSGS_LOCAL, relax)
     if err_more <= 0.5 * tol:
         left = 0.0
     elif 0.0 < err_more < err:
         left = more * math.log(0.5 * tol / err_more) / math.log(err_more / err)
     else:
         left = math.inf
-    return r, int(done + more), left
+    return r, int(done + more), left, err_more
 
 
 def short_nsgs_route(data: FrictionData, tol: float) -> tuple[np.ndarray, int, bool]:
     """:data:`NSGS_SHORT` sweeps from r = 0, then Newton from there: :data:`QUICK_POLISH`
     steps when the sweeps' rate predicts they reach the tolerance within :data:`NSGS_MORE`
-    more (:data:`QUICK_PROBE` where those have not divided ‖F‖ by :data:`QUICK_GAIN`), else
-    up to ``POLISH_STEPS``. When Newton has not succeeded, the sweeps go on from
-    their r, in rounds of the predicted number, for as long as each round gains a factor
+    more, else up to ``POLISH_STEPS`` (either cut short after :data:`QUICK_PROBE` steps that
+    have not divided ‖F‖ by :data:`QUICK_GAIN`). When Newton has not succeeded, the sweeps go
+    on from their r, in rounds of the predicted number, for as long as each round gains a factor
     ten in ‖F‖ and its rate predicts the tolerance within what is left of
     :data:`NSGS_MORE` sweeps (else their r is returned, to the next method), after which
     Newton is tried again (docs/theory.md §15).
     Returns r, the sweeps and steps done, and whether Newton was run last."""
-    r, its, left = nsgs_route(data, np.zeros_like(data.q), tol, NSGS_SHORT)
-    if left == 0.0 and data.error(r) <= 0.5 * tol:
+    r, its, left, err = nsgs_route(data, np.zeros_like(data.q), tol, NSGS_SHORT)
+    if left == 0.0:
         return r, its, False
     if left <= NSGS_MORE:  # a quick polish, cut short where Newton is far from converging
         r_pol, steps, ok = newton(data, r, tol, max_steps=QUICK_POLISH,
                                   probe=(QUICK_PROBE, QUICK_GAIN))
-    else:
-        r_pol, steps, ok = newton(data, r, tol, max_steps=POLISH_STEPS)
+    else:  # probed alike: from sweeps that stall, Newton stalled on the FCLib problems
+        r_pol, steps, ok = newton(data, r, tol, max_steps=POLISH_STEPS,
+                                  probe=(QUICK_PROBE, QUICK_GAIN))
     its += steps
     if ok or left > NSGS_MORE or data.error(r_pol) <= 0.5 * tol:
         return r_pol, its, True
     more = 0
-    err = data.error(r)
     while more < NSGS_MORE:
         rounds = int(min(max(left, NSGS_SHORT), NSGS_MORE - more))
-        r, done, left = nsgs_route(data, r, tol, rounds)
+        r, done, left, err_round = nsgs_route(data, r, tol, rounds)
         more += done
-        err_round = data.error(r)
         if err_round <= 0.5 * tol:
             return r, its + more, False
         if not err_round <= 0.1 * err:  # stalling: NSGS will not get there soon
@@ -231,8 +262,11 @@ def _from(data: FrictionData, start: np.ndarray | None) -> np.ndarray:
 
 
 def socp(data: FrictionData, start: np.ndarray | None, tol: float) -> FrictionSolution:
-    """The ``"clarabel"`` method: :func:`socp_route` from ``start`` (None: r = 0), polished by
-    Newton when it ends short of the tolerance."""
+    """The ``"clarabel"`` method: :func:`socp_route` from ``start`` (None: r = 0; r = 0 too
+    where its error lies between :data:`SOCP_WARM` times the tolerance and
+    :data:`STALL_NEAR`), polished by Newton when it ends short of the tolerance."""
+    if start is not None and SOCP_WARM * tol < data.error(start) <= STALL_NEAR:
+        start = None
     r, its, finished = socp_route(data, _from(data, start), tol)
     return FrictionSolution(project_cones(r, data.mu, data.d), its, "clarabel",
                             0 if finished else NEWTON_STEPS)
@@ -246,17 +280,19 @@ def gauss_seidel(data: FrictionData, start: np.ndarray | None, tol: float,
     if method == "nsgs-short":
         r, its, _ = short_nsgs_route(data, tol)
         return FrictionSolution(project_cones(r, data.mu, data.d), its, method)
-    r, its, _ = nsgs_route(data, _from(data, start), tol, NSGS_SWEEPS)
+    r, its, _, _ = nsgs_route(data, _from(data, start), tol, NSGS_SWEEPS)
     return FrictionSolution(project_cones(r, data.mu, data.d), its, method, POLISH_STEPS)
 
 
 def newton_method(data: FrictionData, start: np.ndarray | None, tol: float,
                   method: str) -> FrictionSolution:
     """The ``"newton"`` and ``"newton-damped"`` methods (Alart–Curnier's Newton from r = 0
-    with the shift factor of :data:`NEWTON_SHIFT`) and ``"newton-lstsq"`` (the least-squares
+    with the shift factor of :data:`NEWTON_SHIFT`, ended where it stalls,
+    :data:`NEWTON_STALL`) and ``"newton-lstsq"`` (the least-squares
     Newton on the natural map from ``start``); both end with r projected onto the cones."""
     if method == "newton-lstsq":
         r, its, _ = lstsq_newton(data, _from(data, start), tol)
     else:
-        r, its, _ = newton(data, np.zeros_like(data.q), tol, NEWTON_SHIFT[method])
+        r, its, _ = newton(data, np.zeros_like(data.q), tol, NEWTON_SHIFT[method],
+                           stall=NEWTON_STALL)
     return FrictionSolution(r, its, method)

@@ -1,31 +1,21 @@
 """Newton's methods for local frictional contact problems (docs/theory.md §15): the
 semismooth Newton on Alart–Curnier's function with shifted sparse LU steps, and the
 least-squares Newton on the natural map (dense; for rank-deficient W where the first stalls),
-with :class:`FrictionData`, the problem's arrays as every friction method uses them.
+on :class:`~.data.FrictionData`, the problem's arrays as every friction method uses them.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
-from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ...kernels.friction import (
-    alart_curnier,
-    kernel_mu,
-    modified_velocity,
-    natural_map,
-    project_cones,
-)
-from ...kernels.friction_blocks import nonzero_rows
+from ...kernels.friction import alart_curnier, modified_velocity, natural_map, project_cones
 from ...kernels.friction_jacobians import modified_velocity_jacobian, projection_jacobian
-from ...kernels.friction_newton import scales
-from . import FrictionProgram
+from .data import FrictionData, norm
 
 NEWTON_STEPS = 50
 """Most steps of one run of Newton (those that converge here take 5 to 35)."""
@@ -43,158 +33,6 @@ LSTSQ_STEPS = 60
 """Most steps of the least-squares Newton."""
 LSTSQ_MAX = 600
 """Most unknowns d·m for the least-squares Newton (a dense QR per step: 0.1 s at 858)."""
-
-
-class ContactBlocks(NamedTuple):
-    """W stored in d×d blocks, contact by contact (block compressed rows), every diagonal
-    block present: the pattern of Newton's J = A + λI + B W, whose block-diagonal A and B
-    scale W's block rows, so J is assembled from it with one product per stored block.
-
-    Attributes
-    ----------
-    data : (k, d, d) ndarray
-        The stored blocks of W.
-    indices, indptr : ndarray
-        Their block columns and each block row's span, as in scipy's BSR format.
-    rows : (k,) ndarray
-        The block row (contact) of each stored block.
-    diagonal : (m,) ndarray
-        Where the diagonal block of each contact is stored.
-    csc_order : (k·d·d,) ndarray
-        For each entry of the pattern in compressed-column order, its place in the blocks'
-        entries flattened, so that J is built in that format without converting.
-    csc_indices, csc_indptr : ndarray
-        The pattern's rows and columns' spans in compressed-column order.
-    """
-
-    data: np.ndarray
-    indices: np.ndarray
-    indptr: np.ndarray
-    rows: np.ndarray
-    diagonal: np.ndarray
-    csc_order: np.ndarray
-    csc_indices: np.ndarray
-    csc_indptr: np.ndarray
-
-    @classmethod
-    def of(cls, W: sp.csr_matrix, d: int) -> ContactBlocks:
-        """The blocks of W (explicit zeros added where a diagonal block is not stored)."""
-        n = W.shape[0]
-        coo = W.tocoo()
-        eye = np.repeat(np.arange(n), d)  # every entry of each diagonal block, as zeros
-        cols = (eye // d) * d + np.tile(np.arange(d), n)
-        pattern = sp.coo_matrix((np.concatenate([coo.data, np.zeros(eye.size)]),
-                                 (np.concatenate([coo.row, eye]),
-                                  np.concatenate([coo.col, cols]))),
-                                shape=(n, n)).tobsr(blocksize=(d, d))
-        pattern.sort_indices()
-        rows = np.repeat(np.arange(n // d), np.diff(pattern.indptr))
-        diagonal = np.flatnonzero(pattern.indices == rows)
-        # the entries numbered 1, 2, … through scipy's conversion give the column order
-        places = sp.bsr_matrix((np.arange(1.0, pattern.data.size + 1.0).reshape(
-            pattern.data.shape), pattern.indices, pattern.indptr), shape=(n, n)).tocsc()
-        places.sort_indices()
-        return cls(pattern.data, pattern.indices, pattern.indptr, rows, diagonal,
-                   places.data.astype(np.int64) - 1, places.indices, places.indptr)
-
-    def jacobian(self, A: np.ndarray, B: np.ndarray, shift: float) -> sp.csc_matrix:
-        """J = A + shift·I + B W (A, B: one d×d block per contact), for a sparse LU."""
-        data = np.matmul(B[self.rows], self.data)
-        data[self.diagonal] += A + shift * np.eye(A.shape[1])
-        n = A.shape[0] * A.shape[1]
-        J = sp.csc_matrix((data.ravel()[self.csc_order], self.csc_indices.copy(),
-                           self.csc_indptr.copy()), shape=(n, n))
-        J.eliminate_zeros()  # rows B_c = 0 (a contact coming apart) add no work to the LU
-        return J
-
-
-class FrictionData:
-    """The problem's arrays as the friction methods use them, each built when first asked for
-    (a problem the compiled call certifies never needs its compressed rows): W as compressed
-    rows, W dense, ‖q‖, and the scale ρ_c of each contact's Alart–Curnier function
-    (:func:`scales`)."""
-
-    def __init__(self, program: FrictionProgram) -> None:
-        self.program = program
-        self.q = program.q
-        self.mu = kernel_mu(program.mu)
-        self.d = program.contact_dim
-        self.n = self.q.size
-        self._rows: sp.csr_matrix | None = None
-        self._dense: np.ndarray | None = None
-        self._qn: float | None = None
-        self._rho: np.ndarray | None = None
-        self._blocks: ContactBlocks | None = None
-
-    @property
-    def W(self) -> sp.csr_matrix:
-        """W as compressed rows (a dense W's nonzero entries, found in one compiled pass:
-        the price of one dense sweep, where W of contacts is mostly zeros)."""
-        if self._rows is None:
-            W = self.program.W
-            if sp.issparse(W):
-                self._rows = sp.csr_matrix(W, dtype=float)
-                self._rows.sum_duplicates()
-            else:
-                indptr, indices, data = nonzero_rows(np.ascontiguousarray(W, dtype=float))
-                self._rows = sp.csr_matrix((data, indices, indptr), shape=(self.n, self.n))
-        return self._rows
-
-    @property
-    def dense(self) -> np.ndarray:
-        """W as a dense C-contiguous float array."""
-        if self._dense is None:
-            W = self.program.W
-            self._dense = np.ascontiguousarray(W.toarray() if sp.issparse(W) else W,
-                                               dtype=float)
-        return self._dense
-
-    @property
-    def qn(self) -> float:
-        """‖q‖ (1 for q = 0)."""
-        if self._qn is None:
-            self._qn = norm(self.q) or 1.0
-        return self._qn
-
-    @property
-    def rho(self) -> np.ndarray:
-        if self._rho is None:
-            # a contiguous writable copy, the array kernels pass: one compiled signature
-            self._rho = scales(self.W.diagonal().copy(), self.d)
-        return self._rho
-
-    @property
-    def blocks(self) -> ContactBlocks:
-        """W in blocks of one contact by another (:class:`ContactBlocks`)."""
-        if self._blocks is None:
-            self._blocks = ContactBlocks.of(self.W, self.d)
-        return self._blocks
-
-    def velocity(self, r: np.ndarray) -> np.ndarray:
-        """u = W r + q."""
-        return self.W @ r + self.q
-
-    def error(self, r: np.ndarray) -> float:
-        """‖F(r)‖/‖q‖."""
-        return norm(natural_map(r, self.velocity(r), self.mu, self.d)) / self.qn
-
-    def finished(self, r: np.ndarray, f: float, tol: float) -> np.ndarray | None:
-        """r projected onto the cones when ‖F(r)‖ = ``f`` is within tol/2·‖q‖ and the
-        projected r too (projecting moves r by up to ‖F‖, hence u by up to ‖W‖‖F‖); else
-        None."""
-        if f > 0.5 * tol * self.qn:
-            return None
-        rp = project_cones(r, self.mu, self.d)
-        return rp if self.error(rp) <= 0.5 * tol else None
-
-
-def norm(x: np.ndarray) -> float:
-    """‖x‖₂ of a vector, summed by numpy's own loop rather than BLAS: OpenBLAS splits a dot
-    product of more than 10⁴ entries over its threads, which then spin on every core
-    between calls; on a loaded machine that made each norm of Newton on the 7,002-contact
-    granular flow cost ~8 ms and slowed the LU beside it two-fold (docs/theory.md §23)."""
-    x = np.ravel(x)
-    return math.sqrt(np.einsum("i,i->", x, x))
 
 
 def backtrack(r: np.ndarray, step: np.ndarray, f: float,
@@ -238,8 +76,8 @@ def newton_step(J: sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
 
 
 def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
-            max_steps: int = NEWTON_STEPS,
-            probe: tuple[int, float] | None = None) -> tuple[np.ndarray, int, bool]:
+            max_steps: int = NEWTON_STEPS, probe: tuple[int, float] | None = None,
+            stall: tuple[int, float, float] | None = None) -> tuple[np.ndarray, int, bool]:
     """Semismooth Newton on Alart–Curnier's function Φ (docs/theory.md §15) from r: steps
     (J + λI)Δ = −Φ with J = A + B W (A, B block-diagonal, from
     :func:`impactqp.kernels.friction.alart_curnier`) and λ = κ·min(‖Φ‖/‖Φ(0)‖, 10⁻²) (J is
@@ -250,8 +88,11 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
 
     Stops when the projected r is within tol/2 in ‖F‖/‖q‖ (projecting moves r by up to ‖F‖,
     hence u by up to ‖W‖‖F‖), after ``max_steps`` steps (a rejected step counts), when
-    the line search fails at the largest shift, or, with ``probe`` = (k, g), after k steps
-    that have not divided ‖F‖ by g (Newton still far from its fast convergence). Returns r
+    the line search fails at the largest shift, with ``probe`` = (k, g), after k steps
+    that have not divided ‖F‖ by g (Newton still far from its fast convergence), or, with
+    ``stall`` = (k, g, e), at the first k steps in a row that have not divided ‖F‖ by g
+    ending within ‖F‖/‖q‖ ≤ e (Newton stalled near the answer, docs/theory.md §15).
+    Returns r
     projected onto the cones, the steps done, and whether that r is within tol/2 (the
     certificate's figure)."""
     q, mu, d, rho = data.q, data.mu, data.d, data.rho
@@ -264,15 +105,16 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
     f = norm(phi)
     steps = 0
     boost = 1.0
-    first = -1.0
+    errors: list[float] = []  # ‖F‖ at r and after each step
     while True:
         f_nat = norm(natural_map(r, u, mu, d))
         rp = data.finished(r, f_nat, tol)
         if rp is not None:
             return rp, steps, True
-        first = f_nat if first < 0.0 else first
-        if steps == max_steps or (probe is not None and steps == probe[0]
-                                  and not f_nat * probe[1] <= first):
+        errors.append(f_nat)
+        if (steps == max_steps or _slow(errors, probe, only_first=True)
+                or (stall is not None and f_nat <= stall[2] * data.qn
+                    and _slow(errors, stall[:2], only_first=False))):
             break
         steps += 1
         shift = boost * kappa * min(f / (scale or 1.0), 1e-2)
@@ -294,6 +136,20 @@ def newton(data: FrictionData, r: np.ndarray, tol: float, kappa: float = 1.0,
         phi = alart_curnier(r, u, mu, rho, d, True, A, B)
         f = norm(phi)
     return project_cones(r, mu, d), steps, False
+
+
+def _slow(errors: list[float], window: tuple[int, float] | None, only_first: bool) -> bool:
+    """Whether the last k = ``window[0]`` steps of Newton (``errors``: ‖F‖ at its start and
+    after each step) have not divided ‖F‖ by g = ``window[1]``: asked after the first k steps
+    only when ``only_first`` (:func:`newton`'s probe), else after every step from the k-th
+    (its stall)."""
+    if window is None:
+        return False
+    k, gain = window
+    steps = len(errors) - 1
+    if steps < k or (only_first and steps > k):
+        return False
+    return not errors[-1] * gain <= errors[-1 - k]
 
 
 def lstsq_newton(data: FrictionData, r: np.ndarray, tol: float) -> tuple[np.ndarray, int, bool]:
