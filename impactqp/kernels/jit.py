@@ -93,9 +93,12 @@ def _cached_in_user_dir() -> Iterator[None]:
         numba.config.CACHE_DIR = chosen
 
 
-OPTIONS = {"nopython": True, "nogil": True, "error_model": "numpy", "boundscheck": None}
+OPTIONS = {"nopython": True, "nogil": True, "error_model": "numpy", "boundscheck": None,
+           "no_cfunc_wrapper": True}
 """numba's options for every kernel: ``error_model="numpy"`` lets a division by zero give
-inf/NaN (which every certificate then rejects) instead of raising."""
+inf/NaN (which every certificate then rejects) instead of raising; ``no_cfunc_wrapper``
+leaves out the wrapper numba builds for calls through a C function pointer, which nothing
+makes (kernels are called from Python or from other kernels)."""
 
 
 class InternalDispatcher(CPUDispatcher):
