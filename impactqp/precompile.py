@@ -195,8 +195,10 @@ def compile_kernels(progress: Callable[[str, int, int], None] | None = None,
     jobs : int
         Processes compiling at once (``impactqp compile`` uses one per core), each writing
         to the same cache: two run two groups of stages (``PAIRED``), more the stages one by
-        one, longest first. 1 compiles in this process (a dask worker, which may not start
-        processes of its own).
+        one, longest first. This process runs the first group (or stage) itself while
+        ``jobs`` − 1 processes it starts run the others: a process started imports
+        impactqp again, about a second before it compiles anything. 1 compiles in this
+        process alone (a dask worker, which may not start processes of its own).
 
     Returns
     -------
@@ -216,9 +218,14 @@ def compile_kernels(progress: Callable[[str, int, int], None] | None = None,
         NOTICE.say()
         context = multiprocessing.get_context("spawn")
         tasks = PAIRED if jobs == 2 else tuple((name,) for name in LONGEST_FIRST)
-        done = 0
-        with ProcessPoolExecutor(max_workers=min(jobs, len(tasks)), mp_context=context) as pool:
-            futures = {pool.submit(_run_stages, task, True): task for task in tasks}
+        own, others = tasks[0], tasks[1:]  # the longest in this process, imported already
+        with ProcessPoolExecutor(max_workers=min(jobs, len(tasks)) - 1,
+                                 mp_context=context) as pool:
+            futures = {pool.submit(_run_stages, task, True): task for task in others}
+            _run_stages(own, True)
+            done = len(own)
+            if progress is not None:
+                progress(", ".join(own), done, len(names))
             for future in as_completed(futures):
                 future.result()
                 done += len(futures[future])

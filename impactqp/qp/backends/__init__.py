@@ -146,8 +146,9 @@ Friction: cheapest where each works first — one compiled call for a few contac
 NSGS on well-conditioned problems, Newton from r = 0 most of the rest, Newton with local
 repairs where it stalls on a few contacts (docs/theory.md §22), the SOCP fixed point the
 badly conditioned ones, the damped and least-squares Newton some rank-deficient ones, a long
-NSGS last; the SOCP route, the least-squares Newton and the long NSGS start from the best
-answer so far (docs/theory.md §15, §22)."""
+NSGS last; the least-squares Newton and the long NSGS start from the best answer so far, the
+SOCP route too unless that answer lies between 10·tol and 1e-4 (from such a stalled answer
+it took 2–6 times longer than from r = 0) (docs/theory.md §15, §22)."""
 
 def sub_solvers(entry: Backend) -> list[dict]:
     """The solvers of :data:`SOLVERS` that ``entry`` runs, as ``"family:solver"``, each with
