@@ -31,7 +31,9 @@ MIDDLE = ("NESpheres-30", "BoxesStack1", "Confeti-ex03", "PerioBox")
 
 
 def general_route(problem: iq.FrictionContactProblem, tol: float = TOL):
-    """``auto`` without the route of a few contacts (nor its one sweep)."""
+    """``auto`` without the route of a few contacts (nor its one sweep); the pack an earlier
+    solve kept on ``problem`` is dropped, or a solve again would take it."""
+    problem.__dict__.pop(friction_small._KEPT, None)
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(methods, "SMALL_CONTACTS", 0)
         patch.setattr(friction_small, "SWEPT_CONTACTS", 0)
