@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from cone_reference import project_onto_cone
 
 import impactqp as iq
 from benchmarks.friction_data import load
@@ -41,17 +42,6 @@ def planar_pile(m: int, seed: int, mu: float = 0.5) -> iq.FrictionContactProblem
     return iq.FrictionContactProblem(W, q, mu, contact_dim=2)
 
 
-def reference_projection(x: np.ndarray, mu: float) -> np.ndarray:
-    """P_K of one contact (normal first), written here from the cone's definition: the point of
-    K_μ = {‖x_T‖ ≤ μ x_n} nearest x, by its three cases."""
-    xn, xt = x[0], x[1:]
-    t = float(np.linalg.norm(xt))
-    if t <= mu * xn:
-        return x.copy()
-    if mu * t <= -xn:
-        return np.zeros_like(x)
-    a = (xn + mu * t) / (1.0 + mu * mu)
-    return np.concatenate([[a], mu * a * xt / t])
 
 
 def test_arrays_are_kept_on_the_problem_between_solves() -> None:
@@ -157,7 +147,7 @@ def test_relaxed_sweeps_end_on_a_certified_answer_and_the_plain_sweeps_one(seed:
 
 @pytest.mark.parametrize("d", [2, 3])
 def test_a_relaxed_contact_is_the_projection_of_the_relaxed_point(d: int) -> None:
-    """relax_contact against the cone's definition (reference_projection) at random old and
+    """relax_contact against the cone's definition (project_onto_cone) at random old and
     new reactions, each of the projection's three cases met."""
     rng = np.random.default_rng(d)
     cases = set()
@@ -168,7 +158,7 @@ def test_a_relaxed_contact_is_the_projection_of_the_relaxed_point(d: int) -> Non
         before = r.copy()
         relax_contact(r, d, d, mu, omega, old[0], old[1], old[2] if d == 3 else 0.0)
         x = (1.0 - omega) * old + omega * new
-        expected = reference_projection(x, mu)
+        expected = project_onto_cone(x, mu)
         np.testing.assert_allclose(r[d:2 * d], expected, rtol=1e-13, atol=1e-15)
         np.testing.assert_array_equal(np.delete(r, range(d, 2 * d)),
                                       np.delete(before, range(d, 2 * d)))

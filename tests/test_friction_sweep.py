@@ -10,6 +10,7 @@ compared with W₀(r·a/b) + q₀ in the same units.
 
 import numpy as np
 import pytest
+from cone_reference import project_onto_cone
 
 import impactqp as iq
 from impactqp.errors import ImpactError, OutOfRangeError
@@ -52,15 +53,6 @@ def _problems() -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray, int]]:
 PROBLEMS = _problems()
 
 
-def _project(x: np.ndarray, mu: float) -> np.ndarray:
-    """P_{K_μ}(x) of one contact, K_μ = {‖x_T‖ ≤ μ x_n} (docs/theory.md §15)."""
-    t = np.linalg.norm(x[1:])
-    if t <= mu * x[0]:
-        return x.copy()
-    if mu * t <= -x[0]:
-        return np.zeros_like(x)
-    a = (x[0] + mu * t) / (1.0 + mu * mu)
-    return np.concatenate([[a], mu * a * x[1:] / t])
 
 
 def _judge(W0, q0, mu, d, r, u, a, b) -> float:
@@ -77,7 +69,7 @@ def _judge(W0, q0, mu, d, r, u, a, b) -> float:
         k = slice(c * d, c * d + d)
         ut = u0[k].copy()
         ut[0] += mu[c] * np.linalg.norm(u0[k][1:])  # De Saxcé's modified velocity
-        F[k] = r0[k] - _project(r0[k] - ut, mu[c])
+        F[k] = r0[k] - project_onto_cone(r0[k] - ut, mu[c])
     qn = np.linalg.norm(qt)
     return max(np.linalg.norm(F), np.linalg.norm(u / b / sigma - u0)) / qn
 

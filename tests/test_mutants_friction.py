@@ -2,9 +2,9 @@
 written here in numpy from the theory's formulas, written to kill the mutants
 benchmarks/mutation.py makes of impactqp/kernels/friction.py.
 
-The projection on K_μ is written here again from its closed form (docs/theory.md §15): x
-itself when ‖x_T‖ ≤ μx_n, 0 when μ‖x_T‖ ≤ −x_n, else a·(1, μx_T/‖x_T‖) with
-a = (x_n + μ‖x_T‖)/(1 + μ²).
+The projection on K_μ is the tests' own, from its closed form (tests/cone_reference.py,
+docs/theory.md §15): x itself when ‖x_T‖ ≤ μx_n, 0 when μ‖x_T‖ ≤ −x_n, else
+a·(1, μx_T/‖x_T‖) with a = (x_n + μ‖x_T‖)/(1 + μ²).
 """
 
 from __future__ import annotations
@@ -13,19 +13,9 @@ import math
 
 import numpy as np
 import pytest
+from cone_reference import project_onto_cone
 
 from impactqp.kernels.friction import certificate_sums, nsgs
-
-
-def _project(x: np.ndarray, mu: float) -> np.ndarray:
-    xn, xt = x[0], x[1:]
-    t = float(np.linalg.norm(xt))
-    if t <= mu * xn:
-        return x.copy()
-    if mu * t <= -xn:
-        return np.zeros_like(x)
-    a = (xn + mu * t) / (1.0 + mu * mu)
-    return np.concatenate([[a], mu * a * xt / t])
 
 
 def _reference_sums(r, u, mu, d):
@@ -34,11 +24,11 @@ def _reference_sums(r, u, mu, d):
         rc, uc = r[c * d:(c + 1) * d], u[c * d:(c + 1) * d]
         tilde = uc.copy()
         tilde[0] += m * float(np.linalg.norm(uc[1:]))  # ũ = u + μ‖u_T‖e_n
-        F = rc - _project(rc - tilde, m)
+        F = rc - project_onto_cone(rc - tilde, m)
         f2 += float(F @ F)
         comp += abs(float(rc @ tilde))
         pen += max(-uc[0], 0.0) ** 2
-        cone += float(np.sum((rc - _project(rc, m)) ** 2))
+        cone += float(np.sum((rc - project_onto_cone(rc, m)) ** 2))
     return f2, comp, pen, cone
 
 
