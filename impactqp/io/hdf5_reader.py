@@ -26,12 +26,19 @@ MAX_DATASET_BYTES = 2**30
 compressed dataset may declare far more than its file's size; it is refused before reading."""
 
 
+FCLIB_EXTRA = "fclib"
+"""The extra of impactqp's install that brings h5py (``pip install 'impactqp[fclib]'``)."""
+
+
 def h5py_module() -> Any:
-    """h5py, or an error naming the package to install."""
+    """h5py, or an error naming the extra that installs it: FCLib's HDF5 files need it,
+    Siconos' text files (:mod:`impactqp.io.siconos_text`) do not."""
     try:
         import h5py
     except ImportError:
-        raise OptionalDependencyError("FCLib files need h5py: pip install h5py") from None
+        raise OptionalDependencyError(
+            f"FCLib files (HDF5) need h5py: pip install 'impactqp[{FCLIB_EXTRA}]' (Siconos' "
+            "text files, .dat and .dat.gz, are read without it)") from None
     return h5py
 
 
