@@ -14,10 +14,10 @@ from .friction import contact_steps, next_check, relative_error
 from .friction_blocks import sticking
 from .friction_planar import planar_contact
 from .friction_slip import sliding_3d, sliding_from
-from .jit import kernel
+from .jit import inline_kernel, kernel
 
 
-@kernel
+@inline_kernel
 def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
     """:func:`~impactqp.kernels.friction.nsgs_contacts` by :func:`sweep_once` on W's
     compressed ``rows`` (scipy's CSR arrays) and ``blocks`` = (W_cc, ρ_c)
