@@ -88,10 +88,12 @@ def kernel_mu(mu: np.ndarray) -> np.ndarray:
     return np.array(mu, dtype=float)
 
 
-@inline_kernel
+@kernel(internal=True, refcounted=False)
 def natural_map_into(r, u, mu, d, F):
     """``F`` = r − P_{K_μ}(r − ũ) contact by contact, ũ = u + μ‖u_T‖e_n (F neither r nor
-    u): the one definition, without an array of its own."""
+    u): the one definition, without an array of its own. Compiled once, not inlined: its
+    callers (the sweeps' stopping test, the certificate of a few contacts, :func:`natural_map`)
+    would otherwise each compile its inlined helpers again."""
     for c in range(mu.size):
         k = c * d
         modified_contact(u, mu[c], k, d, F)
@@ -190,7 +192,7 @@ def alart_curnier(r, u, mu, rho, d, jac, A, B):
     return Phi
 
 
-@kernel
+@inline_kernel
 def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
     """:func:`nsgs_rows` on a dense W's nonzero entries
     (:func:`~impactqp.kernels.friction_blocks.nonzero_rows`)."""
@@ -198,7 +200,7 @@ def nsgs(W, q, mu, d, r, tol, max_sweeps, local_iters):
     return nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters)
 
 
-@kernel
+@inline_kernel
 def nsgs_rows(indptr, indices, data, q, mu, d, r, tol, max_sweeps, local_iters):
     """:func:`nsgs_contacts` on W's compressed rows (scipy's CSR arrays), W gathered by
     contacts at each call (:func:`~impactqp.kernels.friction_rows.contact_rows`)."""

@@ -170,7 +170,7 @@ def newton_dense(W, q, mu, rho, d, r, tol, kappa, max_steps):
     return steps, False
 
 
-@kernel
+@inline_kernel
 def _accept(W, q, mu, d, r, tol):
     """Whether P_K(r) is within tol/2 in ‖F‖/‖q‖; r is replaced by P_K(r) when it is."""
     qn = np.sqrt(np.sum(q * q))
@@ -187,7 +187,7 @@ ROUND_OFF = 1e-14
 from it and keeps it when better (:func:`to_round_off`)."""
 
 
-@kernel
+@inline_kernel
 def to_round_off(W, q, mu, rho, d, r, tol):
     """One Newton step from the sweeps' r (within tol/2), kept when it is better, unless r is
     within :data:`ROUND_OFF` already: as :func:`newton_dense` answers, the few contacts of a

@@ -17,7 +17,7 @@ from .friction_slip import sliding_3d, sliding_from
 from .jit import inline_kernel, kernel
 
 
-@kernel
+@inline_kernel
 def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
     """:func:`~impactqp.kernels.friction.nsgs_contacts` by :func:`sweep_once` on W's
     compressed ``rows`` (scipy's CSR arrays) and ``blocks`` = (W_cc, ρ_c)
@@ -27,10 +27,11 @@ def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
     angle (``slip`` of :func:`sweep_once`)."""
     indptr, indices, data = rows
     n = r.size
+    slip = np.bool_(True)  # not a literal: one compiled sweep_once serves solve_packed too
     u, F, scratch = np.empty(n), np.empty(n), np.empty(3 * d)
     err, last_err, last_at, check_at = np.inf, np.inf, 0, 1
     for sweep in range(max_sweeps):
-        sweep_once(rows, blocks, q, mu, d, r, local_iters, True, scratch)
+        sweep_once(rows, blocks, q, mu, d, r, local_iters, slip, scratch)
         done = sweep + 1
         if done < check_at and done < max_sweeps:
             continue
@@ -46,7 +47,7 @@ def nsgs_blocks(rows, blocks, q, mu, d, r, tol, max_sweeps, local_iters):
     return max_sweeps, err
 
 
-@inline_kernel
+@kernel(internal=True, refcounted=False)
 def sweep_once(rows, blocks, q, mu, d, r, local_iters, slip, scratch):
     """One sweep over the contacts on W's compressed ``rows`` and ``blocks`` (as
     :func:`nsgs_blocks` takes them), updating ``r`` in place (``scratch``: ≥ 3·d floats).
