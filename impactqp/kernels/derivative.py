@@ -35,7 +35,7 @@ import numpy as np
 
 from .active_set import _append, cholesky_solve
 from .impact import _unpack
-from .jit import kernel, read_only
+from .jit import inline_kernel, kernel
 
 SMOOTH, KINK, UNCERTIFIED, DEPENDENT = 0, 1, 2, 3
 """Status codes: of :func:`derivative_rows`' rows (the first three) and of the single
@@ -146,7 +146,7 @@ def classify_rows(G, s, R, M, Um, Lam, kink_tol, classes, codes):
         keys[r] = key if m <= MASK_BITS else 0
 
 
-@kernel
+@inline_kernel
 def factor_cell(G, active, cells, e):
     """Factor the cell of ``active`` into cell number ``e`` of ``cells``: G_AA = LLᵀ (a
     dependent contact is dropped, as in the active-set search) and K_AA = G_AA⁻¹ from it.
@@ -166,7 +166,7 @@ def factor_cell(G, active, cells, e):
     return k
 
 
-@kernel
+@inline_kernel
 def measure_cell(G, R, active, cells, e):
     """What cell ``e`` of ``cells`` depends on alone (docs/theory.md §20), from X =
     K_AA R_A: the inverse norms of the gradients in u⁻ of Λᵢ (active: −Xᵢ) and wᵢ
@@ -301,8 +301,8 @@ def derivative_rows(packed, Um, dU, Ubar, IE, settings, solved, out):
                     for f in range(residual.size):
                         slot[owner[f]] = -1
             e, used = used, used + 1
-            factor_cell(read_only(G), active[r], cells, e)  # typed as the single impact's
-            measure_cell(read_only(G), R, active[r], cells, e)
+            factor_cell(G, active[r], cells, e)
+            measure_cell(G, R, active[r], cells, e)
             if lookup:
                 slot[keys[r]], owner[e] = e, keys[r]
         if not residual[e] <= settings.tol:  # NaN fails

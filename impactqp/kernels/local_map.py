@@ -36,7 +36,7 @@ from .derivative import (
     new_cells,
 )
 from .impact import _unpack
-from .jit import inline_kernel, kernel, read_only
+from .jit import inline_kernel, kernel
 
 
 class Point(NamedTuple):
@@ -106,14 +106,14 @@ def local_cell(packed, Minv, E, eps, um, lam, kink_tol, out):
         return status[0]
     active = one.active[0]
     cells = new_cells(m, np.int64(0))  # typed as derivative_rows' call: one signature
-    k = factor_cell(read_only(ops.G), active, cells, np.int64(0))  # derivative_rows' types
+    k = factor_cell(ops.G, active, cells, 0)
     count = 0
     for i in range(m):
         flags[i] = 1.0 if active[i] else 0.0
         count += 1 if active[i] else 0
     if k < count:
         return DEPENDENT
-    measure_cell(read_only(ops.G), R, active, cells, np.int64(0))
+    measure_cell(ops.G, R, active, cells, 0)
     idx, KA = cells.idx[0], cells.K[0]
     p.K[:] = 0.0
     gnorm, knorm = 0.0, 0.0
