@@ -12,6 +12,7 @@ import impactqp as iq
 from impactqp.derivatives.complementarity import ComplementarityMap
 from impactqp.derivatives.impact import ImpactDerivative
 from impactqp.kernels import derivative as cells_kernel
+from impactqp.kernels.impact import solve_impact_rows
 
 LAWS = [iq.Moreau(0.5), iq.Newton(0.3), iq.Newton([0.1, 0.9, 0.4, 0.0, 0.7]),
         iq.Fremond(0.2 * np.eye(5) + 0.04)]
@@ -129,17 +130,18 @@ def test_kernel_rows_mark_kinks_and_uncertified_rows() -> None:
     U, dU, Ub = (rng.normal(size=(k, 3)) for _ in range(3))
     U[5], U[6] = [1.0, 0.0, 0.5], [2.0, 0.0, 1.0]  # the three-ball kink, twice
     U[[10, 30]] = np.nan
-    spec = cells_kernel.Law(np.zeros((2, 2)), 0.0, True, np.eye(2))
-    out = cells_kernel.Rows(np.empty((k, 3)), np.empty((k, 2)), np.empty((k, 6)),
-                            np.empty((k, 3)), np.empty((k, 3)), np.empty(k, dtype=np.int64),
-                            np.empty(k))
+    Up, Lam, _, solved = solve_impact_rows(p.structure.kernel_pack, U, np.zeros((2, 2)), 0.0,
+                                           True, 1e-9, np.zeros(2, dtype=bool))
+    assert list(np.flatnonzero(~solved)) == [10, 30]
+    out = cells_kernel.Rows(Up, Lam, np.empty((k, 3)), np.empty((k, 3)),
+                            np.empty(k, dtype=np.int64), np.empty(k))
 
-    def run(tol: float, solved: bool) -> None:
-        settings = cells_kernel.Settings(tol, 1e-9, True, True, solved)
-        cells_kernel.derivative_rows(p.structure.kernel_pack, U, dU, Ub, spec, settings,
-                                     np.zeros(2, dtype=bool), out)
+    def run(tol: float) -> None:
+        settings = cells_kernel.Settings(tol, 1e-9, True, True)
+        cells_kernel.derivative_rows(p.structure.kernel_pack, U, dU, Ub, np.eye(2), settings,
+                                     solved, out)
 
-    run(1e-9, False)
+    run(1e-9)
     names = {cells_kernel.SMOOTH: "smooth", cells_kernel.KINK: "kink"}
     for i in range(k):
         if i in (10, 30):
@@ -151,5 +153,6 @@ def test_kernel_rows_mark_kinks_and_uncertified_rows() -> None:
         assert np.allclose(out.dUp[i], d.jvp(u_minus=dU[i]).u_plus, atol=1e-12)
         assert np.allclose(out.Ubar[i], d.vjp(u_plus=Ub[i])["u_minus"], atol=1e-12)
         assert np.isclose(out.margin[i], d.certificate.margin, rtol=1e-9)
-    run(-1.0, True)  # the solved rows again, no cell's residual within the tolerance
+    solved[:] = True  # every row again, no cell's residual within the tolerance
+    run(-1.0)
     assert (out.status == cells_kernel.UNCERTIFIED).all() and np.isnan(out.margin).all()

@@ -2,12 +2,12 @@
 (docs/theory.md §18–§20).
 
 Dense impacts of a compiled complementarity family (Moreau, local Newton, Frémond; where the
-compiled single impact applies) run the compiled kernel
-:func:`impactqp.kernels.derivative.derivative_rows` in the chunks of
-:func:`impactqp.solve_batch`: each row is solved, certified and differentiated on its active
-set with one factor of G_AA (short chains are solved by :func:`impactqp.solve_batch`'s
-column path first, then only differentiated). Other laws, and rows the kernel does not
-certify, go one by one through :func:`impactqp.solve` and ``result.derivative()``.
+compiled single impact applies) are solved and certified in the chunks of
+:func:`impactqp.solve_batch` by its compiled rows
+(:func:`impactqp.kernels.impact.solve_impact_rows`; short chains by its column path), then
+differentiated by :func:`impactqp.kernels.derivative.derivative_rows`, each row on its
+active set with one factor of G_AA. Other laws, and rows the kernel does not certify, go one
+by one through :func:`impactqp.solve` and ``result.derivative()``.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from ..base.arrays import as_array, as_count
 from ..base.checks import DEFAULT_TOL
 from ..errors import DerivativeUnsupportedError, ShapeError
 from ..kernels import derivative as compiled
+from ..kernels.impact import solve_impact_rows
 from ..kernels.jit import read_only
 from ..laws import small
 from ..laws.base import MOREAU_FAMILY
@@ -77,30 +78,32 @@ def _compiled(problem, law, U, dU, Ubar, tol, kink_tol, n_jobs):
     k, n, m = U.shape[0], st.n, st.m
     moreau = law.family == MOREAU_FAMILY
     E = small.restitution_for(law, m)
+    eps = law.eps if moreau else 0.0
     IE = np.eye(m) + (law.eps * np.eye(m) if moreau else E)
-    spec = compiled.Law(E, law.eps if moreau else 0.0, moreau, IE)
-    solved = plan(problem, law, "auto", mode="batch").path == "chain"
-    settings = compiled.Settings(tol, kink_tol, dU is not None, Ubar is not None, solved)
+    settings = compiled.Settings(tol, kink_tol, dU is not None, Ubar is not None)
     dUp, Uout = np.empty((k, n)) if dU is not None else None, \
         np.empty((k, n)) if Ubar is not None else None
-    if solved:  # a short chain: its columns solve faster than rows; differentiate after
+    chain = plan(problem, law, "auto", mode="batch").path == "chain"
+    if chain:  # a short chain: its columns solve faster than rows; differentiate after
         done = solve_batch(problem, law, U, tol=tol, n_jobs=n_jobs)
-        Up, Lam = done.u_plus, done.impulses
+        Up, Lam, solved = done.u_plus, done.impulses, np.ones(k, dtype=bool)
     else:
-        Up, Lam = np.empty((k, n)), np.empty((k, m))
-    out = compiled.Rows(Up, Lam, np.empty((k, 6)), dUp, Uout, np.empty(k, dtype=np.int64),
-                        np.empty(k))
+        Up, Lam, solved = np.empty((k, n)), np.empty((k, m)), np.empty(k, dtype=bool)
+    out = compiled.Rows(Up, Lam, dUp, Uout, np.empty(k, dtype=np.int64), np.empty(k))
     placeholder = np.zeros((1, n))
 
     def work(a: int, b: int) -> np.ndarray:
-        rows = compiled.Rows(*(x[a:b] for x in out[:3]),
+        Ua = read_only(np.ascontiguousarray(U[a:b]))
+        if not chain:  # the batch's compiled rows, each chunk from its own cold support
+            Up[a:b], Lam[a:b], _, solved[a:b] = solve_impact_rows(
+                st.kernel_pack, Ua, E, eps, moreau, tol, np.zeros(m, dtype=bool))
+        rows = compiled.Rows(Up[a:b], Lam[a:b],
                              placeholder.copy() if dUp is None else dUp[a:b],
                              placeholder.copy() if Uout is None else Uout[a:b],
                              out.status[a:b], out.margin[a:b])
-        compiled.derivative_rows(st.kernel_pack, read_only(np.ascontiguousarray(U[a:b])),
-                                 placeholder if dU is None else dU[a:b],
-                                 placeholder if Ubar is None else Ubar[a:b], spec, settings,
-                                 np.zeros(m, dtype=bool), rows)
+        compiled.derivative_rows(st.kernel_pack, Ua, placeholder if dU is None else dU[a:b],
+                                 placeholder if Ubar is None else Ubar[a:b], IE, settings,
+                                 solved[a:b], rows)
         return a + np.flatnonzero(rows.status == compiled.UNCERTIFIED)
 
     return out, _in_chunks(k, work, n_jobs)

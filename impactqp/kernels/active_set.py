@@ -125,7 +125,7 @@ def _member(idx, k, i):
     return False
 
 
-@kernel(internal=True)
+@inline_kernel
 def _to_minimizer(L, idx, k, G, q, x, s, joined):
     """Move x towards the minimizer of the quadratic on P = idx[:k] until it is reached with
     x_P > 0, dropping the variables that reach zero on the way (Lawson–Hanson's inner loop).
@@ -171,7 +171,7 @@ def _to_minimizer(L, idx, k, G, q, x, s, joined):
     return k, True
 
 
-@kernel(internal=True)
+@inline_kernel
 def _final_solve(L, idx, k, G, q, x, w, s):
     """The solution on the final support as a function of the support alone (indices in
     order, a fresh factor, one step of iterative refinement), so that the path that found it

@@ -1,8 +1,9 @@
 """Derivatives of many dense impacts of a complementarity law, in compiled code
 (docs/theory.md §18–§20).
 
-Each row is solved and certified by the compiled impact (:mod:`impactqp.kernels.impact`)
-and classified; its cell (active set A) is factored once — G_AA = LLᵀ, dependent columns
+The rows come solved and certified (by the compiled impacts of
+:func:`impactqp.kernels.impact.solve_impact_rows`, or a batch's chain path): each is
+classified; its cell (active set A) is factored once — G_AA = LLᵀ, dependent columns
 dropped as in the active-set search, K_AA = G_AA⁻¹ from the factor — with what depends on A
 alone: the gradients in u⁻ of the quantities bounding the cell and the relative residual
 ‖G_AA K_AA R_A − R_A‖ / ‖R_A‖ of its linear solves (a wrong factor shows there). Up to
@@ -33,7 +34,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .active_set import _append, cholesky_solve
-from .impact import _solve_into, _unpack, workspace
+from .impact import _unpack
 from .jit import inline_kernel, kernel
 
 SMOOTH, KINK, UNCERTIFIED, DEPENDENT = 0, 1, 2, 3
@@ -48,36 +49,23 @@ CACHED_CELLS = 64
 and the cells refilled)."""
 
 
-class Law(NamedTuple):
-    """The compiled complementarity law: E for the solve (Frémond, Newton), ε and the
-    Moreau flag, and IE = I + E (m × m) for the derivative."""
-
-    E: np.ndarray
-    eps: float
-    moreau: bool
-    IE: np.ndarray
-
-
 class Settings(NamedTuple):
-    """Tolerances and what to compute: the certificate's ``tol``, the degeneracy
-    ``kink_tol`` (docs/theory.md §19), whether JVP and VJP rows are asked for, and whether
-    the rows come solved and certified (U⁺ and Λ already in the outputs, from another fast
-    path of the batch) so that only their derivatives are computed."""
+    """Tolerances and what to compute: the tolerance ``tol`` of a cell's linear solves,
+    the degeneracy ``kink_tol`` (docs/theory.md §19) and whether JVP and VJP rows are
+    asked for."""
 
     tol: float
     kink_tol: float
     jvp: bool
     vjp: bool
-    solved: bool
 
 
 class Rows(NamedTuple):
-    """Outputs, one row per impact: U⁺, Λ, residuals (k × 6), JVP rows du⁺, VJP rows ū⁻,
-    status codes and margins."""
+    """One row per impact: U⁺ and Λ (inputs, the rows' certified answers), then the
+    outputs: JVP rows du⁺, VJP rows ū⁻, status codes and margins."""
 
     Up: np.ndarray
     Lam: np.ndarray
-    Res: np.ndarray
     dUp: np.ndarray
     Ubar: np.ndarray
     status: np.ndarray
@@ -276,24 +264,21 @@ def finish_rows(Um, Lam, classes, cells, R, YT, dU, Ubar, settings, out, start, 
 
 
 @kernel
-def derivative_rows(packed, Um, dU, Ubar, law, settings, passive, out):
-    """Solve, certify and differentiate every row of U⁻ into ``out`` (:class:`Rows`); a
-    row that the compiled solve does not certify, or whose cell's linear solves miss the
-    tolerance, gets status UNCERTIFIED (the caller answers it on its own)."""
+def derivative_rows(packed, Um, dU, Ubar, IE, settings, solved, out):
+    """Differentiate every row of U⁻ whose answer (U⁺, Λ in ``out``, :class:`Rows`) the
+    caller has certified (``solved``, one flag per row) into ``out``, with IE = I + E
+    (m × m) of the law; the other rows, and rows whose cell's linear solves miss the
+    tolerance, get status UNCERTIFIED (the caller answers them on its own). Solving the
+    rows is left to :func:`impactqp.kernels.impact.solve_impact_rows`, so that this
+    kernel's compile holds no second copy of the solve."""
     k_rows, n = Um.shape
-    m = passive.size
+    m = IE.shape[0]
     ops = _unpack(packed, n, m)
-    R = law.IE @ ops.Wt  # ∂q/∂u⁻ and Yᵀ, the same for every row
+    R = IE @ ops.Wt  # ∂q/∂u⁻ and Yᵀ, the same for every row
     YT = np.ascontiguousarray(ops.MinvW.T)
     # contiguous copies of the packed views: the row loops index them faster
     G, s, M = ops.G.copy(), ops.s.copy(), ops.M.copy()
     Lam, codes, margin = out.Lam, out.status, out.margin
-    solved = np.ones(k_rows, dtype=np.bool_)
-    if not settings.solved:
-        work = workspace(n, m)
-        for r in range(k_rows):
-            solved[r] = _solve_into(ops, Um[r], law.E, law.eps, law.moreau, settings.tol,
-                                    passive, out.Up[r], Lam[r], out.Res[r], work)
     classes = Classes(np.empty((k_rows, m)), np.empty((k_rows, m), dtype=np.bool_),
                       np.empty(k_rows, dtype=np.int64), np.full(k_rows, -1, dtype=np.int64))
     classify_rows(G, s, R, M, Um, Lam, settings.kink_tol, classes, codes)

@@ -91,9 +91,14 @@ def local_cell(packed, Minv, E, eps, um, lam, kink_tol, out):
     size = point_size(n, m)
     p = unpack_point(out[:size], n, m)
     w, flags, figures = out[size:size + m], out[size + m:size + 2 * m], out[size + 2 * m:]
-    IE = np.eye(m) * (1.0 + eps) if E.size == 0 else np.eye(m) + E
+    IE = p.IE  # I + E, or (1 + ε)I; loops: np.eye and array expressions compile slowly
+    for c in range(m):
+        for b in range(m):
+            diagonal = 1.0 if c == b else 0.0
+            IE[c, b] = diagonal * (1.0 + eps) if E.size == 0 else diagonal + E[c, b]
     R = IE @ ops.Wt
-    ints = np.zeros(3, dtype=np.int64)  # the batch's classification of one row, in cell 0
+    ints = np.empty(3, dtype=np.int64)  # the batch's classification of one row, in cell 0
+    ints[1] = 0
     one = Classes(w.reshape((1, m)), np.empty((1, m), dtype=np.bool_), ints[:1], ints[1:2])
     Um, Lam, status = um.reshape((1, n)), lam.reshape((1, m)), ints[2:]
     classify_rows(ops.G, ops.s, R, ops.M, Um, Lam, kink_tol, one, status)
@@ -128,8 +133,6 @@ def local_cell(packed, Minv, E, eps, um, lam, kink_tol, out):
             p.W[a, c] = ops.Wt[c, a]
     for c in range(m):
         p.lam[c] = lam[c]
-        for b in range(m):
-            p.IE[c, b] = IE[c, b]
     for i in range(m):
         total = 0.0
         for c in range(n):

@@ -38,7 +38,7 @@ from .active_set import SOLVED, lcp_psd_work
 from .chain import project
 from .clusters import group, group_work
 from .events import full, mark, open_record, put_floats, put_ints, rollback
-from .jit import kernel, read_only
+from .jit import inline_kernel, kernel, read_only
 from .residuals import chain_step_residuals, dense_step_residuals
 from .step import activation, end_step, free_velocity, linear_gaps, rows_times, step_q
 
@@ -98,7 +98,7 @@ def worst_step(n: int, m: int) -> np.ndarray:
     return np.array([n, n + m, CHECKED * n + 3 * n + m], dtype=np.int64)
 
 
-@kernel(internal=True)
+@inline_kernel
 def _work(n, m, chain):
     """Scratch of a run: the clusters' buffers, the dense or chain solves' scratch."""
     dense = 0 if chain else n
@@ -115,7 +115,7 @@ def _work(n, m, chain):
             np.empty(6), np.empty(2 * n + 2 * m))
 
 
-@kernel(internal=True)
+@inline_kernel
 def _solve_dense(cl, contacts, law, tol, dense_work, res, work):
     """One cluster ``cl`` = (dofs D, contacts C, u⁻, v_k, u⁺, Λ, q) by the active-set search
     on G_CC, u⁺ = u⁻ + (Ŵ⁻¹H)_DC Λ and the dense certificate; True when certified (then
@@ -173,7 +173,7 @@ def _solve_dense(cl, contacts, law, tol, dense_work, res, work):
     return True
 
 
-@kernel(internal=True)
+@inline_kernel
 def _solve_chain(cl, units, chain, left, right, tol, chain_work, res):
     """One run ``cl`` of a chain (balls D, contacts C) with one restitution e, as the
     isotonic path solves it (docs/theory.md §14): z = prox_{T_C}(u⁻ + e v_k) by
@@ -208,7 +208,7 @@ def _solve_chain(cl, units, chain, left, right, tol, chain_work, res):
     return True
 
 
-@kernel(internal=True)
+@inline_kernel
 def _record(events, k, D, C, res, um, up, vp, lam):
     """Record a solved cluster (dofs D, contacts C) of step k."""
     nc, mc = D.size, C.size

@@ -21,7 +21,7 @@ import scipy.sparse as sp
 from ..base.arrays import as_dense
 from ..derivatives.lcp import ActiveSet, classify, tangent
 from ..kernels.sensitivity import StepMaps, StepTangents, adjoint, forward
-from ..kernels.step import activation, predicted_gap
+from ..kernels.step import activation, gap_ahead
 from ..laws.base import ImpactLaw
 from .sensitivity import Columns, Sensitivities, TrajectoryKink, full_restitution
 from .system import LinearSystem
@@ -114,7 +114,7 @@ def chained(system: LinearSystem, maps: StepMaps, Q: np.ndarray, V: np.ndarray,
     h, tol, t0 = settings["h"], settings["tol"], settings["t0"]
     gaps = np.atleast_2d(system.gaps(Q[:-1]))
     gam = np.atleast_2d(system.contact_velocities(V))
-    predicted = predicted_gap(gaps, gam[:-1], h)  # the activation rule's own quantity
+    predicted = gap_ahead(gaps, gam[:-1], h)  # the activation rule's own quantity
     closed = np.empty(gaps.size, dtype=bool)
     activation(np.ascontiguousarray(gaps).ravel(), np.ascontiguousarray(gam[:-1]).ravel(), h,
                closed)
