@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from declared_dependencies import declared
 
 import impactqp as iq
 from impactqp.cli.main import main
@@ -149,12 +150,7 @@ def test_a_solver_that_is_absent_is_refused_by_name_with_its_extra(
 
 
 def test_the_extra_named_in_the_refusal_is_the_one_pyproject_declares() -> None:
-    tomllib = pytest.importorskip("tomllib")
-    root = Path(__file__).resolve().parent.parent
-    project = tomllib.loads((root / "pyproject.toml").read_text())["project"]
-    core = {d.split(">")[0].split(";")[0].strip() for d in project["dependencies"]}
-    extras = {name: {d.split(">")[0].strip() for d in deps}
-              for name, deps in project["optional-dependencies"].items()}
+    core, extras = declared()
     assert "cvxpy-base" in core and "cvxpy" not in core  # no bundled scs/highspy
     for solver in backends.SOLVERS.values():
         if solver.extra == "":

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from declared_dependencies import declared
 
 import impactqp as iq
 from impactqp.cli import main
@@ -29,20 +30,8 @@ def without_h5py(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "h5py", None)
 
 
-def _extras() -> tuple[set[str], dict[str, set[str]]]:
-    tomllib = pytest.importorskip("tomllib")
-    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
-
-    def name(requirement: str) -> str:
-        return requirement.split(">")[0].split(";")[0].strip()
-
-    core = {name(d) for d in project["dependencies"]}
-    extras = {k: {name(d) for d in v} for k, v in project["optional-dependencies"].items()}
-    return core, extras
-
-
 def test_h5py_is_the_extra_the_refusal_names_and_what_tests_and_docs_install() -> None:
-    core, extras = _extras()
+    core, extras = declared()
     assert "h5py" not in core
     assert extras[FCLIB_EXTRA] == {"h5py"}
     assert "h5py" in extras["test"]  # the suite reads FCLib files
