@@ -156,3 +156,30 @@ def test_kernel_rows_mark_kinks_and_uncertified_rows() -> None:
     solved[:] = True  # every row again, no cell's residual within the tolerance
     run(-1.0)
     assert (out.status == cells_kernel.UNCERTIFIED).all() and np.isnan(out.margin).all()
+
+
+def test_a_row_the_compiled_solve_does_not_certify_is_answered_on_its_own(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """derivative_batch differentiates only the rows its compiled solve certified: a row it
+    reports uncertified (its u⁺ and Λ left as garbage) is solved and differentiated one by one,
+    and gets what that row's own derivative gives."""
+    import impactqp.derivatives.batch as batch
+
+    def one_row_uncertified(*args: object) -> tuple:
+        Up, Lam, Res, ok = solve_impact_rows(*args)
+        Up[3], Lam[3], ok[3] = 1e3, -1e3, False  # the chunk's fourth row
+        return Up, Lam, Res, ok
+
+    monkeypatch.setattr(batch, "solve_impact_rows", one_row_uncertified)
+    law = iq.Moreau(0.3)
+    p = iq.random_impact(6, 4, seed=8, consistent=False)
+    rng = np.random.default_rng(3)
+    U, dU = rng.normal(size=(8, 6)), rng.normal(size=(8, 6))
+    b = iq.derivative_batch(p, law, U, jvp=dU)
+    assert b.backend == "kernel"
+    for i in range(8):
+        d = iq.derivative(p.with_u_minus(U[i]), law)
+        assert np.allclose(b.u_plus[i], iq.solve(p.with_u_minus(U[i]), law).u_plus,
+                           atol=1e-12)
+        assert b.status[i] == d.status
+        assert np.allclose(b.jvp[i], d.jvp(u_minus=dU[i]).u_plus, atol=1e-12)
