@@ -9,10 +9,12 @@ import math
 import numpy as np
 import pytest
 import scipy.linalg
+import scipy.sparse
 
 import impactqp as iq
-from impactqp.kernels.friction_blocks import sticking
+from impactqp.kernels.friction_blocks import diagonal_blocks, local_steps, sticking
 from impactqp.kernels.friction_slip import _slip_at, _slip_terms, sliding_3d, sliding_from
+from impactqp.kernels.friction_sweep import nsgs_blocks
 from impactqp.laws import friction_small
 from impactqp.laws.friction_small import SmallFrictionResult
 from impactqp.model.friction import certify_friction
@@ -159,3 +161,20 @@ def test_coupled_sliding_contacts_agree_with_the_general_route(seed: int) -> Non
             iq.FrictionContactProblem(coupled, problem.q, 0.3, contact_dim=3), tol=TOL)
     assert general.backend != "kernel" and general.certificate.ok
     np.testing.assert_allclose(fast.u, general.u, atol=1e-5 * np.linalg.norm(problem.q))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_sweeps_after_the_first_solve_sliding_contacts_by_their_slip_angle(
+        seed: int) -> None:
+    """The sweeps that go on after the first one (nsgs_blocks, which solve_packed's
+    sweeps_on runs) solve each sliding contact exactly too: on a block-diagonal W one of them
+    from r = 0 ends the problem to round-off, where local fixed-point steps would not."""
+    problem = decoupled_problem(3, seed)
+    W = scipy.sparse.csr_matrix(problem.W)
+    rows = (W.indptr, W.indices, W.data)
+    Wcc = diagonal_blocks(W.indptr, W.indices, W.data, 3, 3)
+    r = np.zeros(9)
+    mu = np.full(3, 0.3)
+    done, err = nsgs_blocks(rows, (Wcc, local_steps(Wcc)), problem.q, mu, 3, r, 1e-30, 1, 3)
+    assert done == 1 and err <= 1e-14
+    assert certify_friction(problem, r, problem.W @ r + problem.q, tol=1e-13).ok
